@@ -28,10 +28,12 @@ setup(
     zip_safe=True,
     maintainer='Swarm search maintainers',
     maintainer_email='maintainers@swarm-search.org',
-    description='Bayes-Swarm-P decentralized batch Bayesian source seeking and its baselines (Bayes-Swarm-O, Glowworm, Levy walk, exhaustive search).',
+    description=(
+        'Bayes-Swarm-P decentralized batch Bayesian source seeking and its baselines '
+        '(Bayes-Swarm-O, Glowworm, Levy walk, exhaustive search).'
+    ),
     license='Apache-2.0',
     entry_points={
-        'console_scripts': [
-        ],
+        'console_scripts': [],
     },
 )

@@ -28,10 +28,12 @@ setup(
     zip_safe=True,
     maintainer='Swarm search maintainers',
     maintainer_email='maintainers@swarm-search.org',
-    description='Hardware driver nodes: RPLidar A1, MP503 gas sensor through an ADC, MPU6050 IMU, Silicon Labs BG22 AoA locator receiver, pump on a GPIO.',
+    description=(
+        'Hardware driver nodes: RPLidar A1, MP503 gas sensor through an ADC, MPU6050 IMU,'
+        ' Silicon Labs BG22 AoA locator receiver, pump on a GPIO.'
+    ),
     license='Apache-2.0',
     entry_points={
-        'console_scripts': [
-        ],
+        'console_scripts': [],
     },
 )

@@ -28,10 +28,12 @@ setup(
     zip_safe=True,
     maintainer='Swarm search maintainers',
     maintainer_email='maintainers@swarm-search.org',
-    description='Multi-target RSSI search and capture: MSC with a particle filter (proposed swarm control) and the MSC and MSC+PF reference schemes.',
+    description=(
+        'Multi-target RSSI search and capture: MSC with a particle filter (proposed swarm'
+        ' control) and the MSC and MSC+PF reference schemes.'
+    ),
     license='Apache-2.0',
     entry_points={
-        'console_scripts': [
-        ],
+        'console_scripts': [],
     },
 )

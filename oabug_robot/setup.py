@@ -28,10 +28,12 @@ setup(
     zip_safe=True,
     maintainer='Swarm search maintainers',
     maintainer_email='maintainers@swarm-search.org',
-    description='OA-Bug swarm exploration (scent trail + AoA bearings, no map) and its four ablations, as a per-robot ROS 2 node.',
+    description=(
+        'OA-Bug swarm exploration (scent trail + AoA bearings, no map) and its four '
+        'ablations, as a per-robot ROS 2 node.'
+    ),
     license='Apache-2.0',
     entry_points={
-        'console_scripts': [
-        ],
+        'console_scripts': [],
     },
 )

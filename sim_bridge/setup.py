@@ -35,7 +35,10 @@ setup(
     zip_safe=True,
     maintainer='Swarm search maintainers',
     maintainer_email='maintainers@swarm-search.org',
-    description="pybullet simulation bridge publishing the robots' sensor topics, site generator and layout importer, signal fields, and the launch-free spawner.",
+    description=(
+        "pybullet simulation bridge publishing the robots' sensor topics, site generator "
+        'and layout importer, signal fields, and the launch-free spawner.'
+    ),
     license='Apache-2.0',
     entry_points={
         'console_scripts': [],

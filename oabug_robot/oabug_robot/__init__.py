@@ -1,1 +1,3 @@
-"""OA-Bug swarm exploration (scent trail + AoA bearings, no map) and its four ablations, as a per-robot ROS 2 node."""
+"""OA-Bug swarm exploration (scent trail + AoA bearings, no map) and its four ablations, as a per-
+robot ROS 2 node.
+"""

@@ -28,7 +28,10 @@ setup(
     zip_safe=True,
     maintainer='Swarm search maintainers',
     maintainer_email='maintainers@swarm-search.org',
-    description='Bag replay, mission metrics (coverage, relative completion time, capture completion time), plots and experiment reports.',
+    description=(
+        'Bag replay, mission metrics (coverage, relative completion time, capture '
+        'completion time), plots and experiment reports.'
+    ),
     license='Apache-2.0',
     entry_points={
         'console_scripts': [],

@@ -28,7 +28,11 @@ setup(
     zip_safe=True,
     maintainer='Swarm search maintainers',
     maintainer_email='maintainers@swarm-search.org',
-    description='The ROS indirection for swarm nodes: real rclpy when present, otherwise a deterministic built-in sim-time runtime with rclpy-like message classes, plus rosbag2 MCAP recording and replay.',
+    description=(
+        'The ROS indirection for swarm nodes: real rclpy when present, otherwise a '
+        'deterministic built-in sim-time runtime with rclpy-like message classes, plus '
+        'rosbag2 MCAP recording and replay.'
+    ),
     license='Apache-2.0',
     entry_points={
         'console_scripts': [],

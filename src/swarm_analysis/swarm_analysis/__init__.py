@@ -1,1 +1,3 @@
-"""Bag replay, mission metrics (coverage, relative completion time, capture completion time), plots and experiment reports."""
+"""Bag replay, mission metrics (coverage, relative completion time, capture completion time), plots
+and experiment reports.
+"""

@@ -27,6 +27,7 @@ from types import ModuleType
 from typing import Any
 
 __all__ = [
+    'RUNTIME_ENV_VAR',
     'Duration',
     'ExternalShutdownException',
     'HistoryPolicy',
@@ -35,7 +36,6 @@ __all__ = [
     'QoSDurabilityPolicy',
     'QoSProfile',
     'ReliabilityPolicy',
-    'RUNTIME_ENV_VAR',
     'SingleThreadedExecutor',
     'Time',
     'message_module',
