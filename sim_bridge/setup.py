@@ -41,6 +41,11 @@ setup(
     ),
     license='Apache-2.0',
     entry_points={
-        'console_scripts': [],
+        'console_scripts': [
+            'sim_bridge = sim_bridge.bridge_node:main',
+            'spawn = sim_bridge.spawn:main',
+            'spawn_bayes_swarm = sim_bridge.spawn_bayes_swarm:main',
+            'spawn_msc_pf = sim_bridge.spawn_msc_pf:main',
+        ],
     },
 )

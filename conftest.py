@@ -1,0 +1,14 @@
+"""Test-session settings shared by every package's tests.
+
+The suite runs the way a careful robot deployment should be checked: generated message
+classes validate every field assignment (as Jazzy does with ROS_PYTHON_CHECK_FIELDS=1), and
+the built-in runtime round-trips every published message through CDR, so a value that a
+robot could not serialize fails here. Both are set before any test module imports a
+message class; an explicit setting in the environment wins.
+"""
+
+import os
+
+os.environ.setdefault('ROS_PYTHON_CHECK_FIELDS', '1')
+os.environ.setdefault('SWARM_RUNTIME_CDR_ROUNDTRIP', '1')
+os.environ.setdefault('MPLBACKEND', 'Agg')
