@@ -1,0 +1,54 @@
+#!/usr/bin/env bash
+# Prepare a development machine: Debian packages the tests need, then one virtualenv (.venv)
+# with every ament_python package of the workspace installed editable from its own setup.py,
+# all third-party versions taken from constraints.txt.
+#
+# Safe to run repeatedly: it does nothing when the virtualenv is already up to date.
+# Environment: PYTHON (interpreter for the virtualenv, default python3), VENV (default .venv).
+set -euo pipefail
+
+cd "$(dirname "$0")/.."
+PYTHON=${PYTHON:-python3}
+VENV=${VENV:-.venv}
+PACKAGES=(src/swarm_runtime src/swarm_analysis oabug_robot bayes_swarm msc_pf hw_drivers sim_bridge)
+# Debian packages: the real ROS message parser and package.xml tools used by the tests.
+APT_PACKAGES=(python3-rosidl python3-catkin-pkg python3-ament-xmllint)
+
+log() { printf '[bootstrap] %s\n' "$*"; }
+
+install_debian_packages() {
+  local missing=()
+  for pkg in "${APT_PACKAGES[@]}"; do
+    dpkg-query -W -f='${Status}' "$pkg" 2>/dev/null | grep -q 'install ok installed' || missing+=("$pkg")
+  done
+  [ ${#missing[@]} -eq 0 ] && return 0
+  if ! command -v apt-get >/dev/null; then
+    log "missing Debian packages ${missing[*]} and no apt-get: the .msg lint tests will fail"
+    return 0
+  fi
+  local sudo=()
+  [ "$(id -u)" -eq 0 ] || sudo=(sudo)
+  log "installing ${missing[*]}"
+  "${sudo[@]}" apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive "${sudo[@]}" apt-get install -y -qq "${missing[@]}" >/dev/null
+}
+
+install_python_packages() {
+  local stamp="$VENV/.bootstrap-stamp"
+  local digest
+  digest=$(cat constraints.txt requirements-dev.txt "${PACKAGES[@]/%//setup.py}" | sha256sum | cut -d' ' -f1)
+  if [ -f "$stamp" ] && [ "$(cat "$stamp")" = "$digest" ]; then
+    return 0
+  fi
+  [ -x "$VENV/bin/python" ] || { log "creating $VENV with $($PYTHON --version)"; "$PYTHON" -m venv "$VENV"; }
+  log "installing Python packages (versions from constraints.txt)"
+  "$VENV/bin/python" -m pip install -q --upgrade pip
+  local editable=()
+  for pkg in "${PACKAGES[@]}"; do editable+=(-e "$pkg"); done
+  "$VENV/bin/python" -m pip install -q -c constraints.txt -r requirements-dev.txt "${editable[@]}"
+  echo "$digest" > "$stamp"
+}
+
+install_debian_packages
+install_python_packages
+log "ready: $VENV"
