@@ -1,0 +1,482 @@
+"""Source generation for rosidl-like message classes and their rosbags converters.
+
+Every message type gets its own class, built once from Python source text specialised to its
+fields (the same approach rosidl_generator_py takes at build time, done here at first use):
+no per-field dispatch happens when a message is constructed, assigned, compared or converted.
+
+The generated class mirrors a Jazzy rosidl class: keyword construction, ``__slots__``
+(``_<field>`` plus ``_check_fields``), one property per field whose setter applies rosidl's
+assertions when field checks are on, ``__eq__``, ``__repr__``, ``get_fields_and_field_types()``,
+``SLOT_TYPES`` and the constants as class attributes.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from array import array
+from collections import UserString
+from collections.abc import Callable, Mapping
+from operator import attrgetter
+from typing import Any
+
+import numpy as np
+
+from . import checks
+from .fields import FLOAT_LIMITS, INTEGER_BOUNDS, FieldSpec, MessageSpec
+
+__all__ = [
+    'GeneratedMessage',
+    'build_converters',
+    'build_message_class',
+    'class_source',
+    'converter_source',
+    'module_name_for',
+]
+
+
+def _camel_to_snake(name: str) -> str:
+    """rosidl's module naming: 'LaserScan' -> 'laser_scan', 'TFMessage' -> 'tf_message'."""
+    name = re.sub(r'(.)([A-Z][a-z]+)', r'\1_\2', name)
+    name = re.sub(r'([a-z0-9])([A-Z])', r'\1_\2', name)
+    return name.lower()
+
+
+def module_name_for(spec: MessageSpec) -> str:
+    """The ``__module__`` rosidl gives the class, e.g. 'sensor_msgs.msg._laser_scan'."""
+    return f'{spec.package}.{spec.interface}._{_camel_to_snake(spec.name)}'
+
+
+class GeneratedMessage:
+    """Base class of every generated message class (rosidl classes have none; it adds copying)."""
+
+    __slots__ = ()
+    __msgtype__: str
+
+    def __copy__(self) -> GeneratedMessage:
+        duplicate = object.__new__(type(self))
+        for slot in type(self).__slots__:
+            setattr(duplicate, slot, getattr(self, slot))
+        return duplicate
+
+    def __deepcopy__(self, memo: dict[int, Any]) -> GeneratedMessage:
+        from copy import deepcopy
+
+        duplicate = object.__new__(type(self))
+        memo[id(self)] = duplicate
+        for slot in type(self).__slots__:
+            setattr(duplicate, slot, deepcopy(getattr(self, slot), memo))
+        return duplicate
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        from .registry import restore_message
+
+        state = {slot: getattr(self, slot) for slot in type(self).__slots__}
+        return (restore_message, (self.__msgtype__, state))
+
+
+# --------------------------------------------------------------------------- class source
+
+
+def _nested_names(spec: MessageSpec) -> dict[str, str]:
+    """Namespace name of each nested message class: '_msg_0', '_msg_1', ..."""
+    return {typename: f'_msg_{index}' for index, typename in enumerate(spec.nested_types())}
+
+
+def _scalar_default(field: FieldSpec, nested: Mapping[str, str]) -> str:
+    element = field.element
+    if element.is_message:
+        return f'{nested[element.nested]}()'
+    if element.is_string:
+        return "''"
+    if element.base == 'byte':
+        return "b'\\x00'"
+    if element.base == 'bool':
+        return 'False'
+    if element.is_float:
+        return '0.0'
+    return '0'
+
+
+def _check_lines(field: FieldSpec, nested: Mapping[str, str]) -> list[str]:
+    """Assertions of rosidl's setter for ``field`` (run only when checks are on)."""
+    name = field.name
+    element = field.element
+    lines: list[str] = []
+    if field.is_nested and element.is_numeric:
+        if field.is_array:
+            lines += [
+                'if isinstance(value, _ndarray):',
+                f'    assert value.dtype == _np.{element.dtype}, '
+                + repr(
+                    f"The '{name}' numpy.ndarray() must have the dtype of 'numpy.{element.dtype}'"
+                ),
+                f'    assert value.size == {field.length}, '
+                + repr(f"The '{name}' numpy.ndarray() must have a size of {field.length}"),
+                f'    self._{name} = value',
+                '    return',
+            ]
+        else:
+            lines += [
+                'if isinstance(value, _array):',
+                f'    assert value.typecode == {element.typecode!r}, '
+                + repr(
+                    f"The '{name}' array.array() must have the type code of '{element.typecode}'"
+                ),
+            ]
+            if field.length:
+                lines.append(
+                    f'    assert len(value) <= {field.length}, '
+                    + repr(f"The '{name}' array.array() must have a size <= {field.length}")
+                )
+            lines += [f'    self._{name} = value', '    return']
+
+    if field.is_nested:
+        conditions = ['_is_sequence(value)']
+        suffixes = ['a set or sequence']
+        if element.is_string and element.string_bound:
+            conditions.append(f'all(len(v) <= {element.string_bound} for v in value)')
+            suffixes.append(f'and each string value not longer than {element.string_bound}')
+        if field.is_array:
+            conditions.append(f'len(value) == {field.length}')
+            suffixes.insert(1, f'with length {field.length}')
+        elif field.length:
+            conditions.append(f'len(value) <= {field.length}')
+            suffixes.insert(1, f'with length <= {field.length}')
+        type_expr = nested[element.nested] if element.is_message else element.python_type
+        if element.base == 'byte':
+            type_expr = 'bytes'
+        conditions.append(f'_all_instances(value, {type_expr})')
+        suffixes.append(f"and each value of type '{element.python_type}'")
+        if element.is_integer:
+            low, high = INTEGER_BOUNDS[element.idl_name]
+            conditions.append(f'_integers_in_range(value, {low}, {high})')
+            if low < 0:
+                suffixes.append(f'and each integer in [{low}, {high - 1}]')
+            else:
+                suffixes.append(f'and each unsigned integer in [0, {high - 1}]')
+        elif element.is_float:
+            limit = FLOAT_LIMITS[element.idl_name]
+            conditions.append(f'_floats_in_range(value, {limit!r})')
+            suffixes.append(f'and each {element.idl_name} in [{-limit:f}, {limit:f}]')
+        message = f"The '{name}' field must be {' '.join(suffixes)}"
+        lines.append(f'assert {" and ".join(conditions)}, {message!r}')
+        return lines
+
+    if element.is_message:
+        short = element.nested.rsplit('/', 1)[1]
+        lines.append(
+            f'assert isinstance(value, {nested[element.nested]}), '
+            + repr(f"The '{name}' field must be a sub message of type '{short}'")
+        )
+    elif element.is_string and element.string_bound:
+        lines.append(
+            f'assert isinstance(value, (str, _UserString)) and len(value) <= '
+            f'{element.string_bound}, '
+            + repr(
+                f"The '{name}' field must be string value not longer than {element.string_bound}"
+            )
+        )
+    elif element.is_string:
+        lines.append(
+            'assert isinstance(value, str), ' + repr(f"The '{name}' field must be of type 'str'")
+        )
+    elif element.base == 'byte':
+        lines.append(
+            'assert isinstance(value, (bytes, bytearray)) and len(value) == 1, '
+            + repr(f"The '{name}' field must be of type 'bytes' or 'ByteString' with length 1")
+        )
+    else:
+        python_type = element.python_type
+        lines.append(
+            f'assert isinstance(value, {python_type}), '
+            + repr(f"The '{name}' field must be of type '{python_type}'")
+        )
+        if element.is_integer:
+            low, high = INTEGER_BOUNDS[element.idl_name]
+            kind = 'an integer' if low < 0 else 'an unsigned integer'
+            lines.append(
+                f'assert value >= {low} and value < {high}, '
+                + repr(f"The '{name}' field must be {kind} in [{low}, {high - 1}]")
+            )
+        elif element.is_float:
+            limit = FLOAT_LIMITS[element.idl_name]
+            lines.append(
+                f'assert not (value < {-limit!r} or value > {limit!r}) or _isinf(value), '
+                + repr(
+                    f"The '{name}' field must be a {element.idl_name} in [{-limit!r}, {limit!r}]"
+                )
+            )
+    return lines
+
+
+def _store_expr(field: FieldSpec) -> str:
+    """What the setter stores after the checks (rosidl converts numeric arrays/sequences)."""
+    element = field.element
+    if field.is_nested and element.is_numeric:
+        if field.is_array:
+            return f'_np.array(value, dtype=_np.{element.dtype})'
+        return f'_array({element.typecode!r}, value)'
+    return 'value'
+
+
+def _initial_expr(field: FieldSpec, nested: Mapping[str, str]) -> str:
+    """The value rosidl's constructor passes to the setter."""
+    key = repr(field.name)
+    element = field.element
+    if field.is_array:
+        if element.is_numeric:
+            default = f'_np.zeros({field.length}, dtype=_np.{element.dtype})'
+        else:
+            default = f'[{_scalar_default(field, nested)} for _ in range({field.length})]'
+        return f'kwargs[{key}] if {key} in kwargs else {default}'
+    if field.is_sequence:
+        if element.is_numeric:
+            return f'_array({element.typecode!r}, kwargs.get({key}, ()))'
+        return f'kwargs[{key}] if {key} in kwargs else []'
+    if element.is_message:
+        return f'kwargs[{key}] if {key} in kwargs else {_scalar_default(field, nested)}'
+    return f'kwargs.get({key}, {_scalar_default(field, nested)})'
+
+
+def _unchecked_expr(field: FieldSpec, nested: Mapping[str, str]) -> str:
+    """The value stored by the constructor when checks are off (setter conversions applied)."""
+    key = repr(field.name)
+    element = field.element
+    if field.is_nested and element.is_numeric:
+        if field.is_array:
+            return (
+                f'_np.array(kwargs[{key}], dtype=_np.{element.dtype}) if {key} in kwargs '
+                f'else _np.zeros({field.length}, dtype=_np.{element.dtype})'
+            )
+        code = repr(element.typecode)
+        return f'_array({code}, kwargs[{key}]) if {key} in kwargs else _array({code})'
+    return _initial_expr(field, nested)
+
+
+def class_source(spec: MessageSpec) -> str:
+    """Python source of the functions of ``spec``'s class (see :func:`build_message_class`)."""
+    nested = _nested_names(spec)
+    out: list[str] = []
+
+    for index, field in enumerate(spec.fields):
+        out.append(f'def _set_{index}(self, value):')
+        out.append('    if self._check_fields:')
+        out.extend(f'        {line}' for line in _check_lines(field, nested))
+        out.append(f'    self._{field.name} = {_store_expr(field)}')
+        out.append('')
+
+    out.append('def __init__(self, **kwargs):')
+    out.append("    check = kwargs['check_fields'] if 'check_fields' in kwargs else _CHECK_FIELDS")
+    out.append('    self._check_fields = check')
+    out.append('    if check:')
+    out.append(
+        '        assert all(key in _VALID_KEYS for key in kwargs), '
+        "'Invalid arguments passed to constructor: %s' % "
+        "', '.join(sorted(k for k in kwargs if k not in _VALID_KEYS))"
+    )
+    for index, field in enumerate(spec.fields):
+        out.append(f'        _set_{index}(self, {_initial_expr(field, nested)})')
+    if spec.fields:
+        out.append('    else:')
+        for field in spec.fields:
+            out.append(f'        self._{field.name} = {_unchecked_expr(field, nested)}')
+    out.append('')
+
+    out.append('def __eq__(self, other):')
+    out.append('    if not isinstance(other, self.__class__):')
+    out.append('        return False')
+    for field in spec.fields:
+        slot = f'_{field.name}'
+        if field.is_array and field.element.is_numeric:
+            out.append(f'    if not _arrays_equal(self.{slot}, other.{slot}):')
+        else:
+            out.append(f'    if self.{slot} != other.{slot}:')
+        out.append('        return False')
+    out.append('    return True')
+    out.append('')
+
+    display = f'{spec.package}.{spec.interface}.{spec.name}'
+    out.append('def __repr__(self):')
+    parts = []
+    for field in spec.fields:
+        if field.is_sequence and field.element.is_numeric:
+            value = f'_sequence_repr(self._{field.name}, self._check_fields)'
+        else:
+            value = f'repr(self._{field.name})'
+        parts.append(f'{field.name + "="!r} + {value}')
+    joined = ', '.join(parts)
+    out.append(f"    return {display + '(%s)'!r} % ', '.join(({joined}{',' if parts else ''}))")
+    out.append('')
+    return '\n'.join(out)
+
+
+def _class_doc(spec: MessageSpec) -> str:
+    if not spec.constants:
+        return f"Message class '{spec.name}'."
+    names = '\n'.join(f'      {constant.name}' for constant in spec.constants)
+    return f"\n    Message class '{spec.name}'.\n\n    Constants:\n{names}\n    "
+
+
+def build_message_class(
+    spec: MessageSpec, nested_classes: Mapping[str, type], *, check_fields: bool
+) -> type[GeneratedMessage]:
+    """Create the class of ``spec``.
+
+    Args:
+        spec: The message type.
+        nested_classes: Generated class of every type in ``spec.nested_types()``.
+        check_fields: Default of ``_check_fields`` for new instances (rosidl reads
+            ROS_PYTHON_CHECK_FIELDS once, when the package's module is imported).
+    """
+    nested = _nested_names(spec)
+    namespace: dict[str, Any] = {
+        '_CHECK_FIELDS': check_fields,
+        '_VALID_KEYS': frozenset([*(f.name for f in spec.fields), 'check_fields']),
+        '_MISSING': checks.MISSING,
+        '_array': array,
+        '_ndarray': np.ndarray,
+        '_np': np,
+        '_isinf': math.isinf,
+        '_UserString': UserString,
+        '_is_sequence': checks.is_sequence,
+        '_all_instances': checks.all_instances,
+        '_floats_in_range': checks.floats_in_range,
+        '_integers_in_range': checks.integers_in_range,
+        '_sequence_repr': checks.sequence_repr,
+        '_arrays_equal': checks.arrays_equal,
+    }
+    for typename, alias in nested.items():
+        namespace[alias] = nested_classes[typename]
+    source = class_source(spec)
+    exec(compile(source, f'<message {spec.typename}>', 'exec'), namespace)
+
+    body: dict[str, Any] = {
+        '__slots__': [*(f'_{f.name}' for f in spec.fields), '_check_fields'],
+        '__doc__': _class_doc(spec),
+        '__module__': module_name_for(spec),
+        '__qualname__': spec.name,
+        '__msgtype__': spec.typename,
+        '__init__': namespace['__init__'],
+        '__eq__': namespace['__eq__'],
+        '__repr__': namespace['__repr__'],
+        '__hash__': None,
+        '_fields_and_field_types': {f.name: f.rosidl_text for f in spec.fields},
+        'SLOT_TYPES': tuple(f.slot_type() for f in spec.fields),
+        'get_fields_and_field_types': classmethod(_get_fields_and_field_types),
+    }
+    for constant in spec.constants:
+        body[constant.name] = constant.value
+    for index, field in enumerate(spec.fields):
+        body[field.name] = property(
+            attrgetter(f'_{field.name}'),
+            namespace[f'_set_{index}'],
+            doc=f"Message field '{field.name}'.",
+        )
+    return type(spec.name, (GeneratedMessage,), body)
+
+
+def _get_fields_and_field_types(cls: type) -> dict[str, str]:
+    """Return a copy of the field name -> rosidl type text mapping."""
+    return dict(cls._fields_and_field_types)  # type: ignore[attr-defined]
+
+
+# --------------------------------------------------------------------------- rosbags converters
+
+
+def _to_rosbags_expr(field: FieldSpec, nested: Mapping[str, str]) -> str:
+    value = f'm._{field.name}'
+    element = field.element
+    if not field.is_nested:
+        if element.is_message:
+            return f'_to{nested[element.nested]}({value})'
+        if element.base == 'byte':
+            return f'_octet_to_int8({value})'
+        return value
+    if element.is_message:
+        return f'[_to{nested[element.nested]}(item) for item in {value}]'
+    if element.is_numeric:
+        return f'_np.asarray({value}, dtype=_np.{element.dtype})'
+    if element.base == 'bool':
+        return f'_np.asarray({value}, dtype=_np.bool_)'
+    if element.base == 'byte':
+        return f'_octets_to_numpy({value})'
+    return value
+
+
+def _from_rosbags_expr(field: FieldSpec, nested: Mapping[str, str]) -> str:
+    value = f'r.{field.rosbags_name}'
+    element = field.element
+    if not field.is_nested:
+        if element.is_message:
+            return f'_from{nested[element.nested]}({value})'
+        if element.base == 'byte':
+            return f'_int8_to_octet({value})'
+        return value
+    if element.is_message:
+        return f'[_from{nested[element.nested]}(item) for item in {value}]'
+    if element.is_numeric:
+        if field.is_array:
+            return f'_np.array({value}, dtype=_np.{element.dtype})'
+        return f'_array_from_numpy({value}, {element.typecode!r})'
+    if element.base == 'bool':
+        return f'[bool(item) for item in {value}]'
+    if element.base == 'byte':
+        return f'_octets_from_numpy({value})'
+    return f'list({value})'
+
+
+def converter_source(spec: MessageSpec) -> str:
+    """Python source of ``_to_rosbags(m)`` and ``_from_rosbags(r)`` for ``spec``."""
+    nested = _nested_names(spec)
+    out = ['def _to_rosbags(m):']
+    if spec.padded_empty:
+        out.append('    return _RB(0)')
+    else:
+        args = ''.join(f'        {_to_rosbags_expr(f, nested)},\n' for f in spec.fields)
+        out.append(f'    return _RB(\n{args}    )')
+    out.append('')
+    out.append('def _from_rosbags(r):')
+    out.append('    m = _new(_CLS)')
+    out.append('    m._check_fields = _CHECK_FIELDS')
+    for field in spec.fields:
+        out.append(f'    m._{field.name} = {_from_rosbags_expr(field, nested)}')
+    out.append('    return m')
+    out.append('')
+    return '\n'.join(out)
+
+
+def build_converters(
+    spec: MessageSpec,
+    cls: type,
+    rosbags_cls: type,
+    nested_converters: Mapping[str, tuple[Callable[[Any], Any], Callable[[Any], Any]]],
+    *,
+    check_fields: bool,
+) -> tuple[Callable[[Any], Any], Callable[[Any], Any]]:
+    """Create ``(to_rosbags, from_rosbags)`` for ``spec``.
+
+    ``to_rosbags`` turns an instance of ``cls`` into rosbags' message object of the same type
+    (without checking: a wrongly typed value surfaces when rosbags serializes it);
+    ``from_rosbags`` builds an instance of ``cls`` the way rclpy hands a received message over.
+    """
+    nested = _nested_names(spec)
+    namespace: dict[str, Any] = {
+        '_RB': rosbags_cls,
+        '_CLS': cls,
+        '_CHECK_FIELDS': check_fields,
+        '_new': object.__new__,
+        '_np': np,
+        '_octet_to_int8': checks.octet_to_int8,
+        '_int8_to_octet': checks.int8_to_octet,
+        '_octets_to_numpy': checks.octets_to_numpy,
+        '_octets_from_numpy': checks.octets_from_numpy,
+        '_array_from_numpy': checks.array_from_numpy,
+    }
+    for typename, alias in nested.items():
+        to_nested, from_nested = nested_converters[typename]
+        namespace[f'_to{alias}'] = to_nested
+        namespace[f'_from{alias}'] = from_nested
+    source = converter_source(spec)
+    exec(compile(source, f'<converters {spec.typename}>', 'exec'), namespace)
+    return namespace['_to_rosbags'], namespace['_from_rosbags']
