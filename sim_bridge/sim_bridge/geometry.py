@@ -1,0 +1,311 @@
+"""Planar geometry kernels shared by the world and the sensor models (numpy, vectorized).
+
+Walls are line segments given as an (M, 2, 2) array: ``walls[m] = [[x0, y0], [x1, y1]]`` in
+metres. Robots are discs. Everything here is pure and deterministic.
+
+The lidar caster works per (robot, wall) pair on the angular interval the wall covers as seen
+from the robot, so its cost grows with the number of bins actually hit (a few thousand per
+robot in a room-and-corridor site) rather than with bins x walls. On this project's Small
+sites it is about 30 times faster than pybullet's ``rayTestBatch`` for the same rays (see
+docs/simulation.md for the measurement).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from sim_bridge.errors import WorldGeometryError
+
+__all__ = [
+    'RayCaster',
+    'as_segments',
+    'count_crossings',
+    'point_segment_distance',
+    'wrap_angle',
+]
+
+TWO_PI = 2.0 * math.pi
+
+
+def wrap_angle(angle_rad: np.ndarray | float) -> np.ndarray | float:
+    """Wrap angles [rad] to (-pi, pi]."""
+    wrapped = np.mod(np.asarray(angle_rad, dtype=float) + math.pi, TWO_PI) - math.pi
+    wrapped = np.where(wrapped <= -math.pi, wrapped + TWO_PI, wrapped)
+    if np.ndim(angle_rad) == 0:
+        return float(wrapped)
+    return wrapped
+
+
+def as_segments(walls: object) -> np.ndarray:
+    """Return wall segments as a float (M, 2, 2) array, rejecting malformed input."""
+    segments = np.asarray(walls, dtype=float)
+    if segments.size == 0:
+        return np.zeros((0, 2, 2))
+    if segments.ndim != 3 or segments.shape[1:] != (2, 2):
+        msg = f'wall segments must have shape (M, 2, 2), got {segments.shape}'
+        raise WorldGeometryError(msg)
+    if not np.all(np.isfinite(segments)):
+        raise WorldGeometryError('wall segments contain NaN or inf coordinates')
+    lengths = np.linalg.norm(segments[:, 1] - segments[:, 0], axis=1)
+    if np.any(lengths <= 0.0):
+        bad = int(np.flatnonzero(lengths <= 0.0)[0])
+        msg = f'wall segment {bad} has zero length: {segments[bad].tolist()}'
+        raise WorldGeometryError(msg)
+    return segments
+
+
+def point_segment_distance(points: np.ndarray, segments: np.ndarray) -> np.ndarray:
+    """Distance [m] from each point to each segment.
+
+    Args:
+        points: (K, 2) array of x, y [m].
+        segments: (M, 2, 2) array of segment end points [m].
+
+    Returns:
+        (K, M) array of Euclidean distances [m].
+    """
+    a = segments[:, 0]
+    ab = segments[:, 1] - a
+    ab_len2 = np.einsum('ij,ij->i', ab, ab)
+    ap = points[:, None, :] - a[None, :, :]
+    t = np.clip(np.einsum('kmj,mj->km', ap, ab) / ab_len2, 0.0, 1.0)
+    closest = a[None, :, :] + t[:, :, None] * ab[None, :, :]
+    return np.linalg.norm(points[:, None, :] - closest, axis=2)
+
+
+def count_crossings(starts: np.ndarray, ends: np.ndarray, segments: np.ndarray) -> np.ndarray:
+    """Number of wall segments each straight path crosses.
+
+    Args:
+        starts: (K, 2) path start points [m].
+        ends: (K, 2) path end points [m].
+        segments: (M, 2, 2) wall segments [m].
+
+    Returns:
+        (K,) int array: how many segments each path properly intersects.
+    """
+    if len(segments) == 0 or len(starts) == 0:
+        return np.zeros(len(starts), dtype=int)
+    p = starts[:, None, :]
+    r = (ends - starts)[:, None, :]
+    q = segments[None, :, 0, :]
+    s = (segments[:, 1] - segments[:, 0])[None, :, :]
+    r_cross_s = r[..., 0] * s[..., 1] - r[..., 1] * s[..., 0]
+    qp = q - p
+    with np.errstate(divide='ignore', invalid='ignore'):
+        t = (qp[..., 0] * s[..., 1] - qp[..., 1] * s[..., 0]) / r_cross_s
+        u = (qp[..., 0] * r[..., 1] - qp[..., 1] * r[..., 0]) / r_cross_s
+    hit = (r_cross_s != 0.0) & (t >= 0.0) & (t <= 1.0) & (u >= 0.0) & (u <= 1.0)
+    return hit.sum(axis=1)
+
+
+def _expand_intervals(starts: np.ndarray, counts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Expand integer intervals [start, start + count) into (owner, index) pairs."""
+    total = int(counts.sum())
+    owner = np.repeat(np.arange(len(counts)), counts)
+    first = np.cumsum(counts) - counts
+    offsets = np.arange(total) - np.repeat(first, counts)
+    return owner, np.repeat(starts, counts) + offsets
+
+
+class RayCaster:
+    """360-degree planar range caster against thick wall segments and other robots' discs.
+
+    Bin ``k`` of a scan points at ``angle_min_rad + k * 2 pi / num_bins`` in the robot frame
+    (REP 103: counter-clockwise from the robot's x axis), ``angle_min_rad = -pi``. Rays start at
+    the robot's centre and ignore the robot's own disc.
+    """
+
+    def __init__(
+        self,
+        walls: np.ndarray,
+        *,
+        wall_thickness_m: float,
+        robot_radius_m: float,
+        num_bins: int,
+    ) -> None:
+        """Prepare the caster.
+
+        Args:
+            walls: (M, 2, 2) wall centre lines [m].
+            wall_thickness_m: full wall thickness [m]; rays stop at the wall's face.
+            robot_radius_m: radius of every robot disc [m].
+            num_bins: number of equally spaced rays per revolution.
+        """
+        if num_bins < 4:
+            msg = f'num_bins must be at least 4, got {num_bins}'
+            raise WorldGeometryError(msg)
+        segments = as_segments(walls)
+        half = 0.5 * wall_thickness_m
+        caps = np.zeros((0, 2, 2))
+        if len(segments):
+            direction = segments[:, 1] - segments[:, 0]
+            direction /= np.linalg.norm(direction, axis=1)[:, None]
+            normal = np.column_stack([-direction[:, 1], direction[:, 0]])
+            # The wall box reaches half a thickness beyond each end point; its two short end
+            # faces are cast as separate zero-thickness segments (rays along the wall hit them).
+            segments = np.stack(
+                [segments[:, 0] - half * direction, segments[:, 1] + half * direction], axis=1
+            )
+            if half > 0.0:
+                ends = np.concatenate([segments[:, 0], segments[:, 1]])
+                side = np.concatenate([normal, normal]) * half
+                caps = np.stack([ends - side, ends + side], axis=1)
+                # Sign telling on which side of each cap segment its outward face lies.
+                cap_ab = caps[:, 1] - caps[:, 0]
+                cap_normal = np.column_stack([cap_ab[:, 1], -cap_ab[:, 0]])
+                outward = np.concatenate([-direction, direction])
+                self._cap_outward = np.sign(np.einsum('ij,ij->i', cap_normal, outward))
+        self._segments = segments
+        self._caps = caps
+        if len(caps) == 0:
+            self._cap_outward = np.zeros(0)
+        self._half_thickness_m = half
+        self._robot_radius_m = float(robot_radius_m)
+        self.num_bins = int(num_bins)
+        self.angle_min_rad = -math.pi
+        self.angle_increment_rad = TWO_PI / self.num_bins
+        self._bin_offsets_rad = self.angle_min_rad + self.angle_increment_rad * np.arange(
+            self.num_bins
+        )
+
+    @property
+    def bin_angles_rad(self) -> np.ndarray:
+        """(num_bins,) robot-frame angle of every bin [rad]."""
+        return self._bin_offsets_rad.copy()
+
+    def _arc_bins(
+        self, yaw: np.ndarray, angle_a: np.ndarray, angle_b: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """First bin and bin count of the shorter arc between two world angles, per pair."""
+        inc = self.angle_increment_rad
+        ua = (angle_a - yaw - self.angle_min_rad) / inc
+        du = (wrap_angle(angle_b - angle_a)) / inc
+        lo = np.minimum(ua, ua + du)
+        hi = np.maximum(ua, ua + du)
+        first = np.ceil(lo).astype(int)
+        counts = np.maximum(np.floor(hi).astype(int) - first + 1, 0)
+        return first, counts
+
+    def scan(self, poses: np.ndarray, max_range_m: float) -> np.ndarray:
+        """Exact ranges [m] of every bin for every robot; ``inf`` where nothing is in range.
+
+        Args:
+            poses: (N, 3) array of x [m], y [m], yaw [rad] of every robot; each robot's rays
+                also hit the other robots' discs.
+            max_range_m: rays longer than this return ``inf``.
+
+        Returns:
+            (N, num_bins) float array of ranges [m] from each robot's centre.
+        """
+        poses = np.asarray(poses, dtype=float)
+        n = len(poses)
+        nb = self.num_bins
+        best = np.full(n * nb, np.inf)
+        if n == 0:
+            return best.reshape(0, nb)
+        origin = poses[:, :2]
+        yaw = poses[:, 2]
+        theta = (yaw[:, None] + self._bin_offsets_rad[None, :]).ravel()
+        ray_dir = (np.cos(theta), np.sin(theta))
+        self._scan_segments(
+            self._segments, self._half_thickness_m, None, origin, yaw, ray_dir, max_range_m, best
+        )
+        self._scan_segments(
+            self._caps, 0.0, self._cap_outward, origin, yaw, ray_dir, max_range_m, best
+        )
+        if n > 1:
+            self._scan_discs(origin, yaw, ray_dir, max_range_m, best)
+        best[best > max_range_m] = np.inf
+        return best.reshape(n, nb)
+
+    def _scan_segments(
+        self,
+        segs: np.ndarray,
+        half_thickness_m: float,
+        outward: np.ndarray | None,
+        origin: np.ndarray,
+        yaw: np.ndarray,
+        ray_dir: tuple[np.ndarray, np.ndarray],
+        max_range_m: float,
+        best: np.ndarray,
+    ) -> None:
+        """Lower ``best`` (flat N * num_bins ranges) with the hits on ``segs``' near faces.
+
+        ``outward`` (one sign per segment) marks one-sided segments (the walls' end faces):
+        only robots on that side see them.
+        """
+        if len(segs) == 0:
+            return
+        dist = point_segment_distance(origin, segs)
+        near = dist <= max_range_m + half_thickness_m
+        if outward is not None:
+            # An end face is seen only from in front of it: cull the pairs where it faces away.
+            a = segs[:, 0]
+            ab = segs[:, 1] - a
+            facing = np.column_stack([ab[:, 1], -ab[:, 0]])
+            rel = origin[:, None, :] - a[None, :, :]
+            side = rel[..., 0] * facing[None, :, 0] + rel[..., 1] * facing[None, :, 1]
+            near &= side * outward[None, :] > 0.0
+        robot_idx, wall_idx = np.nonzero(near)
+        if len(robot_idx) == 0:
+            return
+        o = origin[robot_idx]
+        a = segs[wall_idx, 0] - o
+        b = segs[wall_idx, 1] - o
+        ab = b - a
+        normal = np.column_stack([ab[:, 1], -ab[:, 0]])
+        normal /= np.linalg.norm(normal, axis=1)[:, None]
+        offset = np.einsum('ij,ij->i', a, normal)
+        # Orient each normal from the robot towards the wall's centre line.
+        flip = offset < 0.0
+        normal[flip] *= -1.0
+        offset = np.abs(offset)
+        face = np.maximum(offset - half_thickness_m, 1e-6)
+        # The angular interval is the one of the face nearest to the robot.
+        a_face = a - half_thickness_m * normal
+        b_face = b - half_thickness_m * normal
+        first, counts = self._arc_bins(
+            yaw[robot_idx],
+            np.arctan2(a_face[:, 1], a_face[:, 0]),
+            np.arctan2(b_face[:, 1], b_face[:, 0]),
+        )
+        owner, k = _expand_intervals(first, counts)
+        k %= self.num_bins
+        flat = robot_idx[owner] * self.num_bins + k
+        along = ray_dir[0][flat] * normal[owner, 0] + ray_dir[1][flat] * normal[owner, 1]
+        with np.errstate(divide='ignore'):
+            ranges = np.where(along > 1e-9, face[owner] / along, np.inf)
+        np.minimum.at(best, flat, ranges)
+
+    def _scan_discs(
+        self,
+        origin: np.ndarray,
+        yaw: np.ndarray,
+        ray_dir: tuple[np.ndarray, np.ndarray],
+        max_range_m: float,
+        best: np.ndarray,
+    ) -> None:
+        """Lower ``best`` with the hits on the other robots' discs."""
+        radius = self._robot_radius_m
+        delta = origin[None, :, :] - origin[:, None, :]
+        dist = np.linalg.norm(delta, axis=2)
+        np.fill_diagonal(dist, np.inf)
+        viewer, target = np.nonzero((dist <= max_range_m + radius) & (dist > radius))
+        if len(viewer) == 0:
+            return
+        d = dist[viewer, target]
+        centre = np.arctan2(delta[viewer, target, 1], delta[viewer, target, 0])
+        half = np.arcsin(np.clip(radius / d, 0.0, 1.0))
+        first, counts = self._arc_bins(yaw[viewer], centre - half, centre + half)
+        owner, k = _expand_intervals(first, counts)
+        k %= self.num_bins
+        flat = viewer[owner] * self.num_bins + k
+        c = delta[viewer, target][owner]
+        s = ray_dir[0][flat] * c[:, 0] + ray_dir[1][flat] * c[:, 1]
+        h2 = d[owner] ** 2 - s**2
+        inside = (h2 <= radius**2) & (s > 0.0)
+        ranges = np.where(inside, s - np.sqrt(np.maximum(radius**2 - h2, 0.0)), np.inf)
+        np.minimum.at(best, flat, ranges)

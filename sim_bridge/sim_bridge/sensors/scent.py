@@ -1,0 +1,183 @@
+"""Scent field: ethanol puffs that a pump deposits on the floor, spreading and decaying.
+
+Each puff is a 2D Gaussian of ethanol concentration whose width grows from
+``initial_spread_m`` towards ``final_spread_m`` (the liquid spreads and its vapour plume
+widens, then the deposit settles) and whose mass evaporates with time constant
+``decay_time_constant_s``. Concentration [ppm] at a point is the sum over puffs:
+
+    c(p, t) = sum_k m_k exp(-age_k / tau_decay) / (2 pi s_k^2) exp(-|p - p_k|^2 / (2 s_k^2))
+    s_k^2   = s0^2 + (s1^2 - s0^2) (1 - exp(-age_k / tau_spread))
+
+with m_k in ppm m^2. Vapour does not pass through walls: a puff does not contribute at a
+point when the straight path between them crosses a wall. The paper's scent marks never
+decay; the default decay time is longer than a mission so that trails laid at the start are
+still found at the end, while the spread makes a chain of puffs read as one trail.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from sim_bridge.errors import ConfigurationError
+from sim_bridge.geometry import as_segments, count_crossings
+
+__all__ = ['PumpDepositor', 'ScentConfig', 'ScentField']
+
+
+@dataclass(frozen=True)
+class ScentConfig:
+    """Parameters of the scent field.
+
+    Attributes:
+        deposit_rate_ppm_m2_per_s: ethanol released while the pump runs [ppm m^2 / s].
+        deposit_period_s: pump-on time gathered into one puff [s]; a shorter pulse still
+            leaves its (smaller) puff when the pump stops.
+        initial_spread_m: standard deviation of a fresh puff [m].
+        final_spread_m: standard deviation a puff settles at [m].
+        spread_time_constant_s: time constant of the spreading [s].
+        decay_time_constant_s: evaporation time constant of a puff's mass [s].
+        cutoff_sigmas: contributions farther than this many final spreads are ignored.
+        walls_block: when True, vapour does not cross walls.
+    """
+
+    deposit_rate_ppm_m2_per_s: float = 250.0
+    deposit_period_s: float = 0.25
+    initial_spread_m: float = 0.05
+    final_spread_m: float = 0.35
+    spread_time_constant_s: float = 10.0
+    decay_time_constant_s: float = 1800.0
+    cutoff_sigmas: float = 3.0
+    walls_block: bool = True
+
+    def __post_init__(self) -> None:
+        positive = (
+            'deposit_rate_ppm_m2_per_s',
+            'deposit_period_s',
+            'initial_spread_m',
+            'spread_time_constant_s',
+            'decay_time_constant_s',
+            'cutoff_sigmas',
+        )
+        for name in positive:
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value > 0.0):
+                msg = f'{name} must be a positive finite number, got {value!r}'
+                raise ConfigurationError(msg)
+        if self.final_spread_m < self.initial_spread_m:
+            msg = (
+                f'final_spread_m ({self.final_spread_m}) must be >= initial_spread_m '
+                f'({self.initial_spread_m})'
+            )
+            raise ConfigurationError(msg)
+
+
+class ScentField:
+    """All puffs deposited so far, and the concentration they produce."""
+
+    def __init__(self, config: ScentConfig, walls: np.ndarray | None = None) -> None:
+        self.config = config
+        self._walls = as_segments(walls if walls is not None else np.zeros((0, 2, 2)))
+        self._xy = np.zeros((256, 2))
+        self._time_s = np.zeros(256)
+        self._mass = np.zeros(256)
+        self._count = 0
+
+    @property
+    def num_puffs(self) -> int:
+        """Number of puffs deposited so far."""
+        return self._count
+
+    @property
+    def puffs(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Copies of the puffs: (P, 2) positions [m], (P,) deposit times [s], (P,) masses."""
+        n = self._count
+        return self._xy[:n].copy(), self._time_s[:n].copy(), self._mass[:n].copy()
+
+    def deposit(self, xy: np.ndarray, time_s: float, mass_ppm_m2: np.ndarray) -> None:
+        """Add puffs at (K, 2) positions [m] with (K,) masses [ppm m^2] at ``time_s``."""
+        xy = np.atleast_2d(np.asarray(xy, dtype=float))
+        mass = np.broadcast_to(np.asarray(mass_ppm_m2, dtype=float), (len(xy),))
+        keep = np.isfinite(xy).all(axis=1) & (mass > 0.0)
+        xy, mass = xy[keep], mass[keep]
+        k = len(xy)
+        if k == 0:
+            return
+        if self._count + k > len(self._mass):
+            size = max(2 * len(self._mass), self._count + k)
+            self._xy = np.resize(self._xy, (size, 2))
+            self._time_s = np.resize(self._time_s, size)
+            self._mass = np.resize(self._mass, size)
+        sl = slice(self._count, self._count + k)
+        self._xy[sl] = xy
+        self._time_s[sl] = time_s
+        self._mass[sl] = mass
+        self._count += k
+
+    def spread_m(self, age_s: np.ndarray) -> np.ndarray:
+        """Standard deviation [m] of puffs of the given ages [s]."""
+        cfg = self.config
+        growth = 1.0 - np.exp(-np.maximum(age_s, 0.0) / cfg.spread_time_constant_s)
+        var = cfg.initial_spread_m**2 + (cfg.final_spread_m**2 - cfg.initial_spread_m**2) * growth
+        return np.sqrt(var)
+
+    def concentration(self, points: np.ndarray, time_s: float) -> np.ndarray:
+        """Ethanol concentration [ppm] at (K, 2) points at ``time_s``; returns (K,)."""
+        points = np.atleast_2d(np.asarray(points, dtype=float))
+        out = np.zeros(len(points))
+        n = self._count
+        if n == 0:
+            return out
+        cfg = self.config
+        xy = self._xy[:n]
+        age = time_s - self._time_s[:n]
+        live = age >= 0.0
+        d2 = ((points[:, None, :] - xy[None, :, :]) ** 2).sum(axis=2)
+        cutoff2 = (cfg.cutoff_sigmas * cfg.final_spread_m) ** 2
+        near = (d2 <= cutoff2) & live[None, :]
+        q_idx, p_idx = np.nonzero(near)
+        if len(q_idx) == 0:
+            return out
+        if cfg.walls_block and len(self._walls):
+            open_path = count_crossings(points[q_idx], xy[p_idx], self._walls) == 0
+            q_idx, p_idx = q_idx[open_path], p_idx[open_path]
+        a = age[p_idx]
+        sigma2 = self.spread_m(a) ** 2
+        value = (
+            self._mass[p_idx]
+            * np.exp(-a / cfg.decay_time_constant_s)
+            / (2.0 * math.pi * sigma2)
+            * np.exp(-d2[q_idx, p_idx] / (2.0 * sigma2))
+        )
+        np.add.at(out, q_idx, value)
+        return out
+
+
+class PumpDepositor:
+    """Turns per-robot pump on/off states into puffs, one per ``deposit_period_s`` of pumping."""
+
+    def __init__(self, field: ScentField, num_robots: int) -> None:
+        self._field = field
+        self._on_time_s = np.zeros(num_robots)
+
+    def step(self, pump_on: np.ndarray, nozzle_xy: np.ndarray, time_s: float, dt_s: float) -> None:
+        """Account ``dt_s`` seconds of pumping and deposit the puffs that are complete.
+
+        Args:
+            pump_on: (N,) bool, pump running during the step.
+            nozzle_xy: (N, 2) nozzle positions [m] at the end of the step.
+            time_s: time at the end of the step [s].
+            dt_s: step length [s].
+        """
+        cfg = self._field.config
+        pump_on = np.asarray(pump_on, dtype=bool)
+        self._on_time_s[pump_on] += dt_s
+        full = self._on_time_s >= cfg.deposit_period_s - 1e-9
+        stopped = ~pump_on & (self._on_time_s > 0.0)
+        release = full | stopped
+        if release.any():
+            mass = cfg.deposit_rate_ppm_m2_per_s * self._on_time_s[release]
+            self._field.deposit(nozzle_xy[release], time_s, mass)
+            self._on_time_s[release] = 0.0

@@ -1,0 +1,149 @@
+"""The simulated world: static walls and disc robots driven as kinematic unicycles.
+
+The world is ROS-free and deterministic. It integrates every robot's commanded forward speed
+and yaw rate (clipped to the body's limits) once per physics step and resolves collisions the
+way a real base pressing against an obstacle behaves: a robot whose move would bring its disc
+into a wall or another robot keeps its rotation but does not translate. Robots are updated in
+bridge order (r0 first), so later robots see the already-moved earlier ones.
+
+Geometry queries (lidar rays, wall crossings) go through :mod:`sim_bridge.geometry`; a pybullet
+scene of the same walls and bodies is available for cross-checks and as an alternative ray
+backend (:mod:`sim_bridge.pybullet_scene`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from sim_bridge.errors import ConfigurationError, WorldGeometryError
+from sim_bridge.geometry import as_segments, point_segment_distance, wrap_angle
+
+__all__ = ['BodyConfig', 'World']
+
+
+@dataclass(frozen=True)
+class BodyConfig:
+    """Robot body and drive limits shared by every robot.
+
+    Attributes:
+        robot_radius_m: radius of the robot's disc [m] (the paper's robots are 0.2 m wide).
+        wall_thickness_m: thickness of every wall [m] (the authors' simulator: 2.5 cm).
+        max_linear_speed_mps: forward speed limit [m/s]; reverse is limited the same.
+        max_angular_speed_radps: yaw rate limit [rad/s].
+    """
+
+    robot_radius_m: float = 0.1
+    wall_thickness_m: float = 0.025
+    max_linear_speed_mps: float = 0.5
+    max_angular_speed_radps: float = 2.0
+
+    def __post_init__(self) -> None:
+        for name in ('robot_radius_m', 'max_linear_speed_mps', 'max_angular_speed_radps'):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value > 0.0):
+                msg = f'{name} must be a positive finite number, got {value!r}'
+                raise ConfigurationError(msg)
+        if not (math.isfinite(self.wall_thickness_m) and self.wall_thickness_m >= 0.0):
+            msg = f'wall_thickness_m must be >= 0, got {self.wall_thickness_m!r}'
+            raise ConfigurationError(msg)
+
+
+class World:
+    """Walls plus N disc robots; owns the true state of every robot."""
+
+    def __init__(
+        self, walls: np.ndarray, initial_poses: np.ndarray, body: BodyConfig | None = None
+    ) -> None:
+        """Build the world.
+
+        Args:
+            walls: (M, 2, 2) wall centre lines [m].
+            initial_poses: (N, 3) x [m], y [m], yaw [rad] of every robot.
+            body: body and drive limits; defaults to :class:`BodyConfig`.
+        """
+        self.body = body or BodyConfig()
+        self.walls = as_segments(walls)
+        poses = np.array(initial_poses, dtype=float)
+        if poses.ndim != 2 or poses.shape[1] != 3 or len(poses) == 0:
+            msg = f'initial_poses must have shape (N, 3) with N >= 1, got {poses.shape}'
+            raise WorldGeometryError(msg)
+        if not np.all(np.isfinite(poses)):
+            raise WorldGeometryError('initial_poses contain NaN or inf')
+        poses[:, 2] = wrap_angle(poses[:, 2])
+        self._poses = poses
+        self._velocities = np.zeros((len(poses), 2))
+        self._wall_clearance_m = self.body.robot_radius_m + 0.5 * self.body.wall_thickness_m
+        self.collision_count = np.zeros(len(poses), dtype=int)
+
+    @property
+    def num_robots(self) -> int:
+        """Number of robots N."""
+        return len(self._poses)
+
+    @property
+    def poses(self) -> np.ndarray:
+        """(N, 3) copy of the true poses: x [m], y [m], yaw [rad] in (-pi, pi]."""
+        return self._poses.copy()
+
+    @property
+    def velocities(self) -> np.ndarray:
+        """(N, 2) achieved forward speed [m/s] and yaw rate [rad/s] of the last step."""
+        return self._velocities.copy()
+
+    def clip_commands(self, commands: np.ndarray) -> np.ndarray:
+        """Clip (N, 2) commands (speed [m/s], yaw rate [rad/s]) to the drive limits.
+
+        Non-finite commands become zero (a base driver ignores garbage and stops).
+        """
+        cmd = np.array(commands, dtype=float).reshape(self.num_robots, 2)
+        cmd[~np.isfinite(cmd)] = 0.0
+        v_max = self.body.max_linear_speed_mps
+        w_max = self.body.max_angular_speed_radps
+        cmd[:, 0] = np.clip(cmd[:, 0], -v_max, v_max)
+        cmd[:, 1] = np.clip(cmd[:, 1], -w_max, w_max)
+        return cmd
+
+    def step(self, commands: np.ndarray, dt_s: float) -> None:
+        """Advance every robot by ``dt_s`` seconds under (N, 2) velocity commands.
+
+        The unicycle is integrated exactly (arc of constant curvature). A move that would end
+        closer to a wall or another robot than contact distance, and closer than before, is
+        cancelled (the robot still turns).
+        """
+        cmd = self.clip_commands(commands)
+        v = cmd[:, 0]
+        w = cmd[:, 1]
+        yaw = self._poses[:, 2]
+        new_yaw = yaw + w * dt_s
+        small = np.abs(w) < 1e-9
+        safe_w = np.where(small, 1.0, w)
+        dx = np.where(small, v * dt_s * np.cos(yaw), v / safe_w * (np.sin(new_yaw) - np.sin(yaw)))
+        dy = np.where(small, v * dt_s * np.sin(yaw), -v / safe_w * (np.cos(new_yaw) - np.cos(yaw)))
+        old_xy = self._poses[:, :2]
+        cand_xy = old_xy + np.column_stack([dx, dy])
+        moves = (dx != 0.0) | (dy != 0.0)
+        allowed = moves.copy()
+        if len(self.walls) and moves.any():
+            new_clear = point_segment_distance(cand_xy, self.walls).min(axis=1)
+            old_clear = point_segment_distance(old_xy, self.walls).min(axis=1)
+            blocked = (new_clear < self._wall_clearance_m) & (new_clear < old_clear)
+            allowed &= ~blocked
+        final_xy = old_xy.copy()
+        contact = 2.0 * self.body.robot_radius_m
+        for i in np.flatnonzero(allowed):
+            others = np.delete(final_xy, i, axis=0)
+            if len(others):
+                new_d = np.hypot(*(others - cand_xy[i]).T).min()
+                old_d = np.hypot(*(others - old_xy[i]).T).min()
+                if new_d < contact and new_d < old_d:
+                    allowed[i] = False
+                    continue
+            final_xy[i] = cand_xy[i]
+        self.collision_count += (moves & ~allowed).astype(int)
+        self._poses[:, :2] = final_xy
+        self._poses[:, 2] = wrap_angle(new_yaw)
+        achieved_v = np.where(allowed, v, 0.0)
+        self._velocities = np.column_stack([achieved_v, w])

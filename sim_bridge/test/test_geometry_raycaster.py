@@ -1,0 +1,110 @@
+"""The lidar ray caster against walls and robots whose ranges are known in closed form."""
+
+import math
+
+import numpy as np
+import pytest
+from sim_bridge.errors import WorldGeometryError
+from sim_bridge.geometry import RayCaster, count_crossings, point_segment_distance, wrap_angle
+
+BOX = np.array(
+    [
+        [[0.0, 0.0], [4.0, 0.0]],
+        [[4.0, 0.0], [4.0, 3.0]],
+        [[4.0, 3.0], [0.0, 3.0]],
+        [[0.0, 3.0], [0.0, 0.0]],
+    ]
+)
+
+
+def bin_of(caster: RayCaster, robot_frame_angle_rad: float) -> int:
+    return round((robot_frame_angle_rad - caster.angle_min_rad) / caster.angle_increment_rad)
+
+
+def test_ranges_in_a_box_match_the_distance_to_each_wall_face():
+    caster = RayCaster(BOX, wall_thickness_m=0.1, robot_radius_m=0.1, num_bins=360)
+    ranges = caster.scan(np.array([[1.0, 1.0, 0.0]]), max_range_m=12.0)[0]
+    assert ranges[bin_of(caster, 0.0)] == pytest.approx(3.0 - 0.05)
+    assert ranges[bin_of(caster, math.pi / 2)] == pytest.approx(2.0 - 0.05)
+    assert ranges[bin_of(caster, -math.pi / 2)] == pytest.approx(1.0 - 0.05)
+    assert ranges[bin_of(caster, -math.pi)] == pytest.approx(1.0 - 0.05)
+    diagonal = bin_of(caster, math.pi / 4)
+    assert ranges[diagonal] == pytest.approx(math.sqrt(2) * 1.95)
+    assert np.all(np.isfinite(ranges))
+
+
+def test_scan_bins_rotate_with_the_robot_heading():
+    caster = RayCaster(BOX, wall_thickness_m=0.0, robot_radius_m=0.1, num_bins=360)
+    facing_up = caster.scan(np.array([[1.0, 1.0, math.pi / 2]]), 12.0)[0]
+    # Straight ahead is now +y (2 m away); the robot's left is -x (1 m away).
+    assert facing_up[bin_of(caster, 0.0)] == pytest.approx(2.0)
+    assert facing_up[bin_of(caster, math.pi / 2)] == pytest.approx(1.0)
+
+
+def test_returns_beyond_max_range_are_infinite():
+    caster = RayCaster(BOX, wall_thickness_m=0.0, robot_radius_m=0.1, num_bins=360)
+    ranges = caster.scan(np.array([[1.0, 1.0, 0.0]]), max_range_m=1.5)[0]
+    assert ranges[bin_of(caster, 0.0)] == math.inf
+    assert ranges[bin_of(caster, -math.pi / 2)] == pytest.approx(1.0)
+
+
+def test_rays_hit_other_robots_but_never_the_own_body():
+    caster = RayCaster(np.zeros((0, 2, 2)), wall_thickness_m=0.0, robot_radius_m=0.1, num_bins=360)
+    poses = np.array([[0.0, 0.0, 0.0], [2.0, 0.0, math.pi]])
+    ranges = caster.scan(poses, 12.0)
+    assert ranges[0, bin_of(caster, 0.0)] == pytest.approx(1.9)
+    assert ranges[1, bin_of(caster, 0.0)] == pytest.approx(1.9)
+    assert np.isinf(ranges[0, bin_of(caster, math.pi / 2)])
+
+
+def test_a_ray_along_a_wall_hits_its_end_face():
+    wall = np.array([[[1.0, 0.0], [3.0, 0.0]]])
+    caster = RayCaster(wall, wall_thickness_m=0.1, robot_radius_m=0.1, num_bins=360)
+    ranges = caster.scan(np.array([[0.0, 0.0, 0.0]]), 12.0)[0]
+    assert ranges[bin_of(caster, 0.0)] == pytest.approx(0.95)
+
+
+def test_caster_agrees_with_pybullet_ray_tests():
+    pytest.importorskip('pybullet')
+    from sim_bridge.pybullet_scene import PybulletScene
+
+    rng = np.random.default_rng(4)
+    walls = []
+    for i in range(40):
+        x, y, length = rng.uniform(0, 8), rng.uniform(0, 6), rng.uniform(0.3, 2.0)
+        walls.append([[x, y], [x + length, y]] if i % 2 else [[x, y], [x, y + length]])
+    walls = np.array(walls)
+    caster = RayCaster(walls, wall_thickness_m=0.025, robot_radius_m=0.1, num_bins=360)
+    poses = np.column_stack([rng.uniform(0, 8, 3), rng.uniform(0, 6, 3), rng.uniform(-3, 3, 3)])
+    with PybulletScene(walls, wall_thickness_m=0.025) as scene:
+        for pose in poses:
+            expected = scene.cast_scan(pose, caster.bin_angles_rad, max_range_m=12.0)
+            got = caster.scan(pose[None, :], 12.0)[0]
+            assert np.array_equal(np.isinf(got), np.isinf(expected))
+            finite = np.isfinite(got)
+            assert np.max(np.abs(got[finite] - expected[finite])) < 0.01
+
+
+def test_malformed_walls_are_rejected_with_the_reason():
+    with pytest.raises(WorldGeometryError, match='shape'):
+        RayCaster(np.zeros((3, 2)), wall_thickness_m=0.0, robot_radius_m=0.1, num_bins=360)
+    with pytest.raises(WorldGeometryError, match='zero length'):
+        RayCaster(np.zeros((1, 2, 2)), wall_thickness_m=0.0, robot_radius_m=0.1, num_bins=360)
+    with pytest.raises(WorldGeometryError, match='NaN'):
+        RayCaster(np.full((1, 2, 2), np.nan), wall_thickness_m=0.0, robot_radius_m=0.1, num_bins=8)
+
+
+def test_point_segment_distance_uses_the_nearest_end_point_beyond_a_segment():
+    d = point_segment_distance(np.array([[5.0, 4.0], [2.0, 1.0]]), BOX[:1])
+    assert d[:, 0] == pytest.approx([math.hypot(1.0, 4.0), 1.0])
+
+
+def test_count_crossings_counts_each_wall_between_two_points():
+    starts = np.array([[-1.0, 1.0], [1.0, 1.0]])
+    ends = np.array([[5.0, 1.0], [2.0, 2.0]])
+    assert count_crossings(starts, ends, BOX).tolist() == [2, 0]
+
+
+def test_wrap_angle_maps_into_minus_pi_to_pi():
+    assert wrap_angle(-math.pi) == pytest.approx(math.pi)
+    assert wrap_angle(3 * math.pi / 2) == pytest.approx(-math.pi / 2)
