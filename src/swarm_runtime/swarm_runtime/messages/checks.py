@@ -25,6 +25,7 @@ __all__ = [
     'int8_to_octet',
     'integers_in_range',
     'is_sequence',
+    'numeric_array',
     'octet_to_int8',
     'octets_from_numpy',
     'octets_to_numpy',
@@ -60,8 +61,16 @@ def all_instances(values: Iterable[object], cls: type | tuple[type, ...]) -> boo
     return all(map(isinstance, values, repeat(cls)))
 
 
-def floats_in_range(values: Iterable[float], limit: float) -> bool:
-    """rosidl's float bound: every value in [-limit, limit], or infinite, or NaN."""
+def floats_in_range(values: Sequence[float] | Set[float], limit: float) -> bool:
+    """rosidl's float bound: every value in [-limit, limit], or infinite, or NaN.
+
+    The largest magnitude is found in C first; only when it is out of bounds (or NaN, which
+    can hide it) does the exact per-element test run.
+    """
+    if not values:
+        return True
+    if max(map(abs, values)) <= limit:
+        return True
     return all(not (v < -limit or v > limit) or math.isinf(v) for v in values)
 
 
@@ -107,6 +116,31 @@ def octets_from_numpy(values: np.ndarray) -> list[bytes]:
     """rosbags' int8 array of an octet sequence as rosidl's list of one-byte ``bytes``."""
     raw = values.tobytes()
     return [raw[i : i + 1] for i in range(len(raw))]
+
+
+_TYPECODE_DTYPES = {
+    'f': np.dtype(np.float32),
+    'd': np.dtype(np.float64),
+    'b': np.dtype(np.int8),
+    'B': np.dtype(np.uint8),
+    'h': np.dtype(np.int16),
+    'H': np.dtype(np.uint16),
+    'i': np.dtype(np.int32),
+    'I': np.dtype(np.uint32),
+    'q': np.dtype(np.int64),
+    'Q': np.dtype(np.uint64),
+}
+
+
+def numeric_array(typecode: str, values: Any) -> array:
+    """``array.array(typecode, values)``, with a fast path for a 1-D numpy array of that type."""
+    if (
+        type(values) is np.ndarray
+        and values.ndim == 1
+        and values.dtype == _TYPECODE_DTYPES[typecode]
+    ):
+        return array(typecode, values.tobytes())
+    return array(typecode, values)
 
 
 def array_from_numpy(values: np.ndarray, typecode: str) -> array:

@@ -83,10 +83,11 @@ def _nested_names(spec: MessageSpec) -> dict[str, str]:
     return {typename: f'_msg_{index}' for index, typename in enumerate(spec.nested_types())}
 
 
-def _scalar_default(field: FieldSpec, nested: Mapping[str, str]) -> str:
+def _element_default(field: FieldSpec, nested: Mapping[str, str]) -> str:
+    """Expression of a fresh default element value (rosidl's defaults)."""
     element = field.element
     if element.is_message:
-        return f'{nested[element.nested]}()'
+        return f'_default{nested[element.nested]}()'
     if element.is_string:
         return "''"
     if element.base == 'byte':
@@ -98,160 +99,168 @@ def _scalar_default(field: FieldSpec, nested: Mapping[str, str]) -> str:
     return '0'
 
 
-def _check_lines(field: FieldSpec, nested: Mapping[str, str]) -> list[str]:
-    """Assertions of rosidl's setter for ``field`` (run only when checks are on)."""
+def _default_expr(field: FieldSpec, nested: Mapping[str, str]) -> str:
+    """Expression of a fresh default value of ``field``."""
+    element = field.element
+    if field.is_array:
+        if element.is_numeric:
+            return f'_np.zeros({field.length}, dtype=_np.{element.dtype})'
+        return f'[{_element_default(field, nested)} for _ in range({field.length})]'
+    if field.is_sequence:
+        return f'_array({element.typecode!r})' if element.is_numeric else '[]'
+    return _element_default(field, nested)
+
+
+def _sequence_condition(field: FieldSpec, nested: Mapping[str, str]) -> tuple[str, str]:
+    """rosidl's assertion (condition, message) for an array or sequence field."""
+    element = field.element
+    conditions = ['_is_sequence(value)']
+    suffixes = ['a set or sequence']
+    if element.is_string and element.string_bound:
+        conditions.append(f'all(len(v) <= {element.string_bound} for v in value)')
+        suffixes.append(f'and each string value not longer than {element.string_bound}')
+    if field.is_array:
+        conditions.append(f'len(value) == {field.length}')
+        suffixes.insert(1, f'with length {field.length}')
+    elif field.length:
+        conditions.append(f'len(value) <= {field.length}')
+        suffixes.insert(1, f'with length <= {field.length}')
+    type_expr = nested[element.nested] if element.is_message else element.python_type
+    conditions.append(f'_all_instances(value, {type_expr})')
+    suffixes.append(f"and each value of type '{element.python_type}'")
+    if element.is_integer:
+        low, high = INTEGER_BOUNDS[element.idl_name]
+        conditions.append(f'_integers_in_range(value, {low}, {high})')
+        if low < 0:
+            suffixes.append(f'and each integer in [{low}, {high - 1}]')
+        else:
+            suffixes.append(f'and each unsigned integer in [0, {high - 1}]')
+    elif element.is_float:
+        limit = FLOAT_LIMITS[element.idl_name]
+        conditions.append(f'_floats_in_range(value, {limit!r})')
+        suffixes.append(f'and each {element.idl_name} in [{-limit:f}, {limit:f}]')
+    return ' and '.join(conditions), f"The '{field.name}' field must be {' '.join(suffixes)}"
+
+
+def _scalar_assertions(field: FieldSpec, nested: Mapping[str, str]) -> list[str]:
+    """rosidl's assertions for a field that is not an array or sequence."""
     name = field.name
     element = field.element
-    lines: list[str] = []
-    if field.is_nested and element.is_numeric:
-        if field.is_array:
-            lines += [
-                'if isinstance(value, _ndarray):',
-                f'    assert value.dtype == _np.{element.dtype}, '
-                + repr(
-                    f"The '{name}' numpy.ndarray() must have the dtype of 'numpy.{element.dtype}'"
-                ),
-                f'    assert value.size == {field.length}, '
-                + repr(f"The '{name}' numpy.ndarray() must have a size of {field.length}"),
-                f'    self._{name} = value',
-                '    return',
-            ]
-        else:
-            lines += [
-                'if isinstance(value, _array):',
-                f'    assert value.typecode == {element.typecode!r}, '
-                + repr(
-                    f"The '{name}' array.array() must have the type code of '{element.typecode}'"
-                ),
-            ]
-            if field.length:
-                lines.append(
-                    f'    assert len(value) <= {field.length}, '
-                    + repr(f"The '{name}' array.array() must have a size <= {field.length}")
-                )
-            lines += [f'    self._{name} = value', '    return']
-
-    if field.is_nested:
-        conditions = ['_is_sequence(value)']
-        suffixes = ['a set or sequence']
-        if element.is_string and element.string_bound:
-            conditions.append(f'all(len(v) <= {element.string_bound} for v in value)')
-            suffixes.append(f'and each string value not longer than {element.string_bound}')
-        if field.is_array:
-            conditions.append(f'len(value) == {field.length}')
-            suffixes.insert(1, f'with length {field.length}')
-        elif field.length:
-            conditions.append(f'len(value) <= {field.length}')
-            suffixes.insert(1, f'with length <= {field.length}')
-        type_expr = nested[element.nested] if element.is_message else element.python_type
-        if element.base == 'byte':
-            type_expr = 'bytes'
-        conditions.append(f'_all_instances(value, {type_expr})')
-        suffixes.append(f"and each value of type '{element.python_type}'")
-        if element.is_integer:
-            low, high = INTEGER_BOUNDS[element.idl_name]
-            conditions.append(f'_integers_in_range(value, {low}, {high})')
-            if low < 0:
-                suffixes.append(f'and each integer in [{low}, {high - 1}]')
-            else:
-                suffixes.append(f'and each unsigned integer in [0, {high - 1}]')
-        elif element.is_float:
-            limit = FLOAT_LIMITS[element.idl_name]
-            conditions.append(f'_floats_in_range(value, {limit!r})')
-            suffixes.append(f'and each {element.idl_name} in [{-limit:f}, {limit:f}]')
-        message = f"The '{name}' field must be {' '.join(suffixes)}"
-        lines.append(f'assert {" and ".join(conditions)}, {message!r}')
-        return lines
-
     if element.is_message:
         short = element.nested.rsplit('/', 1)[1]
-        lines.append(
-            f'assert isinstance(value, {nested[element.nested]}), '
-            + repr(f"The '{name}' field must be a sub message of type '{short}'")
-        )
-    elif element.is_string and element.string_bound:
-        lines.append(
-            f'assert isinstance(value, (str, _UserString)) and len(value) <= '
-            f'{element.string_bound}, '
-            + repr(
-                f"The '{name}' field must be string value not longer than {element.string_bound}"
-            )
-        )
-    elif element.is_string:
-        lines.append(
-            'assert isinstance(value, str), ' + repr(f"The '{name}' field must be of type 'str'")
-        )
-    elif element.base == 'byte':
-        lines.append(
-            'assert isinstance(value, (bytes, bytearray)) and len(value) == 1, '
-            + repr(f"The '{name}' field must be of type 'bytes' or 'ByteString' with length 1")
-        )
-    else:
-        python_type = element.python_type
-        lines.append(
-            f'assert isinstance(value, {python_type}), '
-            + repr(f"The '{name}' field must be of type '{python_type}'")
-        )
-        if element.is_integer:
-            low, high = INTEGER_BOUNDS[element.idl_name]
-            kind = 'an integer' if low < 0 else 'an unsigned integer'
-            lines.append(
-                f'assert value >= {low} and value < {high}, '
-                + repr(f"The '{name}' field must be {kind} in [{low}, {high - 1}]")
-            )
-        elif element.is_float:
-            limit = FLOAT_LIMITS[element.idl_name]
-            lines.append(
-                f'assert not (value < {-limit!r} or value > {limit!r}) or _isinf(value), '
-                + repr(
-                    f"The '{name}' field must be a {element.idl_name} in [{-limit!r}, {limit!r}]"
-                )
-            )
+        message = f"The '{name}' field must be a sub message of type '{short}'"
+        return [f'assert isinstance(value, {nested[element.nested]}), {message!r}']
+    if element.is_string and element.string_bound:
+        bound = element.string_bound
+        message = f"The '{name}' field must be string value not longer than {bound}"
+        condition = f'isinstance(value, (str, _UserString)) and len(value) <= {bound}'
+        return [f'assert {condition}, {message!r}']
+    if element.is_string:
+        message = f"The '{name}' field must be of type 'str'"
+        return [f'assert isinstance(value, str), {message!r}']
+    if element.base == 'byte':
+        message = f"The '{name}' field must be of type 'bytes' or 'ByteString' with length 1"
+        return [f'assert isinstance(value, (bytes, bytearray)) and len(value) == 1, {message!r}']
+    python_type = element.python_type
+    lines = [
+        f'assert isinstance(value, {python_type}), '
+        + repr(f"The '{name}' field must be of type '{python_type}'")
+    ]
+    if element.is_integer:
+        low, high = INTEGER_BOUNDS[element.idl_name]
+        kind = 'an integer' if low < 0 else 'an unsigned integer'
+        message = f"The '{name}' field must be {kind} in [{low}, {high - 1}]"
+        lines.append(f'assert value >= {low} and value < {high}, {message!r}')
+    elif element.is_float:
+        limit = FLOAT_LIMITS[element.idl_name]
+        message = f"The '{name}' field must be a {element.idl_name} in [{-limit!r}, {limit!r}]"
+        condition = f'not (value < {-limit!r} or value > {limit!r}) or _isinf(value)'
+        lines.append(f'assert {condition}, {message!r}')
     return lines
 
 
-def _store_expr(field: FieldSpec) -> str:
-    """What the setter stores after the checks (rosidl converts numeric arrays/sequences)."""
+def _checked_store(field: FieldSpec, nested: Mapping[str, str]) -> list[str]:
+    """Lines that check ``value`` as rosidl's setter does, then store it in the slot."""
+    name = field.name
+    element = field.element
+    slot = f'self._{name}'
+    if field.is_nested and element.is_numeric:
+        condition, message = _sequence_condition(field, nested)
+        if field.is_array:
+            dtype = element.dtype
+            return [
+                'if isinstance(value, _ndarray):',
+                f'    assert value.dtype == _np.{dtype}, '
+                + repr(f"The '{name}' numpy.ndarray() must have the dtype of 'numpy.{dtype}'"),
+                f'    assert value.size == {field.length}, '
+                + repr(f"The '{name}' numpy.ndarray() must have a size of {field.length}"),
+                f'    {slot} = value',
+                'else:',
+                f'    assert {condition}, {message!r}',
+                f'    {slot} = _np.array(value, dtype=_np.{dtype})',
+            ]
+        code = element.typecode
+        lines = [
+            'if isinstance(value, _array):',
+            f'    assert value.typecode == {code!r}, '
+            + repr(f"The '{name}' array.array() must have the type code of '{code}'"),
+        ]
+        if field.length:
+            lines.append(
+                f'    assert len(value) <= {field.length}, '
+                + repr(f"The '{name}' array.array() must have a size <= {field.length}")
+            )
+        return [
+            *lines,
+            f'    {slot} = value',
+            'else:',
+            f'    assert {condition}, {message!r}',
+            f'    {slot} = _numeric_array({code!r}, value)',
+        ]
+    if field.is_nested:
+        condition, message = _sequence_condition(field, nested)
+        return [f'assert {condition}, {message!r}', f'{slot} = value']
+    return [*_scalar_assertions(field, nested), f'{slot} = value']
+
+
+def _unchecked_store(field: FieldSpec) -> str:
+    """What the setter stores when checks are off (rosidl still converts numeric arrays)."""
     element = field.element
     if field.is_nested and element.is_numeric:
         if field.is_array:
             return f'_np.array(value, dtype=_np.{element.dtype})'
-        return f'_array({element.typecode!r}, value)'
+        return f'_numeric_array({element.typecode!r}, value)'
     return 'value'
 
 
-def _initial_expr(field: FieldSpec, nested: Mapping[str, str]) -> str:
-    """The value rosidl's constructor passes to the setter."""
+def _constructor_checked(field: FieldSpec, nested: Mapping[str, str]) -> list[str]:
+    """Constructor lines for ``field`` when checks are on."""
     key = repr(field.name)
     element = field.element
-    if field.is_array:
-        if element.is_numeric:
-            default = f'_np.zeros({field.length}, dtype=_np.{element.dtype})'
-        else:
-            default = f'[{_scalar_default(field, nested)} for _ in range({field.length})]'
-        return f'kwargs[{key}] if {key} in kwargs else {default}'
-    if field.is_sequence:
-        if element.is_numeric:
-            return f'_array({element.typecode!r}, kwargs.get({key}, ()))'
-        return f'kwargs[{key}] if {key} in kwargs else []'
-    if element.is_message:
-        return f'kwargs[{key}] if {key} in kwargs else {_scalar_default(field, nested)}'
-    return f'kwargs.get({key}, {_scalar_default(field, nested)})'
-
-
-def _unchecked_expr(field: FieldSpec, nested: Mapping[str, str]) -> str:
-    """The value stored by the constructor when checks are off (setter conversions applied)."""
-    key = repr(field.name)
-    element = field.element
-    if field.is_nested and element.is_numeric:
-        if field.is_array:
-            return (
-                f'_np.array(kwargs[{key}], dtype=_np.{element.dtype}) if {key} in kwargs '
-                f'else _np.zeros({field.length}, dtype=_np.{element.dtype})'
+    lines = [f'if {key} in kwargs:', f'    value = kwargs[{key}]']
+    if field.is_sequence and element.is_numeric:
+        # rosidl's constructor wraps the value in array.array before the setter sees it.
+        lines.append(f'    value = _numeric_array({element.typecode!r}, value)')
+        if field.length:
+            lines.append(
+                f'    assert len(value) <= {field.length}, '
+                + repr(f"The '{field.name}' array.array() must have a size <= {field.length}")
             )
-        code = repr(element.typecode)
-        return f'_array({code}, kwargs[{key}]) if {key} in kwargs else _array({code})'
-    return _initial_expr(field, nested)
+        lines.append(f'    self._{field.name} = value')
+    else:
+        lines.extend(f'    {line}' for line in _checked_store(field, nested))
+    lines += ['else:', f'    self._{field.name} = {_default_expr(field, nested)}']
+    return lines
+
+
+def _constructor_unchecked(field: FieldSpec, nested: Mapping[str, str]) -> str:
+    """Constructor line for ``field`` when checks are off."""
+    key = repr(field.name)
+    default = _default_expr(field, nested)
+    if not field.is_nested and not field.element.is_message:
+        return f'self._{field.name} = kwargs.get({key}, {default})'
+    given = _unchecked_store(field).replace('value', f'kwargs[{key}]')
+    return f'self._{field.name} = {given} if {key} in kwargs else {default}'
 
 
 def class_source(spec: MessageSpec) -> str:
@@ -262,8 +271,9 @@ def class_source(spec: MessageSpec) -> str:
     for index, field in enumerate(spec.fields):
         out.append(f'def _set_{index}(self, value):')
         out.append('    if self._check_fields:')
-        out.extend(f'        {line}' for line in _check_lines(field, nested))
-        out.append(f'    self._{field.name} = {_store_expr(field)}')
+        out.extend(f'        {line}' for line in _checked_store(field, nested))
+        out.append('    else:')
+        out.append(f'        self._{field.name} = {_unchecked_store(field)}')
         out.append('')
 
     out.append('def __init__(self, **kwargs):')
@@ -271,16 +281,22 @@ def class_source(spec: MessageSpec) -> str:
     out.append('    self._check_fields = check')
     out.append('    if check:')
     out.append(
-        '        assert all(key in _VALID_KEYS for key in kwargs), '
+        '        assert _VALID_KEYS.issuperset(kwargs), '
         "'Invalid arguments passed to constructor: %s' % "
         "', '.join(sorted(k for k in kwargs if k not in _VALID_KEYS))"
     )
-    for index, field in enumerate(spec.fields):
-        out.append(f'        _set_{index}(self, {_initial_expr(field, nested)})')
+    for field in spec.fields:
+        out.extend(f'        {line}' for line in _constructor_checked(field, nested))
     if spec.fields:
         out.append('    else:')
-        for field in spec.fields:
-            out.append(f'        self._{field.name} = {_unchecked_expr(field, nested)}')
+        out.extend(f'        {_constructor_unchecked(field, nested)}' for field in spec.fields)
+    out.append('')
+
+    out.append('def _new_default():')
+    out.append('    m = _new(_CLS)')
+    out.append('    m._check_fields = _CHECK_FIELDS')
+    out.extend(f'    m._{field.name} = {_default_expr(field, nested)}' for field in spec.fields)
+    out.append('    return m')
     out.append('')
 
     out.append('def __eq__(self, other):')
@@ -333,12 +349,13 @@ def build_message_class(
     namespace: dict[str, Any] = {
         '_CHECK_FIELDS': check_fields,
         '_VALID_KEYS': frozenset([*(f.name for f in spec.fields), 'check_fields']),
-        '_MISSING': checks.MISSING,
+        '_new': object.__new__,
         '_array': array,
         '_ndarray': np.ndarray,
         '_np': np,
         '_isinf': math.isinf,
         '_UserString': UserString,
+        '_numeric_array': checks.numeric_array,
         '_is_sequence': checks.is_sequence,
         '_all_instances': checks.all_instances,
         '_floats_in_range': checks.floats_in_range,
@@ -348,6 +365,7 @@ def build_message_class(
     }
     for typename, alias in nested.items():
         namespace[alias] = nested_classes[typename]
+        namespace[f'_default{alias}'] = nested_classes[typename]._new_default
     source = class_source(spec)
     exec(compile(source, f'<message {spec.typename}>', 'exec'), namespace)
 
@@ -361,6 +379,7 @@ def build_message_class(
         '__eq__': namespace['__eq__'],
         '__repr__': namespace['__repr__'],
         '__hash__': None,
+        '_new_default': staticmethod(namespace['_new_default']),
         '_fields_and_field_types': {f.name: f.rosidl_text for f in spec.fields},
         'SLOT_TYPES': tuple(f.slot_type() for f in spec.fields),
         'get_fields_and_field_types': classmethod(_get_fields_and_field_types),
@@ -373,7 +392,9 @@ def build_message_class(
             namespace[f'_set_{index}'],
             doc=f"Message field '{field.name}'.",
         )
-    return type(spec.name, (GeneratedMessage,), body)
+    cls = type(spec.name, (GeneratedMessage,), body)
+    namespace['_CLS'] = cls
+    return cls
 
 
 def _get_fields_and_field_types(cls: type) -> dict[str, str]:
