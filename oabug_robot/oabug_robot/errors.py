@@ -1,0 +1,17 @@
+"""Exceptions raised by the OA-Bug core; the node logs them through its logger."""
+
+from __future__ import annotations
+
+__all__ = ['ConfigError', 'OABugError', 'ScanError']
+
+
+class OABugError(Exception):
+    """Base class of every error the oabug_robot package raises."""
+
+
+class ConfigError(OABugError, ValueError):
+    """A configuration value is out of range or inconsistent with another one."""
+
+
+class ScanError(OABugError, ValueError):
+    """A laser scan cannot be interpreted (wrong geometry, empty, non-finite angles)."""

@@ -1,0 +1,340 @@
+"""The OA-Bug finite state machine (paper Fig. 3, Table I) for all five variants.
+
+States: JUST_STARTED (heading out along a direction, or still on a wall it is about to
+leave) and FOLLOWING_WALL. Triggers, checked every control step in this order:
+
+* hitting others (a peer return in the front cone): turn right by 90 deg (``fixed_turn``),
+  JUST_STARTED;
+* hitting a wall while heading out: take up the wall on a side (fixed, or chosen from the
+  sound direction), FOLLOWING_WALL;
+* at an outer corner while following: Minimum and Sound leave towards the preferred
+  direction (Sound updates it from the bearings first); Gas and Gas+Sound keep following
+  unless the place smells visited, in which case they count the revisit, switch to
+  JUST_STARTED and leave at the *next* outer corner, towards the preferred direction
+  flipped by 180 deg once the revisit count reaches ``revisit_flip_count``, otherwise
+  (Gas+Sound) towards the sound direction.
+
+Random is the blank control: straight legs, a new uniform heading on every hit and, after
+each ``random_step_m`` driven, with probability ``random_turn_probability``.
+
+Besides the paper's state the controller keeps a motion mode (turning in place to a
+heading, going straight, following a wall) that turns its decisions into velocities.
+:meth:`OABugFsm.step` is the only entry point: one sensor snapshot in, one command out.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from enum import Enum
+
+import numpy as np
+
+from oabug_robot.corners import CornerDetector
+from oabug_robot.heading import angle_difference, preferred_direction, wrap_angle
+from oabug_robot.motion import Twist2D, follow_wall, go_straight, turn_in_place
+from oabug_robot.pump import PumpSchedule
+from oabug_robot.scan_features import ScanFeatures
+from oabug_robot.settings import OABugConfig, SoundMemory, SoundTurnRule, TurnDirection, Variant
+from oabug_robot.sound import PeerBearings, opposite_direction
+
+__all__ = ['Command', 'Event', 'FsmMemory', 'FsmState', 'Mode', 'OABugFsm', 'SensorSnapshot']
+
+# Longest time step the Random variant integrates its driven distance over [s].
+_MAX_STEP_S = 1.0
+
+
+class FsmState(Enum):
+    """The paper's two main states."""
+
+    JUST_STARTED = 0
+    FOLLOWING_WALL = 1
+
+
+class Mode(Enum):
+    """What the robot is physically doing."""
+
+    TURN = 0  # rotating in place to target_yaw_rad, then STRAIGHT
+    STRAIGHT = 1  # driving along target_yaw_rad
+    FOLLOW = 2  # following the wall on wall_side
+
+
+class Event(Enum):
+    """What happened in a control step (the last one wins when several do)."""
+
+    NONE = 0
+    START = 1
+    HIT_WALL = 2
+    HIT_ROBOT = 3
+    OUTER_CORNER = 4  # passed an outer corner and kept following
+    REVISIT = 5  # outer corner that smelled visited: leave at the next one
+    LEAVE_WALL = 6  # left the wall towards a direction
+    FLIP = 7  # left the wall towards the preferred direction flipped by 180 deg
+    RANDOM_TURN = 8
+
+
+@dataclass(frozen=True)
+class SensorSnapshot:
+    """Everything the controller reads in one control step.
+
+    Attributes:
+        time_s: current time [s] (sim time in simulation).
+        yaw_rad: heading from the IMU [rad].
+        scan: features of the latest lidar scan.
+        gas_raw: latest gas reading on the 10-bit scale, or None when there is none.
+        bearings: latest peer bearings, or None when none were heard.
+    """
+
+    time_s: float
+    yaw_rad: float
+    scan: ScanFeatures
+    gas_raw: int | None = None
+    bearings: PeerBearings | None = None
+
+
+@dataclass(frozen=True)
+class Command:
+    """Output of one control step: velocity and pump."""
+
+    linear_mps: float
+    angular_radps: float
+    pump_on: bool
+
+
+@dataclass
+class FsmMemory:
+    """The controller's complete mutable state (everything a step may change).
+
+    Angles are radians in the yaw frame, times seconds.
+    """
+
+    state: FsmState = FsmState.JUST_STARTED
+    mode: Mode = Mode.TURN
+    wall_side: int = 0  # +1 wall on the left, -1 on the right, 0 none
+    preferred_direction_rad: float = 0.0
+    target_yaw_rad: float = 0.0
+    leave_at_next_corner: bool = False
+    visit_count: int = 0
+    flip_count: int = 0
+    last_scent_s: float = -math.inf
+    started_s: float | None = None
+    last_step_s: float | None = None
+    random_distance_m: float = 0.0
+    event: Event = Event.NONE
+    counts: dict[Event, int] = field(default_factory=dict)
+
+
+class OABugFsm:
+    """One robot's OA-Bug controller; deterministic given its config (and seed)."""
+
+    def __init__(self, config: OABugConfig) -> None:
+        self._config = config
+        self._rng = np.random.default_rng(config.seed)
+        self._pump = PumpSchedule(config.pump_on_s, config.pump_period_s)
+        self._corners = CornerDetector()
+        phi = preferred_direction(
+            config.robot_index, config.robot_count, config.departure, config.heading_bias_rad
+        )
+        self._memory = FsmMemory(preferred_direction_rad=phi, target_yaw_rad=phi)
+        # Right turn: clockwise, and the wall ends up on the left.
+        self._fixed_turn_sign = -1 if config.fixed_turn is TurnDirection.RIGHT else 1
+
+    @property
+    def config(self) -> OABugConfig:
+        """The configuration this controller runs with."""
+        return self._config
+
+    @property
+    def memory(self) -> FsmMemory:
+        """The controller's state (read it; do not modify it)."""
+        return self._memory
+
+    def scent_detected(self, time_s: float) -> bool:
+        """True when the gas reading crossed the threshold within the scent window."""
+        return time_s - self._memory.last_scent_s <= self._config.scent_window_s
+
+    def step(self, snapshot: SensorSnapshot) -> Command:
+        """Advance one control step and return the command to apply until the next one."""
+        mem = self._memory
+        mem.event = Event.NONE
+        if mem.started_s is None:
+            mem.started_s = snapshot.time_s
+            self._record(Event.START)
+        dt = 0.0 if mem.last_step_s is None else snapshot.time_s - mem.last_step_s
+        mem.last_step_s = snapshot.time_s
+        gas = snapshot.gas_raw
+        if (
+            self._config.variant.uses_scent
+            and gas is not None
+            and gas >= self._config.gas_threshold
+        ):
+            mem.last_scent_s = snapshot.time_s
+        if self._config.variant is Variant.RANDOM:
+            twist = self._step_random(snapshot, min(max(dt, 0.0), _MAX_STEP_S))
+        else:
+            twist = self._step_bug(snapshot)
+        pump = self._config.variant.uses_scent and self._pump.is_on(snapshot.time_s - mem.started_s)
+        return Command(float(twist.linear_mps), float(twist.angular_radps), bool(pump))
+
+    # Bug variants ---------------------------------------------------------------------------
+
+    def _step_bug(self, snap: SensorSnapshot) -> Twist2D:
+        mem = self._memory
+        cfg = self._config
+        scan = snap.scan
+        if mem.mode is not Mode.TURN and scan.front_robot_m <= cfg.perception.robot_hit_distance_m:
+            self._on_hit_robot(snap)
+        if mem.mode is Mode.TURN:
+            error = angle_difference(mem.target_yaw_rad, snap.yaw_rad)
+            if abs(error) > cfg.motion.heading_tolerance_rad:
+                return turn_in_place(error, cfg.motion)
+            mem.mode = Mode.STRAIGHT
+        if mem.mode is Mode.STRAIGHT:
+            if scan.front_wall_m > cfg.perception.wall_hit_distance_m:
+                error = angle_difference(mem.target_yaw_rad, snap.yaw_rad)
+                return go_straight(error, cfg.motion)
+            self._on_hit_wall(snap)
+        elif self._corners.update(
+            snap.time_s, snap.yaw_rad, mem.wall_side, scan.side(mem.wall_side)
+        ):
+            self._on_outer_corner(snap)
+            if mem.mode is Mode.TURN:
+                error = angle_difference(mem.target_yaw_rad, snap.yaw_rad)
+                return turn_in_place(error, cfg.motion)
+        front_blocked = scan.front_wall_m <= cfg.perception.wall_hit_distance_m
+        return follow_wall(mem.wall_side, scan.side(mem.wall_side), front_blocked, cfg.motion)
+
+    def _on_hit_robot(self, snap: SensorSnapshot) -> None:
+        mem = self._memory
+        self._turn_to(wrap_angle(snap.yaw_rad + self._fixed_turn_sign * math.pi / 2))
+        mem.state = FsmState.JUST_STARTED
+        self._record(Event.HIT_ROBOT)
+
+    def _on_hit_wall(self, snap: SensorSnapshot) -> None:
+        """Just Started -> Following Wall: pick the side to keep the wall on."""
+        mem = self._memory
+        # Turning right (clockwise) away from the wall leaves it on the left.
+        side = -self._fixed_turn_sign
+        if self._config.variant.uses_sound:
+            theta = self._sound_direction(snap)
+            if theta is not None:
+                if self._config.sound_memory is SoundMemory.STORED:
+                    mem.preferred_direction_rad = theta
+                side = self._side_from_sound(theta, snap.yaw_rad, side)
+        mem.state = FsmState.FOLLOWING_WALL
+        mem.mode = Mode.FOLLOW
+        mem.wall_side = side
+        mem.leave_at_next_corner = False
+        self._corners.reset()
+        self._record(Event.HIT_WALL)
+
+    def _side_from_sound(self, theta_rad: float, yaw_rad: float, default_side: int) -> int:
+        """Wall side for turning towards (TOWARD) or away from (AWAY) the peers.
+
+        Turning left (towards theta_opp on the left) keeps the wall on the right (-1).
+        """
+        relative = angle_difference(theta_rad, yaw_rad)
+        if relative == 0.0 or abs(relative) == math.pi:
+            return default_side
+        away_side = -1 if relative > 0.0 else 1
+        return away_side if self._config.sound_turn_rule is SoundTurnRule.AWAY else -away_side
+
+    def _on_outer_corner(self, snap: SensorSnapshot) -> None:
+        mem = self._memory
+        cfg = self._config
+        variant = cfg.variant
+        if mem.state is FsmState.FOLLOWING_WALL:
+            if not variant.uses_scent:
+                heading = mem.preferred_direction_rad
+                if variant.uses_sound and cfg.sound_updates_at_corner:
+                    theta = self._sound_direction(snap)
+                    if theta is not None:
+                        heading = theta
+                        if cfg.sound_memory is SoundMemory.STORED:
+                            mem.preferred_direction_rad = theta
+                self._leave_wall(heading, Event.LEAVE_WALL)
+            elif self.scent_detected(snap.time_s):
+                mem.last_scent_s = -math.inf
+                mem.visit_count += 1
+                mem.state = FsmState.JUST_STARTED
+                mem.leave_at_next_corner = True
+                self._record(Event.REVISIT)
+            else:
+                if cfg.visit_count_resets_on_fresh_corner:
+                    mem.visit_count = 0
+                self._record(Event.OUTER_CORNER)
+            return
+        # Just Started, still on the wall after a revisit: leave now.
+        if mem.visit_count >= cfg.revisit_flip_count:
+            mem.visit_count = 0
+            mem.flip_count += 1
+            mem.preferred_direction_rad = wrap_angle(mem.preferred_direction_rad + math.pi)
+            self._leave_wall(mem.preferred_direction_rad, Event.FLIP)
+            return
+        heading = mem.preferred_direction_rad
+        if variant.uses_sound:
+            theta = self._sound_direction(snap)
+            if theta is not None:
+                heading = theta
+                if cfg.sound_memory is SoundMemory.STORED:
+                    mem.preferred_direction_rad = theta
+        self._leave_wall(heading, Event.LEAVE_WALL)
+
+    def _leave_wall(self, heading_rad: float, event: Event) -> None:
+        mem = self._memory
+        self._turn_to(heading_rad)
+        mem.state = FsmState.JUST_STARTED
+        self._record(event)
+
+    def _turn_to(self, heading_rad: float) -> None:
+        mem = self._memory
+        mem.mode = Mode.TURN
+        mem.target_yaw_rad = wrap_angle(heading_rad)
+        mem.wall_side = 0
+        mem.leave_at_next_corner = False
+
+    def _sound_direction(self, snap: SensorSnapshot) -> float | None:
+        """theta_opp in the yaw frame [rad], or None when no fresh bearings are heard."""
+        bearings = snap.bearings
+        if bearings is None or snap.time_s - bearings.stamp_s > self._config.bearing_timeout_s:
+            return None
+        theta = opposite_direction(
+            bearings.azimuths_rad, bearings.distances_m, self._config.sound_weighting
+        )
+        return None if theta is None else wrap_angle(theta + bearings.yaw_at_stamp_rad)
+
+    # Random (blank control) -----------------------------------------------------------------
+
+    def _step_random(self, snap: SensorSnapshot, dt_s: float) -> Twist2D:
+        mem = self._memory
+        cfg = self._config
+        if mem.mode is Mode.TURN:
+            error = angle_difference(mem.target_yaw_rad, snap.yaw_rad)
+            if abs(error) > cfg.motion.heading_tolerance_rad:
+                return turn_in_place(error, cfg.motion)
+            mem.mode = Mode.STRAIGHT
+            mem.random_distance_m = 0.0
+        scan = snap.scan
+        if scan.front_wall_m <= cfg.perception.wall_hit_distance_m:
+            return self._random_turn(snap, Event.HIT_WALL)
+        if scan.front_robot_m <= cfg.perception.robot_hit_distance_m:
+            return self._random_turn(snap, Event.HIT_ROBOT)
+        mem.random_distance_m += cfg.motion.forward_speed_mps * dt_s
+        while mem.random_distance_m >= cfg.motion.random_step_m:
+            mem.random_distance_m -= cfg.motion.random_step_m
+            if self._rng.random() < cfg.motion.random_turn_probability:
+                return self._random_turn(snap, Event.RANDOM_TURN)
+        return go_straight(angle_difference(mem.target_yaw_rad, snap.yaw_rad), cfg.motion)
+
+    def _random_turn(self, snap: SensorSnapshot, event: Event) -> Twist2D:
+        mem = self._memory
+        mem.mode = Mode.TURN
+        mem.target_yaw_rad = float(self._rng.uniform(-math.pi, math.pi))
+        self._record(event)
+        return turn_in_place(
+            angle_difference(mem.target_yaw_rad, snap.yaw_rad), self._config.motion
+        )
+
+    def _record(self, event: Event) -> None:
+        self._memory.event = event
+        self._memory.counts[event] = self._memory.counts.get(event, 0) + 1

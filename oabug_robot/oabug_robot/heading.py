@@ -1,0 +1,51 @@
+"""Angles: wrapping, yaw from the IMU quaternion, the paper's preferred directions."""
+
+from __future__ import annotations
+
+import math
+
+from oabug_robot.settings import Departure
+
+__all__ = ['angle_difference', 'preferred_direction', 'wrap_angle', 'yaw_from_quaternion']
+
+TWO_PI = 2.0 * math.pi
+
+
+def wrap_angle(angle_rad: float) -> float:
+    """Return ``angle_rad`` wrapped to (-pi, pi]."""
+    wrapped = math.fmod(angle_rad + math.pi, TWO_PI)
+    if wrapped <= 0.0:
+        wrapped += TWO_PI
+    return wrapped - math.pi
+
+
+def angle_difference(target_rad: float, source_rad: float) -> float:
+    """Return the signed rotation [rad], in (-pi, pi], from ``source_rad`` to ``target_rad``."""
+    return wrap_angle(target_rad - source_rad)
+
+
+def yaw_from_quaternion(x: float, y: float, z: float, w: float) -> float:
+    """Return the yaw [rad] (rotation about +z, REP 103) of the quaternion (x, y, z, w).
+
+    The quaternion need not be normalised; a zero quaternion raises ValueError.
+    """
+    norm_sq = x * x + y * y + z * z + w * w
+    if not norm_sq > 0.0 or not math.isfinite(norm_sq):
+        msg = f'quaternion ({x}, {y}, {z}, {w}) has no orientation'
+        raise ValueError(msg)
+    return math.atan2(2.0 * (w * z + x * y), w * w + x * x - y * y - z * z)
+
+
+def preferred_direction(
+    robot_index: int, robot_count: int, departure: Departure, bias_rad: float
+) -> float:
+    """Return robot i's preferred direction phi_i [rad], wrapped to (-pi, pi].
+
+    Centre departure (paper, Sec. II-B): phi_i = bias + i * 2 pi / n. Edge departure: the n
+    directions split the half circle into the building evenly, phi_i = bias + (i + 1/2) *
+    pi / n, so with bias = (direction into the building) - pi/2 no robot starts along the
+    outer wall.
+    """
+    if departure is Departure.CENTER:
+        return wrap_angle(bias_rad + robot_index * TWO_PI / robot_count)
+    return wrap_angle(bias_rad + (robot_index + 0.5) * math.pi / robot_count)

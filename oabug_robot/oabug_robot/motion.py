@@ -1,0 +1,82 @@
+"""Motion primitives: turn in place, go straight on a heading, follow a wall.
+
+Each is a pure function of the current error signals and returns a :class:`Twist2D`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from oabug_robot.heading import angle_difference
+from oabug_robot.scan_features import SideWall
+from oabug_robot.settings import MotionConfig
+
+__all__ = ['STOP', 'Twist2D', 'follow_wall', 'go_straight', 'turn_in_place']
+
+
+@dataclass(frozen=True)
+class Twist2D:
+    """A planar velocity command: forward speed [m/s] and yaw rate [rad/s, CCW positive]."""
+
+    linear_mps: float
+    angular_radps: float
+
+
+STOP = Twist2D(0.0, 0.0)
+
+# Heading errors above this are turned out on the spot before driving on.
+_DRIVE_ERROR_RAD = math.radians(30.0)
+# Slowest forward speed while following, as a fraction of cruise speed.
+_MIN_FOLLOW_FRACTION = 0.3
+
+
+def _clamp(value: float, limit: float) -> float:
+    return max(-limit, min(limit, value))
+
+
+def turn_in_place(error_rad: float, cfg: MotionConfig) -> Twist2D:
+    """Rotate on the spot to remove ``error_rad`` (target minus current heading)."""
+    rate = min(
+        cfg.turn_rate_radps, max(cfg.min_turn_rate_radps, cfg.heading_gain_per_s * abs(error_rad))
+    )
+    return Twist2D(0.0, math.copysign(rate, error_rad))
+
+
+def go_straight(error_rad: float, cfg: MotionConfig) -> Twist2D:
+    """Drive at cruise speed holding a heading; ``error_rad`` is target minus current heading."""
+    if abs(error_rad) > _DRIVE_ERROR_RAD:
+        return turn_in_place(error_rad, cfg)
+    return Twist2D(
+        cfg.forward_speed_mps, _clamp(cfg.heading_gain_per_s * error_rad, cfg.turn_rate_radps)
+    )
+
+
+def follow_wall(side: int, wall: SideWall, front_blocked: bool, cfg: MotionConfig) -> Twist2D:
+    """Keep the wall on ``side`` (+1 left, -1 right) at ``cfg.wall_distance_m``.
+
+    The nearest wall return on that side is held abeam (bearing side * 90 deg) at the set
+    distance, so the robot runs along straight walls, wraps round wall ends and door jambs
+    (the return stays at the set distance while it circles the end) and turns away from a
+    wall that blocks the way (inner corner).
+
+    Args:
+        side: the followed side.
+        wall: the nearest wall return on that side.
+        front_blocked: a wall is within hit distance ahead.
+        cfg: speeds and gains.
+    """
+    if front_blocked:
+        return Twist2D(0.0, -side * cfg.turn_rate_radps)
+    if not wall.found:
+        # Lost the wall: arc towards its side until it is back in capture range.
+        speed = 0.5 * cfg.forward_speed_mps
+        return Twist2D(speed, side * min(cfg.turn_rate_radps, speed / cfg.wall_distance_m))
+    angle_error = angle_difference(wall.bearing_rad, side * math.pi / 2)
+    distance_error = wall.distance_m - cfg.wall_distance_m
+    rate = (
+        cfg.wall_angle_gain_per_s * angle_error
+        + side * cfg.wall_distance_gain_radps_per_m * distance_error
+    )
+    fraction = max(_MIN_FOLLOW_FRACTION, math.cos(min(abs(angle_error), math.pi / 2)))
+    return Twist2D(cfg.forward_speed_mps * fraction, _clamp(rate, cfg.turn_rate_radps))

@@ -1,0 +1,233 @@
+"""What the controller needs from one lidar scan: wall ahead, robot ahead, the side walls.
+
+The scan is read the way REP 117 defines it: NaN is an erroneous reading (ignored), +inf is
+"nothing within range" (free space), -inf is "closer than range_min" (an obstacle at
+range_min), and finite values outside [range_min, range_max] are ignored. Returns that
+belong to a peer robot are recognised with the peers' AoA bearings: within the angular
+window a bearing defines (its tolerance plus the angle a peer's body spans), the nearest
+return and everything within one body diameter behind it belong to the peer. Those returns
+count as "another robot", never as wall, so wall following and wall hits ignore peers and
+robot hits ignore walls.
+
+Only returns within the feature range (``PerceptionConfig.feature_range_m``, at least the
+capture and hit distances) are looked at: nothing farther changes what the controller
+does, and the arrays stay short. Everything is vectorized over the rays.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from oabug_robot.errors import ScanError
+from oabug_robot.settings import PerceptionConfig
+
+__all__ = ['LaserScanData', 'ScanFeatureExtractor', 'ScanFeatures', 'SideWall']
+
+_NO_ANGLES = np.zeros(0)
+
+
+@dataclass(frozen=True)
+class LaserScanData:
+    """The parts of a sensor_msgs/LaserScan the controller reads.
+
+    Attributes:
+        ranges_m: (N,) ranges [m], NaN/inf allowed (REP 117).
+        angle_min_rad: angle of the first ray in the lidar frame [rad].
+        angle_increment_rad: angle between rays [rad], non-zero.
+        range_min_m: smallest valid range [m].
+        range_max_m: largest valid range [m].
+    """
+
+    ranges_m: np.ndarray
+    angle_min_rad: float
+    angle_increment_rad: float
+    range_min_m: float
+    range_max_m: float
+
+
+@dataclass(frozen=True)
+class SideWall:
+    """The nearest wall return on one side of the robot.
+
+    Attributes:
+        distance_m: range of that return [m]; inf when there is none within capture range.
+        bearing_rad: its direction in the robot frame [rad]; NaN when there is none.
+    """
+
+    distance_m: float = math.inf
+    bearing_rad: float = math.nan
+
+    @property
+    def found(self) -> bool:
+        """True when a wall return lies on this side within capture range."""
+        return math.isfinite(self.distance_m)
+
+
+@dataclass(frozen=True)
+class ScanFeatures:
+    """Features of one scan in the robot frame (x forward, y left).
+
+    Attributes:
+        front_wall_m: forward distance [m] to the nearest wall return inside the corridor the
+            robot sweeps; inf when the corridor is clear up to the feature range.
+        front_robot_m: range [m] of the nearest peer return inside the front cone; inf if none.
+        left: nearest wall return on the left half-plane (slightly past the centre line).
+        right: nearest wall return on the right half-plane.
+        near_returns: number of rays that hit something within the feature range.
+        peer_returns: number of those attributed to peers.
+    """
+
+    front_wall_m: float = math.inf
+    front_robot_m: float = math.inf
+    left: SideWall = SideWall()
+    right: SideWall = SideWall()
+    near_returns: int = 0
+    peer_returns: int = 0
+
+    def side(self, side: int) -> SideWall:
+        """Return the wall on ``side`` (+1 left, -1 right)."""
+        return self.left if side > 0 else self.right
+
+
+class _RayTable:
+    """cos/sin of every ray, cached for one scan geometry (it rarely changes)."""
+
+    def __init__(self, angle_min_rad: float, angle_increment_rad: float, count: int) -> None:
+        self.key = (angle_min_rad, angle_increment_rad, count)
+        self.angles_rad = angle_min_rad + angle_increment_rad * np.arange(count, dtype=float)
+        self.angles_rad = np.mod(self.angles_rad + math.pi, 2.0 * math.pi) - math.pi
+        self.cos = np.cos(self.angles_rad)
+        self.sin = np.sin(self.angles_rad)
+
+
+class ScanFeatureExtractor:
+    """Turns scans (plus the peers' bearings) into :class:`ScanFeatures`."""
+
+    def __init__(self, config: PerceptionConfig) -> None:
+        self._config = config
+        self._table: _RayTable | None = None
+        self._feature_range_m = max(
+            config.follow_capture_m,
+            config.robot_hit_distance_m,
+            config.wall_hit_distance_m,
+            config.feature_range_m,
+        )
+
+    def _rays(self, scan: LaserScanData, count: int) -> _RayTable:
+        angle_min = scan.angle_min_rad + self._config.lidar_yaw_offset_rad
+        key = (angle_min, scan.angle_increment_rad, count)
+        if self._table is None or self._table.key != key:
+            if not (math.isfinite(angle_min) and math.isfinite(scan.angle_increment_rad)):
+                raise ScanError('scan angles must be finite')
+            if scan.angle_increment_rad == 0.0 and count > 1:
+                raise ScanError('scan angle_increment is zero')
+            self._table = _RayTable(angle_min, scan.angle_increment_rad, count)
+        return self._table
+
+    def extract(
+        self, scan: LaserScanData, peer_azimuths_rad: np.ndarray = _NO_ANGLES
+    ) -> ScanFeatures:
+        """Return the features of ``scan``.
+
+        Args:
+            scan: the scan; its ranges may contain NaN and +-inf.
+            peer_azimuths_rad: (B,) bearings of the peers heard, robot frame [rad].
+
+        Raises:
+            ScanError: the scan has no rays or its angles are not finite.
+        """
+        cfg = self._config
+        ranges = np.asarray(scan.ranges_m, dtype=float)
+        if ranges.ndim != 1 or ranges.size == 0:
+            raise ScanError(f'scan must have at least one range, got shape {ranges.shape}')
+        rays = self._rays(scan, ranges.size)
+        range_min = max(float(scan.range_min_m), 0.0)
+        range_max = float(scan.range_max_m)
+        too_close = ranges == -math.inf
+        if too_close.any():
+            # REP 117: -inf means "too close to measure", i.e. an obstacle at range_min.
+            ranges = np.where(too_close, range_min, ranges)
+        # Nothing farther than the feature range changes a feature; NaN and +inf fail both tests.
+        limit = min(range_max, self._feature_range_m)
+        with np.errstate(invalid='ignore'):
+            index = np.flatnonzero((ranges >= range_min) & (ranges <= limit))
+        if index.size == 0:
+            return ScanFeatures()
+        r = ranges[index]
+        cos = rays.cos[index]
+        x = r * cos
+        y = r * rays.sin[index]
+
+        azimuths = np.asarray(peer_azimuths_rad, dtype=float)
+        is_peer = self._peer_mask(r, rays.angles_rad[index], azimuths) if azimuths.size else None
+        front = (x > 0.0) & (np.abs(y) <= cfg.front_half_width_m)
+        captured = r <= cfg.follow_capture_m
+        front_robot = math.inf
+        peer_returns = 0
+        if is_peer is not None:
+            peer_returns = int(np.count_nonzero(is_peer))
+            if peer_returns:
+                cone = is_peer & (cos >= math.cos(cfg.robot_cone_half_angle_rad))
+                if cone.any():
+                    front_robot = float(r[cone].min())
+                is_wall = ~is_peer
+                front &= is_wall
+                captured &= is_wall
+        front_wall = float(x[front].min()) if front.any() else math.inf
+        left = self._nearest(r, index, rays, captured & (y >= -cfg.side_overlap_m))
+        right = self._nearest(r, index, rays, captured & (y <= cfg.side_overlap_m))
+        return ScanFeatures(
+            front_wall_m=front_wall,
+            front_robot_m=front_robot,
+            left=left,
+            right=right,
+            near_returns=int(index.size),
+            peer_returns=peer_returns,
+        )
+
+    def _peer_mask(self, r: np.ndarray, angles: np.ndarray, azimuths: np.ndarray) -> np.ndarray:
+        """Return a (K,) mask of the returns that belong to the peers at ``azimuths``.
+
+        Each return is compared with the bearing closest to it in angle only (peers rarely
+        overlap in azimuth), which keeps the cost independent of the number of peers.
+
+        Args:
+            r: (K,) ranges of the returns [m].
+            angles: (K,) their directions in the robot frame, in [-pi, pi) [rad].
+            azimuths: (B,) peer bearings [rad]; NaN entries are skipped.
+        """
+        cfg = self._config
+        is_peer = np.zeros(r.size, dtype=bool)
+        azimuths = azimuths[np.isfinite(azimuths)]
+        near = np.flatnonzero(r <= cfg.peer_mask_range_m)
+        if azimuths.size == 0 or near.size == 0:
+            return is_peer
+        bearings = np.sort(np.arctan2(np.sin(azimuths), np.cos(azimuths)))
+        r_near = r[near]
+        a_near = angles[near]
+        after = np.searchsorted(bearings, a_near) % bearings.size
+        before = after - 1  # -1 wraps to the last bearing
+        off_after = np.abs(a_near - bearings[after])
+        off_after = np.minimum(off_after, 2.0 * math.pi - off_after)
+        off_before = np.abs(a_near - bearings[before])
+        off_before = np.minimum(off_before, 2.0 * math.pi - off_before)
+        closer_after = off_after < off_before
+        which = np.where(closer_after, after, before % bearings.size)
+        offset = np.where(closer_after, off_after, off_before)
+        window = offset <= cfg.peer_bearing_tolerance_rad + np.arctan2(cfg.robot_radius_m, r_near)
+        if not window.any():
+            return is_peer
+        nearest = np.full(bearings.size, math.inf)
+        np.minimum.at(nearest, which[window], r_near[window])
+        is_peer[near] = window & (r_near <= nearest[which] + 2.0 * cfg.robot_radius_m)
+        return is_peer
+
+    @staticmethod
+    def _nearest(r: np.ndarray, index: np.ndarray, rays: _RayTable, mask: np.ndarray) -> SideWall:
+        if not mask.any():
+            return SideWall()
+        best = int(np.argmin(np.where(mask, r, math.inf)))
+        return SideWall(distance_m=float(r[best]), bearing_rad=float(rays.angles_rad[index[best]]))

@@ -1,0 +1,284 @@
+"""Configuration of the OA-Bug controller: the paper's parameters as documented defaults.
+
+Paper: Tan et al., "OA-Bug: An Olfactory-Auditory Augmented Bug Algorithm for Swarm Robots
+in a Denied Environment" (IROS 2023). Where the authors' simulator or robot code departs
+from the paper, the default follows the paper and the alternative is an enum value here
+(see docs/oabug.md, "Choices").
+
+Angles are radians in the IMU's yaw frame (REP 103: counter-clockwise positive), distances
+metres, durations seconds.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, fields
+from enum import Enum
+
+from oabug_robot.errors import ConfigError
+
+__all__ = [
+    'Departure',
+    'MotionConfig',
+    'OABugConfig',
+    'PerceptionConfig',
+    'SoundMemory',
+    'SoundTurnRule',
+    'SoundWeighting',
+    'TurnDirection',
+    'Variant',
+]
+
+
+class Variant(Enum):
+    """The five algorithms of the paper's Table I."""
+
+    RANDOM = 'random'  # blank control: straight legs, random headings
+    MINIMUM = 'minimum'  # "Bug 0": fixed turn side, leaves every outer corner towards phi_i
+    SOUND = 'sound'  # auditory only: turn side and phi' from the peers' bearings
+    GAS = 'gas'  # olfactory only ("Advanced Bug 1"): scent-based revisit rule
+    GAS_SOUND = 'gas_sound'  # full OA-Bug
+
+    @classmethod
+    def parse(cls, text: str) -> Variant:
+        """Return the variant named ``text`` (case-insensitive), or raise ConfigError."""
+        try:
+            return cls(text.strip().lower())
+        except ValueError:
+            names = ', '.join(v.value for v in cls)
+            msg = f'unknown OA-Bug variant {text!r}; expected one of {names}'
+            raise ConfigError(msg) from None
+
+    @property
+    def uses_scent(self) -> bool:
+        """True for the variants that pump a scent trail and read the gas sensor."""
+        return self in (Variant.GAS, Variant.GAS_SOUND)
+
+    @property
+    def uses_sound(self) -> bool:
+        """True for the variants that steer by the peers' bearings."""
+        return self in (Variant.SOUND, Variant.GAS_SOUND)
+
+
+class Departure(Enum):
+    """Where the swarm sets off; decides how the preferred directions fan out."""
+
+    CENTER = 'center'  # full circle: phi_i = bias + i * 360 deg / n (paper Sec. II-B)
+    EDGE = 'edge'  # half circle into the building: phi_i = bias + (i + 1/2) * 180 deg / n
+
+    @classmethod
+    def parse(cls, text: str) -> Departure:
+        """Return the departure named ``text`` (case-insensitive), or raise ConfigError."""
+        try:
+            return cls(text.strip().lower())
+        except ValueError:
+            msg = f'unknown departure {text!r}; expected center or edge'
+            raise ConfigError(msg) from None
+
+
+class TurnDirection(Enum):
+    """A fixed turn side ("all turn right")."""
+
+    LEFT = 'left'
+    RIGHT = 'right'
+
+
+class SoundTurnRule(Enum):
+    """How the sound variants pick the wall-following side at a first wall contact."""
+
+    AWAY = 'away'  # paper ("spread out") and the authors' robot: turn away from the peers
+    TOWARD = 'toward'  # the authors' simulator: turn toward the peers' resultant
+
+
+class SoundWeighting(Enum):
+    """How the peers' bearings are summed into the resultant c_i,opp = -sum_j c_j."""
+
+    DISTANCE = 'distance'  # paper: c_j = (dx_j, dy_j), so far peers weigh more (unit if unknown)
+    UNIT = 'unit'  # the authors' robot: unit vectors along each bearing
+
+
+class SoundMemory(Enum):
+    """Whether the sound direction theta_opp becomes the stored preferred direction."""
+
+    STORED = 'stored'  # paper: phi'_i = theta_opp is the new preferred direction
+    ONCE = 'once'  # the authors' simulator: used for one turn, only 180 deg flips are stored
+
+
+def _require(condition: bool, message: str) -> None:
+    if not condition:
+        raise ConfigError(message)
+
+
+@dataclass(frozen=True)
+class PerceptionConfig:
+    """How the lidar scan and the bearings are read.
+
+    Attributes:
+        robot_radius_m: radius of the own body (and of the peers' bodies) [m].
+        front_half_width_m: half width of the corridor ahead checked for walls [m].
+        wall_hit_distance_m: a wall return this close ahead (from the lidar origin) is a hit [m].
+        robot_hit_distance_m: a peer return this close inside the front cone is a hit [m].
+        robot_cone_half_angle_rad: half angle of the cone in which peers count as hit [rad]
+            (the authors' robot: 30 deg).
+        peer_bearing_tolerance_rad: angular error allowed between a bearing and the peer's
+            lidar returns [rad]; added to the angle the peer's body spans.
+        peer_mask_range_m: returns farther than this are never attributed to a peer [m]; a
+            peer beyond it cannot touch any feature the controller uses.
+        feature_range_m: returns farther than this (or than the capture and hit distances,
+            whichever is largest) are ignored [m].
+        follow_capture_m: a side return farther than this does not count as the followed wall [m].
+        side_overlap_m: how far past the centre line a return may lie and still count for a
+            side (lets a wall ahead pull the follower round an inner corner) [m].
+        lidar_yaw_offset_rad: yaw of the lidar's zero ray in the robot frame [rad].
+    """
+
+    robot_radius_m: float = 0.12
+    front_half_width_m: float = 0.14
+    wall_hit_distance_m: float = 0.28
+    robot_hit_distance_m: float = 0.40
+    robot_cone_half_angle_rad: float = math.radians(30.0)
+    peer_bearing_tolerance_rad: float = math.radians(10.0)
+    peer_mask_range_m: float = 1.0
+    feature_range_m: float = 1.0
+    follow_capture_m: float = 0.8
+    side_overlap_m: float = 0.05
+    lidar_yaw_offset_rad: float = 0.0
+
+    def __post_init__(self) -> None:
+        for f in fields(self):
+            value = getattr(self, f.name)
+            _require(math.isfinite(value), f'{f.name} must be finite, got {value!r}')
+            if f.name != 'lidar_yaw_offset_rad':
+                _require(value >= 0.0, f'{f.name} must be >= 0, got {value!r}')
+        _require(self.robot_radius_m > 0.0, 'robot_radius_m must be > 0')
+        _require(
+            self.wall_hit_distance_m > self.robot_radius_m,
+            'wall_hit_distance_m must exceed robot_radius_m',
+        )
+        _require(
+            self.robot_cone_half_angle_rad < math.pi / 2,
+            'robot_cone_half_angle_rad must be below 90 deg',
+        )
+
+
+@dataclass(frozen=True)
+class MotionConfig:
+    """Speeds and gains of the motion primitives (turn in place, go straight, follow wall).
+
+    Attributes:
+        forward_speed_mps: cruise speed [m/s].
+        turn_rate_radps: largest yaw rate commanded [rad/s].
+        min_turn_rate_radps: smallest yaw rate of a turn in place, so turns finish [rad/s].
+        heading_gain_per_s: P gain of the heading controller [1/s].
+        heading_tolerance_rad: a turn in place ends when the heading error is below this [rad].
+        wall_distance_m: distance kept from the followed wall, lidar origin to wall [m].
+        wall_distance_gain_radps_per_m: yaw rate per metre of wall-distance error [rad/(s m)].
+        wall_angle_gain_per_s: yaw rate per radian of wall-direction error [1/s].
+        random_step_m: the Random variant redraws its heading with probability
+            random_turn_probability after each such distance driven (the authors' action
+            length, 0.1 m).
+        random_turn_probability: see random_step_m (authors' simulator: 1/2).
+    """
+
+    forward_speed_mps: float = 0.3
+    turn_rate_radps: float = 1.5
+    min_turn_rate_radps: float = 0.3
+    heading_gain_per_s: float = 3.0
+    heading_tolerance_rad: float = math.radians(3.0)
+    wall_distance_m: float = 0.25
+    wall_distance_gain_radps_per_m: float = 6.0
+    wall_angle_gain_per_s: float = 2.5
+    random_step_m: float = 0.1
+    random_turn_probability: float = 0.5
+
+    def __post_init__(self) -> None:
+        for f in fields(self):
+            value = getattr(self, f.name)
+            _require(math.isfinite(value), f'{f.name} must be finite, got {value!r}')
+            _require(value > 0.0, f'{f.name} must be > 0, got {value!r}')
+        _require(
+            self.min_turn_rate_radps <= self.turn_rate_radps,
+            'min_turn_rate_radps must not exceed turn_rate_radps',
+        )
+        _require(self.random_turn_probability <= 1.0, 'random_turn_probability must be <= 1')
+
+
+@dataclass(frozen=True)
+class OABugConfig:
+    """Everything one OA-Bug robot needs to know; built once from the node's parameters.
+
+    Attributes:
+        variant: which algorithm of Table I runs.
+        robot_index: i, this robot's index in the swarm, 0 <= i < robot_count.
+        robot_count: n, the number of robots that depart together.
+        departure: centre (full-circle fan) or edge (half-circle fan into the building).
+        heading_bias_rad: the paper's common "bias" [rad]; for an edge departure, the
+            direction into the building minus 90 deg, so the fan is centred on it.
+        gas_threshold: raw 10-bit gas reading at or above which a place smells visited
+            (paper: 200).
+        scent_window_s: a reading above the threshold counts as "scent at this corner" for
+            this long, because the MP503 is slow [s].
+        revisit_flip_count: after this many revisits the preferred direction flips by 180 deg
+            (paper: "e.g., three times"; counted as >=, like the authors' simulator).
+        visit_count_resets_on_fresh_corner: forget the revisit count at an unscented corner,
+            i.e. count revisits in a row (the paper's "nearby area thoroughly searched").
+        fixed_turn: side turned to at a first wall contact without sound, and after hitting
+            another robot (paper: "all turn right").
+        sound_turn_rule: see SoundTurnRule (paper: away).
+        sound_weighting: see SoundWeighting (paper: distance).
+        sound_memory: see SoundMemory (paper: stored).
+        sound_updates_at_corner: the Sound variant updates phi' from the bearings at outer
+            corners (paper, Table I); False leaves it at phi_i (the authors' simulator).
+        pump_on_s: pump burst length (paper: 0.5 s).
+        pump_period_s: time between burst starts (paper: every 5 s).
+        bearing_timeout_s: bearings older than this are not used [s].
+        seed: seed of the Random variant's generator.
+        perception: lidar and bearing interpretation.
+        motion: speeds and controller gains.
+    """
+
+    variant: Variant = Variant.GAS_SOUND
+    robot_index: int = 0
+    robot_count: int = 1
+    departure: Departure = Departure.CENTER
+    heading_bias_rad: float = 0.0
+    gas_threshold: int = 200
+    scent_window_s: float = 2.0
+    revisit_flip_count: int = 3
+    visit_count_resets_on_fresh_corner: bool = True
+    fixed_turn: TurnDirection = TurnDirection.RIGHT
+    sound_turn_rule: SoundTurnRule = SoundTurnRule.AWAY
+    sound_weighting: SoundWeighting = SoundWeighting.DISTANCE
+    sound_memory: SoundMemory = SoundMemory.STORED
+    sound_updates_at_corner: bool = True
+    pump_on_s: float = 0.5
+    pump_period_s: float = 5.0
+    bearing_timeout_s: float = 1.0
+    seed: int = 0
+    perception: PerceptionConfig = field(default_factory=PerceptionConfig)
+    motion: MotionConfig = field(default_factory=MotionConfig)
+
+    def __post_init__(self) -> None:
+        _require(self.robot_count >= 1, f'robot_count must be >= 1, got {self.robot_count}')
+        _require(
+            0 <= self.robot_index < self.robot_count,
+            f'robot_index must be in [0, {self.robot_count - 1}], got {self.robot_index}',
+        )
+        _require(math.isfinite(self.heading_bias_rad), 'heading_bias_rad must be finite')
+        _require(
+            0 <= self.gas_threshold <= 1023,
+            f'gas_threshold must be on the 10-bit scale 0..1023, got {self.gas_threshold}',
+        )
+        _require(self.revisit_flip_count >= 1, 'revisit_flip_count must be >= 1')
+        for name in ('scent_window_s', 'bearing_timeout_s'):
+            value = getattr(self, name)
+            _require(math.isfinite(value) and value >= 0.0, f'{name} must be >= 0')
+        _require(
+            math.isfinite(self.pump_period_s) and self.pump_period_s > 0.0,
+            'pump_period_s must be > 0',
+        )
+        _require(
+            math.isfinite(self.pump_on_s) and 0.0 <= self.pump_on_s <= self.pump_period_s,
+            f'pump_on_s must be in [0, pump_period_s], got {self.pump_on_s}',
+        )
+        _require(self.seed >= 0, 'seed must be >= 0')

@@ -1,0 +1,505 @@
+"""Scripted sensor sequences drive the OA-Bug state machine through its transitions."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from oabug_robot.fsm import Event, FsmState, Mode, OABugFsm, SensorSnapshot
+from oabug_robot.heading import angle_difference
+from oabug_robot.scan_features import ScanFeatures, SideWall
+from oabug_robot.settings import (
+    OABugConfig,
+    SoundMemory,
+    SoundTurnRule,
+    TurnDirection,
+    Variant,
+)
+from oabug_robot.sound import PeerBearings
+
+DT = 0.1
+BUG_VARIANTS = [Variant.MINIMUM, Variant.SOUND, Variant.GAS, Variant.GAS_SOUND]
+
+
+def free() -> ScanFeatures:
+    return ScanFeatures()
+
+
+def wall_ahead() -> ScanFeatures:
+    return ScanFeatures(front_wall_m=0.2, left=SideWall(0.2, 0.0), right=SideWall(0.2, 0.0))
+
+
+def robot_ahead() -> ScanFeatures:
+    return ScanFeatures(front_robot_m=0.3)
+
+
+def side_wall(side: int, bearing_deg: float = 90.0) -> ScanFeatures:
+    wall = SideWall(0.25, side * math.radians(bearing_deg))
+    return ScanFeatures(left=wall) if side > 0 else ScanFeatures(right=wall)
+
+
+class Script:
+    """Feeds snapshots at 10 Hz with a fixed yaw unless told otherwise."""
+
+    def __init__(self, fsm: OABugFsm, yaw_rad: float = 0.0) -> None:
+        self.fsm = fsm
+        self.index = 0
+        self.yaw_rad = yaw_rad
+        self.gas_raw = 0
+        self.bearings: PeerBearings | None = None
+
+    def step(self, scan: ScanFeatures, yaw_rad: float | None = None):
+        if yaw_rad is not None:
+            self.yaw_rad = yaw_rad
+        snapshot = SensorSnapshot(
+            time_s=self.time_s,
+            yaw_rad=self.yaw_rad,
+            scan=scan,
+            gas_raw=self.gas_raw,
+            bearings=self.bearings,
+        )
+        command = self.fsm.step(snapshot)
+        self.index += 1
+        return command
+
+    @property
+    def time_s(self) -> float:
+        return self.index * DT
+
+    def hear(self, azimuths_deg: list[float], distances_m: list[float] | None = None) -> None:
+        azimuths = np.radians(azimuths_deg)
+        distances = np.full(azimuths.size, np.nan) if distances_m is None else np.array(distances_m)
+        self.bearings = PeerBearings(azimuths, distances, self.time_s, self.yaw_rad)
+
+    def follow_straight(self, side: int, steps: int = 8) -> None:
+        """The wall stays abeam while the heading is held: the corner reference settles."""
+        for _ in range(steps):
+            self.step(side_wall(side))
+
+    def pass_outer_corner(self, side: int):
+        """The nearest wall return swings past abeam towards the rear: the wall has ended."""
+        return self.step(side_wall(side, bearing_deg=90.0 + 50.0))
+
+
+def make(variant: Variant, **overrides) -> OABugFsm:
+    return OABugFsm(OABugConfig(variant=variant, **overrides))
+
+
+def reach_wall(script: Script) -> None:
+    script.step(free())
+    script.step(wall_ahead())
+
+
+@pytest.mark.parametrize('variant', BUG_VARIANTS)
+def test_robot_heads_out_along_its_preferred_direction_first(variant: Variant) -> None:
+    fsm = make(variant, robot_index=1, robot_count=4)
+    script = Script(fsm, yaw_rad=0.0)
+    command = script.step(free())
+    assert fsm.memory.state is FsmState.JUST_STARTED
+    assert fsm.memory.event is Event.START
+    assert fsm.memory.mode is Mode.TURN
+    assert fsm.memory.target_yaw_rad == pytest.approx(math.pi / 2)
+    assert command.linear_mps == 0.0
+    assert command.angular_radps > 0.0
+    command = script.step(free(), yaw_rad=math.pi / 2)
+    assert fsm.memory.mode is Mode.STRAIGHT
+    assert command.linear_mps > 0.0
+
+
+@pytest.mark.parametrize('variant', BUG_VARIANTS)
+def test_hitting_a_wall_from_just_started_starts_wall_following(variant: Variant) -> None:
+    fsm = make(variant)
+    script = Script(fsm)
+    reach_wall(script)
+    assert fsm.memory.state is FsmState.FOLLOWING_WALL
+    assert fsm.memory.event is Event.HIT_WALL
+    assert fsm.memory.mode is Mode.FOLLOW
+    assert fsm.memory.wall_side != 0
+
+
+@pytest.mark.parametrize('variant', [Variant.MINIMUM, Variant.GAS])
+def test_fixed_turn_right_keeps_the_wall_on_the_left_and_turns_clockwise(variant: Variant) -> None:
+    fsm = make(variant, fixed_turn=TurnDirection.RIGHT)
+    script = Script(fsm)
+    script.step(free())
+    command = script.step(wall_ahead())
+    assert fsm.memory.wall_side == 1
+    assert command.linear_mps == 0.0
+    assert command.angular_radps < 0.0
+
+
+def test_fixed_turn_left_keeps_the_wall_on_the_right() -> None:
+    fsm = make(Variant.MINIMUM, fixed_turn=TurnDirection.LEFT)
+    script = Script(fsm)
+    script.step(free())
+    command = script.step(wall_ahead())
+    assert fsm.memory.wall_side == -1
+    assert command.angular_radps > 0.0
+
+
+@pytest.mark.parametrize('variant', BUG_VARIANTS)
+def test_hitting_another_robot_turns_right_and_returns_to_just_started(variant: Variant) -> None:
+    fsm = make(variant)
+    script = Script(fsm, yaw_rad=0.0)
+    reach_wall(script)
+    script.follow_straight(1)
+    assert fsm.memory.state is FsmState.FOLLOWING_WALL
+    command = script.step(robot_ahead())
+    assert fsm.memory.event is Event.HIT_ROBOT
+    assert fsm.memory.state is FsmState.JUST_STARTED
+    assert fsm.memory.mode is Mode.TURN
+    assert fsm.memory.wall_side == 0
+    assert fsm.memory.target_yaw_rad == pytest.approx(-math.pi / 2)
+    assert command.angular_radps < 0.0
+
+
+@pytest.mark.parametrize('variant', BUG_VARIANTS)
+def test_hitting_another_robot_while_heading_out_stays_just_started(variant: Variant) -> None:
+    fsm = make(variant)
+    script = Script(fsm)
+    script.step(free())
+    script.step(robot_ahead())
+    assert fsm.memory.event is Event.HIT_ROBOT
+    assert fsm.memory.state is FsmState.JUST_STARTED
+
+
+def test_a_peer_is_not_hit_while_turning_in_place() -> None:
+    fsm = make(Variant.GAS)
+    script = Script(fsm, yaw_rad=0.0)
+    script.step(free())
+    script.step(robot_ahead())
+    script.step(robot_ahead())
+    assert fsm.memory.counts[Event.HIT_ROBOT] == 1
+
+
+@pytest.mark.parametrize('variant', [Variant.MINIMUM, Variant.SOUND])
+def test_variants_without_scent_leave_the_wall_at_every_outer_corner(variant: Variant) -> None:
+    fsm = make(variant, robot_count=1)
+    script = Script(fsm, yaw_rad=0.0)
+    reach_wall(script)
+    script.follow_straight(1)
+    script.pass_outer_corner(1)
+    assert fsm.memory.event is Event.LEAVE_WALL
+    assert fsm.memory.state is FsmState.JUST_STARTED
+    assert fsm.memory.mode is Mode.TURN
+    assert fsm.memory.target_yaw_rad == pytest.approx(0.0)
+
+
+def test_minimum_always_returns_to_the_initial_preferred_direction() -> None:
+    fsm = make(Variant.MINIMUM, robot_index=2, robot_count=4)
+    phi = fsm.memory.preferred_direction_rad
+    script = Script(fsm, yaw_rad=phi)
+    for _ in range(3):
+        reach_wall(script)
+        script.follow_straight(1)
+        script.pass_outer_corner(1)
+        assert fsm.memory.target_yaw_rad == pytest.approx(phi)
+        script.step(free(), yaw_rad=phi)
+
+
+def test_a_wall_already_being_followed_does_not_retrigger_wall_hits() -> None:
+    fsm = make(Variant.GAS)
+    script = Script(fsm)
+    reach_wall(script)
+    script.step(wall_ahead())
+    script.step(wall_ahead())
+    assert fsm.memory.counts[Event.HIT_WALL] == 1
+    assert fsm.memory.state is FsmState.FOLLOWING_WALL
+
+
+@pytest.mark.parametrize('variant', [Variant.GAS, Variant.GAS_SOUND])
+def test_gas_variants_keep_following_round_an_unscented_outer_corner(variant: Variant) -> None:
+    fsm = make(variant)
+    script = Script(fsm)
+    reach_wall(script)
+    script.follow_straight(1)
+    script.gas_raw = 150
+    script.pass_outer_corner(1)
+    assert fsm.memory.event is Event.OUTER_CORNER
+    assert fsm.memory.state is FsmState.FOLLOWING_WALL
+    assert fsm.memory.mode is Mode.FOLLOW
+
+
+@pytest.mark.parametrize('variant', [Variant.GAS, Variant.GAS_SOUND])
+def test_scented_outer_corner_switches_to_just_started_and_leaves_at_the_next_one(
+    variant: Variant,
+) -> None:
+    fsm = make(variant, robot_count=1)
+    script = Script(fsm)
+    reach_wall(script)
+    script.follow_straight(1)
+    script.gas_raw = 250
+    script.step(side_wall(1))
+    script.gas_raw = 40
+    command = script.pass_outer_corner(1)
+    assert fsm.memory.event is Event.REVISIT
+    assert fsm.memory.visit_count == 1
+    assert fsm.memory.state is FsmState.JUST_STARTED
+    assert fsm.memory.mode is Mode.FOLLOW, 'it keeps following up to the next outer corner'
+    assert command.linear_mps > 0.0
+    script.follow_straight(1)
+    assert fsm.memory.mode is Mode.FOLLOW
+    script.pass_outer_corner(1)
+    assert fsm.memory.event is Event.LEAVE_WALL
+    assert fsm.memory.mode is Mode.TURN
+    assert fsm.memory.target_yaw_rad == pytest.approx(fsm.memory.preferred_direction_rad)
+
+
+def test_scent_older_than_the_window_does_not_count_as_a_revisit() -> None:
+    fsm = make(Variant.GAS, scent_window_s=1.0)
+    script = Script(fsm)
+    reach_wall(script)
+    script.gas_raw = 300
+    script.step(side_wall(1))
+    script.gas_raw = 0
+    script.follow_straight(1, steps=15)
+    script.pass_outer_corner(1)
+    assert fsm.memory.event is Event.OUTER_CORNER
+    assert fsm.memory.state is FsmState.FOLLOWING_WALL
+
+
+def test_scent_below_the_threshold_is_not_a_revisit() -> None:
+    fsm = make(Variant.GAS, gas_threshold=200)
+    script = Script(fsm)
+    reach_wall(script)
+    script.follow_straight(1)
+    script.gas_raw = 199
+    script.pass_outer_corner(1)
+    assert fsm.memory.event is Event.OUTER_CORNER
+
+
+def revisit_and_leave(script: Script) -> None:
+    """Hit a wall, pass a scented corner, pass the next corner (and leave), head out again."""
+    reach_wall(script)
+    script.follow_straight(1)
+    script.gas_raw = 400
+    script.pass_outer_corner(1)
+    script.gas_raw = 0
+    script.follow_straight(1, steps=25)
+    script.pass_outer_corner(1)
+    script.step(free(), yaw_rad=script.fsm.memory.target_yaw_rad)
+
+
+@pytest.mark.parametrize('variant', [Variant.GAS, Variant.GAS_SOUND])
+def test_third_revisit_flips_the_preferred_direction_by_180_degrees(variant: Variant) -> None:
+    fsm = make(variant, robot_count=1, revisit_flip_count=3, heading_bias_rad=0.3)
+    script = Script(fsm, yaw_rad=0.3)
+    revisit_and_leave(script)
+    revisit_and_leave(script)
+    assert fsm.memory.visit_count == 2
+    assert fsm.memory.flip_count == 0
+    phi_before = fsm.memory.preferred_direction_rad
+    reach_wall(script)
+    script.follow_straight(1)
+    script.gas_raw = 400
+    script.pass_outer_corner(1)
+    assert fsm.memory.visit_count == 3
+    script.gas_raw = 0
+    script.follow_straight(1, steps=25)
+    script.pass_outer_corner(1)
+    assert fsm.memory.event is Event.FLIP
+    assert fsm.memory.flip_count == 1
+    assert fsm.memory.visit_count == 0
+    flipped = angle_difference(fsm.memory.preferred_direction_rad, phi_before)
+    assert abs(flipped) == pytest.approx(math.pi)
+    assert fsm.memory.target_yaw_rad == pytest.approx(fsm.memory.preferred_direction_rad)
+
+
+def test_an_unscented_corner_resets_the_revisit_count_by_default() -> None:
+    fsm = make(Variant.GAS)
+    script = Script(fsm)
+    revisit_and_leave(script)
+    assert fsm.memory.visit_count == 1
+    reach_wall(script)
+    script.follow_straight(1)
+    script.pass_outer_corner(1)
+    assert fsm.memory.visit_count == 0
+
+
+def test_revisit_count_can_accumulate_across_fresh_corners() -> None:
+    fsm = make(Variant.GAS, visit_count_resets_on_fresh_corner=False)
+    script = Script(fsm)
+    revisit_and_leave(script)
+    reach_wall(script)
+    script.follow_straight(1)
+    script.pass_outer_corner(1)
+    assert fsm.memory.visit_count == 1
+
+
+def test_sound_direction_is_opposite_to_the_resultant_of_the_bearings() -> None:
+    fsm = make(Variant.SOUND, robot_count=3)
+    script = Script(fsm, yaw_rad=0.0)
+    script.step(free(), yaw_rad=fsm.memory.preferred_direction_rad)
+    script.step(free(), yaw_rad=0.0)
+    # Peers ahead-right (-45 deg) and behind-right (-135 deg): resultant to the right (-90).
+    script.hear([-45.0, -135.0], [2.0, 2.0])
+    script.step(wall_ahead())
+    assert fsm.memory.preferred_direction_rad == pytest.approx(math.pi / 2)
+
+
+@pytest.mark.parametrize(
+    ('rule', 'expected_side'), [(SoundTurnRule.AWAY, -1), (SoundTurnRule.TOWARD, 1)]
+)
+@pytest.mark.parametrize('variant', [Variant.SOUND, Variant.GAS_SOUND])
+def test_sound_variants_choose_the_wall_side_from_the_peers(
+    variant: Variant, rule: SoundTurnRule, expected_side: int
+) -> None:
+    fsm = make(variant, robot_count=2, sound_turn_rule=rule)
+    script = Script(fsm, yaw_rad=0.0)
+    script.step(free(), yaw_rad=fsm.memory.preferred_direction_rad)
+    script.step(free(), yaw_rad=0.0)
+    script.hear([-90.0])  # the peer is on the right, theta_opp on the left
+    command = script.step(wall_ahead())
+    assert fsm.memory.wall_side == expected_side
+    # AWAY turns left (counter-clockwise) so the wall ends up on the right.
+    assert math.copysign(1.0, command.angular_radps) == -expected_side
+
+
+def test_sound_turn_side_uses_bearings_rotated_into_the_current_heading() -> None:
+    fsm = make(Variant.SOUND, robot_count=2)
+    script = Script(fsm, yaw_rad=0.0)
+    script.step(free())
+    script.hear([-90.0])  # heard at yaw 0: theta_opp points to yaw +90 deg
+    script.step(free(), yaw_rad=math.radians(120.0))
+    script.step(wall_ahead())
+    # From heading 120 deg, +90 deg lies to the right: turn right, wall on the left.
+    assert fsm.memory.wall_side == 1
+
+
+@pytest.mark.parametrize('variant', [Variant.SOUND, Variant.GAS_SOUND])
+def test_without_bearings_sound_variants_fall_back_to_the_fixed_turn(variant: Variant) -> None:
+    fsm = make(variant, fixed_turn=TurnDirection.RIGHT)
+    script = Script(fsm)
+    reach_wall(script)
+    assert fsm.memory.wall_side == 1
+
+
+def test_stale_bearings_are_not_used() -> None:
+    fsm = make(Variant.SOUND, robot_count=2, bearing_timeout_s=0.5, fixed_turn=TurnDirection.RIGHT)
+    script = Script(fsm, yaw_rad=0.0)
+    script.step(free())
+    script.hear([-90.0])
+    for _ in range(10):
+        script.step(free())
+    script.step(wall_ahead())
+    assert fsm.memory.wall_side == 1
+
+
+def test_sound_variant_updates_the_preferred_direction_at_outer_corners() -> None:
+    fsm = make(Variant.SOUND, robot_count=2)
+    script = Script(fsm, yaw_rad=0.0)
+    reach_wall(script)
+    script.follow_straight(1)
+    script.hear([0.0], [3.0])  # peer straight ahead: go back
+    script.pass_outer_corner(1)
+    assert fsm.memory.event is Event.LEAVE_WALL
+    assert abs(fsm.memory.target_yaw_rad) == pytest.approx(math.pi)
+    assert abs(fsm.memory.preferred_direction_rad) == pytest.approx(math.pi)
+
+
+def test_sound_variant_as_in_the_authors_simulator_keeps_its_initial_direction() -> None:
+    fsm = make(Variant.SOUND, robot_count=2, sound_updates_at_corner=False)
+    phi = fsm.memory.preferred_direction_rad
+    script = Script(fsm, yaw_rad=phi)
+    reach_wall(script)
+    script.follow_straight(1)
+    script.hear([0.0], [3.0])
+    script.pass_outer_corner(1)
+    assert fsm.memory.target_yaw_rad == pytest.approx(phi)
+
+
+@pytest.mark.parametrize(
+    ('memory', 'stored'), [(SoundMemory.STORED, True), (SoundMemory.ONCE, False)]
+)
+def test_gas_sound_leaves_a_revisited_wall_towards_the_sound_direction(
+    memory: SoundMemory, stored: bool
+) -> None:
+    fsm = make(
+        Variant.GAS_SOUND, robot_count=2, sound_memory=memory, fixed_turn=TurnDirection.RIGHT
+    )
+    phi = fsm.memory.preferred_direction_rad
+    script = Script(fsm, yaw_rad=phi)
+    reach_wall(script)
+    script.follow_straight(1)
+    script.gas_raw = 300
+    script.pass_outer_corner(1)
+    script.gas_raw = 0
+    script.follow_straight(1, steps=25)
+    script.hear([90.0], [2.0])  # peer on the left: theta_opp to the right of the heading
+    script.pass_outer_corner(1)
+    expected = phi - math.pi / 2
+    assert angle_difference(fsm.memory.target_yaw_rad, expected) == pytest.approx(0.0, abs=1e-9)
+    changed = abs(angle_difference(fsm.memory.preferred_direction_rad, phi)) > 1e-6
+    assert changed is stored
+
+
+def test_random_variant_turns_to_a_random_heading_on_every_hit() -> None:
+    fsm = make(Variant.RANDOM, seed=4)
+    script = Script(fsm, yaw_rad=0.0)
+    script.step(free())
+    targets = set()
+    for scan in (wall_ahead(), robot_ahead()):
+        script.step(free(), yaw_rad=fsm.memory.target_yaw_rad)
+        script.step(scan)
+        assert fsm.memory.mode is Mode.TURN
+        targets.add(round(fsm.memory.target_yaw_rad, 9))
+    assert fsm.memory.counts[Event.HIT_WALL] == 1
+    assert fsm.memory.counts[Event.HIT_ROBOT] == 1
+    assert len(targets) == 2
+    assert fsm.memory.state is FsmState.JUST_STARTED
+
+
+def test_random_variant_redraws_its_heading_after_driving_one_step() -> None:
+    fsm = make(Variant.RANDOM)
+    fsm_config = fsm.config
+    assert fsm_config.motion.random_step_m == pytest.approx(0.1)
+    always = OABugFsm(
+        OABugConfig(
+            variant=Variant.RANDOM,
+            motion=type(fsm_config.motion)(random_turn_probability=1.0),
+        )
+    )
+    script = Script(always, yaw_rad=always.memory.target_yaw_rad)
+    script.step(free())
+    script.step(free())  # 0.1 s at 0.3 m/s: 0.03 m driven
+    assert always.memory.mode is Mode.STRAIGHT
+    for _ in range(3):
+        script.step(free())
+    assert always.memory.counts.get(Event.RANDOM_TURN, 0) == 1
+
+
+def test_random_variant_is_deterministic_for_a_seed() -> None:
+    def run(seed: int) -> list[float]:
+        fsm = make(Variant.RANDOM, seed=seed)
+        script = Script(fsm)
+        targets = []
+        for _ in range(200):
+            script.step(free(), yaw_rad=fsm.memory.target_yaw_rad)
+            targets.append(fsm.memory.target_yaw_rad)
+        return targets
+
+    assert run(7) == run(7)
+    assert run(7) != run(8)
+
+
+@pytest.mark.parametrize('variant', list(Variant))
+def test_pump_runs_half_a_second_every_five_seconds_only_for_gas_variants(variant: Variant) -> None:
+    fsm = make(variant)
+    script = Script(fsm)
+    pump = [script.step(free()).pump_on for _ in range(100)]
+    if variant.uses_scent:
+        assert pump[:5] == [True] * 5
+        assert pump[5:50] == [False] * 45
+        assert pump[50:55] == [True] * 5
+        assert sum(pump) == 10
+    else:
+        assert not any(pump)
+
+
+def test_commands_are_python_floats_and_bools() -> None:
+    fsm = make(Variant.GAS_SOUND)
+    command = Script(fsm).step(free())
+    assert type(command.linear_mps) is float
+    assert type(command.angular_radps) is float
+    assert type(command.pump_on) is bool
