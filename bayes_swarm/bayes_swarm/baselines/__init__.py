@@ -1,0 +1,7 @@
+"""Comparison methods of the Bayes-Swarm-P study (ALGORITHM_SPECS.md §2-§4)."""
+
+from bayes_swarm.baselines.exhaustive import sweep_paths
+from bayes_swarm.baselines.glowworm import GlowwormSwarm, glowworm_step
+from bayes_swarm.baselines.levy import LevyWalk
+
+__all__ = ['GlowwormSwarm', 'LevyWalk', 'glowworm_step', 'sweep_paths']

@@ -1,0 +1,338 @@
+"""Gaussian-process belief of the signal field (paper Sec. 2.3, Appendix A).
+
+Zero prior mean, squared-exponential kernel
+
+    k(x, x') = s2 * exp(-|x - x'|^2 / (2 l^2)),   K_eps = K + noise_std^2 I,
+
+hyperparameters (s2, l) by maximum marginal likelihood within bounds (L-BFGS-B on their
+logarithms, analytic gradient). The posterior is kept as a Cholesky factor; if it fails the
+diagonal receives growing jitter, and if even ``max_jitter`` fails the hyperparameters are
+reset and refitted once before :class:`~bayes_swarm.errors.GpFitError` is raised.
+
+Posterior variance does not depend on the observed values, so the "extended" variance of
+Eq. 7 (observations plus the peers' planned path points) reuses the same hyperparameters and
+extends the Cholesky factor block-wise instead of fitting a second GP.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.linalg import LinAlgError, cho_solve, cholesky, solve_triangular
+from scipy.linalg.lapack import dpotri
+from scipy.optimize import minimize
+
+from bayes_swarm.config import GpConfig
+from bayes_swarm.errors import GpFitError, ObservationError
+
+__all__ = [
+    'GaussianProcess',
+    'Hyperparameters',
+    'downsample_indices',
+    'se_kernel',
+]
+
+
+@dataclass(frozen=True)
+class Hyperparameters:
+    """Kernel hyperparameters: signal variance [signal^2] and length scale [m]."""
+
+    signal_variance: float
+    length_scale_m: float
+
+
+def se_kernel(a: np.ndarray, b: np.ndarray, hyper: Hyperparameters) -> np.ndarray:
+    """Squared-exponential covariance between (n, 2) points ``a`` and (m, 2) points ``b``.
+
+    Returns an (n, m) array.
+    """
+    return hyper.signal_variance * np.exp(-0.5 * _squared_distances(a, b) / hyper.length_scale_m**2)
+
+
+def _squared_distances(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    diff_x = a[:, 0:1] - b[:, 0][None, :]
+    diff_y = a[:, 1:2] - b[:, 1][None, :]
+    return diff_x * diff_x + diff_y * diff_y
+
+
+def downsample_indices(n: int, n_max: int, *, floor_rule: bool = False) -> np.ndarray:
+    """Indices kept when ``n`` time-ordered samples are compressed to at most ``n_max``.
+
+    The paper (Sec. 2.6) keeps the first sample and every d-th after it with
+    d = ceil(n / N_max). ``floor_rule`` reproduces the authors' code, d = floor(n / N_max),
+    which keeps up to about 2 N_max samples.
+    """
+    if n_max < 1:
+        msg = f'n_max must be >= 1, got {n_max}'
+        raise ObservationError(msg)
+    if n <= n_max:
+        return np.arange(n)
+    step = n // n_max if floor_rule else math.ceil(n / n_max)
+    return np.arange(0, n, max(step, 1))
+
+
+class GaussianProcess:
+    """GP regression on 2-D inputs with a Cholesky-factored posterior.
+
+    Typical use::
+
+        gp = GaussianProcess(GpConfig())
+        gp.fit(x_m, values)                 # (n, 2), (n,)
+        mean, std = gp.predict(query_m)     # (q,), (q,)
+    """
+
+    def __init__(self, config: GpConfig) -> None:
+        self._config = config
+        self._hyper = Hyperparameters(config.initial_signal_variance, config.initial_length_scale_m)
+        self._fitted_hyper: Hyperparameters | None = None
+        self._n_at_last_fit = 0
+        self._x = np.zeros((0, 2))
+        self._y = np.zeros(0)
+        self._chol = np.zeros((0, 0))
+        self._weights = np.zeros(0)
+        self._jitter = 0.0
+
+    @property
+    def hyperparameters(self) -> Hyperparameters:
+        """Current kernel hyperparameters."""
+        return self._hyper
+
+    @property
+    def noise_variance(self) -> float:
+        """Observation noise variance on the kernel diagonal [signal^2] (without jitter)."""
+        return self._config.noise_std**2
+
+    @property
+    def n_samples(self) -> int:
+        """Number of samples the posterior is conditioned on."""
+        return int(self._x.shape[0])
+
+    @property
+    def training_inputs(self) -> np.ndarray:
+        """(n, 2) array of the conditioning locations [m] (read-only view)."""
+        view = self._x.view()
+        view.flags.writeable = False
+        return view
+
+    # ------------------------------------------------------------------ fitting
+    def fit(
+        self,
+        x_m: np.ndarray,
+        values: np.ndarray,
+        *,
+        optimise: bool | None = None,
+        hyperparameters: Hyperparameters | None = None,
+    ) -> None:
+        """Condition the GP on (n, 2) locations ``x_m`` and (n,) ``values``.
+
+        ``optimise`` None applies the refit policy (first fit, or data grown by
+        ``refit_growth_factor`` since the last fit); True/False force it. Explicit
+        ``hyperparameters`` skip the likelihood fit.
+        """
+        x = np.ascontiguousarray(x_m, dtype=float)
+        y = np.ascontiguousarray(values, dtype=float)
+        if x.ndim != 2 or x.shape[1] != 2 or y.shape != (x.shape[0],):
+            msg = f'expected (n, 2) locations and (n,) values, got {x.shape} and {y.shape}'
+            raise ObservationError(msg)
+        if x.shape[0] == 0:
+            msg = 'cannot fit a GP on zero samples'
+            raise ObservationError(msg)
+        if not (np.all(np.isfinite(x)) and np.all(np.isfinite(y))):
+            msg = 'GP training data contains non-finite values'
+            raise ObservationError(msg)
+        if hyperparameters is not None:
+            self._hyper = hyperparameters
+        else:
+            if optimise is None:
+                optimise = self._fitted_hyper is None or x.shape[0] >= math.ceil(
+                    self._config.refit_growth_factor * self._n_at_last_fit
+                )
+            if optimise:
+                self._hyper = self._maximise_likelihood(x, y)
+                self._fitted_hyper = self._hyper
+                self._n_at_last_fit = x.shape[0]
+        self._x, self._y = x, y
+        try:
+            self._chol, self._jitter = self._factor(x, self._hyper)
+        except GpFitError:
+            # Recover once: restart the hyperparameters from their initial values and refit.
+            self._hyper = self._maximise_likelihood(x, y, warm=False)
+            self._fitted_hyper = self._hyper
+            self._n_at_last_fit = x.shape[0]
+            self._chol, self._jitter = self._factor(x, self._hyper)
+        self._weights = cho_solve((self._chol, True), y, check_finite=False)
+
+    def _factor(self, x: np.ndarray, hyper: Hyperparameters) -> tuple[np.ndarray, float]:
+        """Lower Cholesky factor of K + (noise + jitter) I with escalating jitter."""
+        k = se_kernel(x, x, hyper)
+        base = self.noise_variance
+        jitter = 0.0
+        while True:
+            k_eps = k.copy()
+            k_eps[np.diag_indices_from(k_eps)] += base + jitter
+            try:
+                return cholesky(k_eps, lower=True, check_finite=False), jitter
+            except LinAlgError:
+                jitter = max(jitter * 10.0, 1e-10 * hyper.signal_variance)
+                if jitter > self._config.max_jitter * max(hyper.signal_variance, 1.0):
+                    msg = (
+                        f'covariance of {x.shape[0]} samples is not positive definite even with '
+                        f'jitter {jitter:.1e} (signal variance {hyper.signal_variance:.3g}, '
+                        f'length scale {hyper.length_scale_m:.3g} m)'
+                    )
+                    raise GpFitError(msg) from None
+
+    def _maximise_likelihood(
+        self, x: np.ndarray, y: np.ndarray, *, warm: bool = True
+    ) -> Hyperparameters:
+        keep = downsample_indices(x.shape[0], self._config.max_fit_points)
+        xs, ys = x[keep], y[keep]
+        sq = _squared_distances(xs, xs)
+        cfg = self._config
+        bounds = [
+            (math.log(cfg.signal_variance_bounds[0]), math.log(cfg.signal_variance_bounds[1])),
+            (math.log(cfg.length_scale_bounds_m[0]), math.log(cfg.length_scale_bounds_m[1])),
+        ]
+        starts = [
+            np.array([math.log(cfg.initial_signal_variance), math.log(cfg.initial_length_scale_m)])
+        ]
+        if warm and self._fitted_hyper is not None:
+            prev = self._fitted_hyper
+            # Warm start only: the previous optimum is close once data accumulates.
+            starts = [np.array([math.log(prev.signal_variance), math.log(prev.length_scale_m)])]
+        best: tuple[float, np.ndarray] | None = None
+        for start in starts:
+            start = np.clip(start, [b[0] for b in bounds], [b[1] for b in bounds])
+            result = minimize(
+                _negative_log_likelihood,
+                start,
+                args=(sq, ys, self.noise_variance),
+                jac=True,
+                method='L-BFGS-B',
+                bounds=bounds,
+                options={'maxiter': 60},
+            )
+            if np.isfinite(result.fun) and (best is None or result.fun < best[0]):
+                best = (float(result.fun), result.x)
+        if best is None:
+            return Hyperparameters(cfg.initial_signal_variance, cfg.initial_length_scale_m)
+        return Hyperparameters(float(math.exp(best[1][0])), float(math.exp(best[1][1])))
+
+    # --------------------------------------------------------------- prediction
+    def predict(self, query_m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Posterior mean (q,) and standard deviation (q,) at (q, 2) query points [m]."""
+        q = np.asarray(query_m, dtype=float).reshape(-1, 2)
+        k_q = se_kernel(self._x, q, self._hyper)
+        mean = k_q.T @ self._weights
+        v = solve_triangular(self._chol, k_q, lower=True, check_finite=False)
+        var = self._hyper.signal_variance - np.einsum('ij,ij->j', v, v)
+        return mean, np.sqrt(np.maximum(var, 0.0))
+
+    def predict_mean(self, query_m: np.ndarray) -> np.ndarray:
+        """Posterior mean (q,) at (q, 2) query points [m]."""
+        q = np.asarray(query_m, dtype=float).reshape(-1, 2)
+        return se_kernel(q, self._x, self._hyper) @ self._weights
+
+    def mean_and_gradient(self, point_m: np.ndarray) -> tuple[float, np.ndarray]:
+        """Posterior mean at one (2,) point and its (2,) gradient [signal / m]."""
+        p = np.asarray(point_m, dtype=float).reshape(1, 2)
+        k = se_kernel(p, self._x, self._hyper)[0] * self._weights
+        diff = self._x - p
+        grad = (k @ diff) / self._hyper.length_scale_m**2
+        return float(k.sum()), grad
+
+    def extended_std(self, extra_m: np.ndarray) -> ExtendedVariance:
+        """Posterior std model conditioned on the data plus (k, 2) extra locations.
+
+        The extra points are the peers' planned observation locations of Eq. 7; their values
+        are not needed because the posterior variance does not depend on them.
+        """
+        return ExtendedVariance(self, np.asarray(extra_m, dtype=float).reshape(-1, 2))
+
+
+class ExtendedVariance:
+    """Posterior standard deviation of a GP conditioned on extra, unobserved locations."""
+
+    def __init__(self, gp: GaussianProcess, extra_m: np.ndarray) -> None:
+        hyper = gp.hyperparameters
+        self._hyper = hyper
+        x = gp._x
+        chol = gp._chol
+        if extra_m.shape[0] == 0:
+            self._x, self._chol = x, chol
+            return
+        noise = gp.noise_variance + gp._jitter
+        k_xe = se_kernel(x, extra_m, hyper)
+        b = solve_triangular(chol, k_xe, lower=True, check_finite=False)
+        schur = se_kernel(extra_m, extra_m, hyper) - b.T @ b
+        schur[np.diag_indices_from(schur)] += noise
+        jitter = 0.0
+        while True:
+            try:
+                c = cholesky(
+                    schur + jitter * np.eye(schur.shape[0]), lower=True, check_finite=False
+                )
+                break
+            except LinAlgError:
+                jitter = max(10.0 * jitter, 1e-10 * hyper.signal_variance)
+                if jitter > 1e-2 * max(hyper.signal_variance, 1.0):
+                    # Extra points add nothing numerically usable: fall back to the data only.
+                    self._x, self._chol = x, chol
+                    return
+        n, k = x.shape[0], extra_m.shape[0]
+        full = np.zeros((n + k, n + k))
+        full[:n, :n] = chol
+        full[n:, :n] = b.T
+        full[n:, n:] = c
+        self._x = np.vstack([x, extra_m])
+        self._chol = full
+
+    @property
+    def n_points(self) -> int:
+        """Number of conditioning locations (data plus extra points)."""
+        return int(self._x.shape[0])
+
+    def std(self, query_m: np.ndarray) -> np.ndarray:
+        """Posterior std (q,) at (q, 2) query points [m]."""
+        q = np.asarray(query_m, dtype=float).reshape(-1, 2)
+        k_q = se_kernel(self._x, q, self._hyper)
+        v = solve_triangular(self._chol, k_q, lower=True, check_finite=False)
+        var = self._hyper.signal_variance - np.einsum('ij,ij->j', v, v)
+        return np.sqrt(np.maximum(var, 0.0))
+
+
+def _negative_log_likelihood(
+    log_params: np.ndarray, sq: np.ndarray, y: np.ndarray, noise_variance: float
+) -> tuple[float, np.ndarray]:
+    """Negative log marginal likelihood and its gradient w.r.t. (log s2, log l)."""
+    s2 = math.exp(log_params[0])
+    ell2 = math.exp(2.0 * log_params[1])
+    r = np.exp(-0.5 * sq / ell2)
+    k = s2 * r
+    k[np.diag_indices_from(k)] += noise_variance
+    try:
+        chol = cholesky(k, lower=True, check_finite=False)
+    except LinAlgError:
+        k[np.diag_indices_from(k)] += 1e-8 * s2
+        try:
+            chol = cholesky(k, lower=True, check_finite=False)
+        except LinAlgError:
+            return 1e25, np.zeros(2)
+    alpha = cho_solve((chol, True), y, check_finite=False)
+    n = y.shape[0]
+    nll = (
+        0.5 * float(y @ alpha)
+        + float(np.log(np.diag(chol)).sum())
+        + 0.5 * n * math.log(2 * math.pi)
+    )
+    k_inv, info = dpotri(chol, lower=1)
+    if info != 0:
+        return 1e25, np.zeros(2)
+    k_inv = np.tril(k_inv) + np.tril(k_inv, -1).T
+    inner = np.outer(alpha, alpha) - k_inv
+    dk_ds = s2 * r
+    dk_dl = dk_ds * (sq / ell2)
+    grad = -0.5 * np.array([np.sum(inner * dk_ds), np.sum(inner * dk_dl)])
+    return nll, grad

@@ -1,0 +1,558 @@
+"""Bayes-Swarm-P waypoint planner of one robot (paper Algorithm 1, with Algorithms 2 and 3).
+
+The planner owns the robot's belief (a :class:`~bayes_swarm.gp.GaussianProcess`), its data
+set D (own and peers' observations), the peers' latest plans and the list of weaker sources.
+It is driven from outside, by the ROS node or by the batch simulator, with the same calls:
+
+* :meth:`BayesSwarmPlanner.add_observations` for the robot's own samples,
+* :meth:`BayesSwarmPlanner.receive` for peers' broadcasts (Algorithm 3, RECEIVEINFORMATION),
+* :meth:`BayesSwarmPlanner.decide` on arrival at a waypoint (Algorithm 1, TAKEDECISION),
+* :meth:`BayesSwarmPlanner.broadcast` after a decision (Algorithm 3, SENDINFORMATION).
+
+Solvers. The inner problem (Eq. 5, argmax of the GP mean) uses multi-start L-BFGS-B with the
+analytic gradient. The outer problem (Eq. 1 s.t. Eq. 2) is by default 'grid': the
+acquisition is evaluated on a polar grid of the reachable disk, where paths along one heading
+share their samples so every candidate's path integral comes from one cumulative sum, and
+a local polar pattern search refines the best grid point (scipy 1.17 ships the pure-Python COBYLA,
+which costs tens of milliseconds per call). 'cobyla' is the authors' choice (COBYLA from the current
+position); 'pso' is a particle swarm over the reachable disk.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+from scipy.linalg import LinAlgError
+from scipy.optimize import minimize
+
+from bayes_swarm.acquisition import acquisition, omega, planned_path_points, ray_integrals
+from bayes_swarm.alpha import AlphaBranch, AlphaDecision, exploitation_weight
+from bayes_swarm.config import BayesSwarmConfig
+from bayes_swarm.errors import BayesSwarmError, ObservationError
+from bayes_swarm.gp import ExtendedVariance, GaussianProcess, downsample_indices
+from bayes_swarm.messages import Decision, DecisionKind, PeerUpdate
+from bayes_swarm.observations import ObservationStore, finite_samples
+from bayes_swarm.penalty import local_penalty
+
+__all__ = ['BayesSwarmPlanner', 'first_waypoint']
+
+_MEAN_GRID_SIZE = 24
+_MAX_RAY_STEPS = 25
+_REFINE_LEVELS = 3
+
+
+def first_waypoint(
+    position_m: np.ndarray,
+    *,
+    fan_index: int,
+    fan_size: int,
+    direction_range_deg: float,
+    direction_offset_deg: float,
+    leg_m: float,
+) -> np.ndarray:
+    """TAKEFIRSTDECISION: leg of length V T along theta = r dtheta / m (or / (m + 1)).
+
+    ``fan_index`` is r (1-based) and ``fan_size`` m; the heading is measured from
+    ``direction_offset_deg``. Returns the (2,) waypoint [m] (not clipped).
+    """
+    if math.isclose(direction_range_deg, 360.0):
+        theta_deg = fan_index * direction_range_deg / fan_size
+    else:
+        theta_deg = fan_index * direction_range_deg / (fan_size + 1)
+    theta = math.radians(theta_deg + direction_offset_deg)
+    return np.asarray(position_m, dtype=float) + leg_m * np.array(
+        [math.cos(theta), math.sin(theta)]
+    )
+
+
+class BayesSwarmPlanner:
+    """Decentralised Bayes-Swarm-P (or -O with ``penalty_enabled=False``) for one robot."""
+
+    def __init__(
+        self,
+        config: BayesSwarmConfig,
+        robot_name: str,
+        seed: int | None = None,
+        *,
+        fan_index: int | None = None,
+        fan_size: int | None = None,
+        direction_offset_deg: float = 0.0,
+    ) -> None:
+        self._cfg = config
+        self._name = robot_name
+        self._rng = np.random.default_rng(seed)
+        self._gp = GaussianProcess(config.gp)
+        self._data = ObservationStore()
+        self._own_unsent_points: list[np.ndarray] = []
+        self._own_unsent_values: list[np.ndarray] = []
+        self._peer_plans: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+        self._peer_last_index: dict[str, int] = {}
+        self._weaker: list[np.ndarray] = []
+        self._k = 0
+        self._last_decision: Decision | None = None
+        self._last_expected_source: np.ndarray | None = None
+        self._fan_index = config.robot_index + 1 if fan_index is None else fan_index
+        self._fan_size = config.n_robots if fan_size is None else fan_size
+        self._direction_offset_deg = direction_offset_deg
+
+    # ----------------------------------------------------------------- inputs
+    @property
+    def name(self) -> str:
+        """Robot name used as the sender of broadcasts."""
+        return self._name
+
+    @property
+    def config(self) -> BayesSwarmConfig:
+        """The planner's configuration."""
+        return self._cfg
+
+    @property
+    def decision_index(self) -> int:
+        """Number of decisions taken so far (k_r)."""
+        return self._k
+
+    @property
+    def n_observations(self) -> int:
+        """Size of D (own plus received samples, before downsampling)."""
+        return len(self._data)
+
+    @property
+    def weaker_sources(self) -> np.ndarray:
+        """(w, 2) known weaker-source locations [m] (own and received)."""
+        return np.array(self._weaker).reshape(-1, 2)
+
+    @property
+    def peer_waypoints(self) -> dict[str, np.ndarray]:
+        """Latest known planned waypoint (2,) of every peer heard from."""
+        return {name: plan[1].copy() for name, plan in self._peer_plans.items()}
+
+    @property
+    def gp(self) -> GaussianProcess:
+        """The belief model as of the last decision."""
+        return self._gp
+
+    def add_observations(self, points_m: np.ndarray, values: np.ndarray) -> int:
+        """Add the robot's own samples: (k, 2) locations [m] and (k,) values.
+
+        Non-finite rows are dropped. Returns the number of rows kept.
+        """
+        pts, vals = finite_samples(points_m, values)
+        self._data.extend(pts, vals)
+        if vals.shape[0]:
+            self._own_unsent_points.append(pts)
+            self._own_unsent_values.append(vals)
+        return int(vals.shape[0])
+
+    def receive(self, update: PeerUpdate) -> bool:
+        """RECEIVEINFORMATION: merge a peer's broadcast; False if it was ignored.
+
+        The robot's own broadcasts and messages not newer than the last accepted one from the
+        same sender (stale or duplicated deliveries) are ignored.
+        """
+        if update.sender == self._name:
+            return False
+        last = self._peer_last_index.get(update.sender)
+        if last is not None and update.decision_index <= last:
+            return False
+        position = np.asarray(update.position_m, dtype=float).reshape(2)
+        waypoint = np.asarray(update.waypoint_m, dtype=float).reshape(2)
+        if not (np.all(np.isfinite(position)) and np.all(np.isfinite(waypoint))):
+            return False
+        pts, vals = finite_samples(update.sample_points_m, update.sample_values)
+        self._peer_last_index[update.sender] = update.decision_index
+        self._data.extend(pts, vals)
+        self._peer_plans[update.sender] = (position, waypoint)
+        for weak in np.asarray(update.weaker_sources_m, dtype=float).reshape(-1, 2):
+            self._add_weaker(weak)
+        return True
+
+    def _add_weaker(self, point: np.ndarray) -> None:
+        if not np.all(np.isfinite(point)):
+            return
+        for known in self._weaker:
+            if np.hypot(*(known - point)) < self._cfg.robot_size_m:
+                return
+        self._weaker.append(np.asarray(point, dtype=float).copy())
+
+    def broadcast(self, position_m: np.ndarray) -> PeerUpdate:
+        """SENDINFORMATION: planned waypoint and the own samples not broadcast yet."""
+        if self._last_decision is None:
+            msg = 'broadcast() needs a decision first'
+            raise ObservationError(msg)
+        if self._own_unsent_points:
+            pts = np.vstack(self._own_unsent_points)
+            vals = np.concatenate(self._own_unsent_values)
+        else:
+            pts, vals = np.zeros((0, 2)), np.zeros(0)
+        self._own_unsent_points, self._own_unsent_values = [], []
+        return PeerUpdate(
+            sender=self._name,
+            decision_index=self._last_decision.decision_index,
+            position_m=np.asarray(position_m, dtype=float).copy(),
+            waypoint_m=self._last_decision.waypoint_m.copy(),
+            sample_points_m=pts,
+            sample_values=vals,
+            weaker_sources_m=self.weaker_sources,
+        )
+
+    # --------------------------------------------------------------- decision
+    def decide(self, position_m: np.ndarray, time_s: float) -> Decision:
+        """TAKEDECISION at the robot's (2,) position [m] and mission time [s]."""
+        start = time.perf_counter()
+        position = np.asarray(position_m, dtype=float).reshape(2)
+        if not np.all(np.isfinite(position)):
+            msg = f'position must be finite, got {position}'
+            raise ObservationError(msg)
+        cfg = self._cfg
+        if self._k == 0:
+            waypoint = cfg.arena.clip(
+                first_waypoint(
+                    position,
+                    fan_index=self._fan_index,
+                    fan_size=self._fan_size,
+                    direction_range_deg=cfg.initial_direction_range_deg,
+                    direction_offset_deg=self._direction_offset_deg,
+                    leg_m=cfg.max_leg_m,
+                )
+            )
+            decision = Decision(waypoint, 0, DecisionKind.FIRST, n_samples=len(self._data))
+        elif len(self._data) == 0:
+            decision = self._random_jump(position, 'no observations yet')
+        else:
+            try:
+                decision = self._bayes_decision(position, time_s)
+            except (BayesSwarmError, LinAlgError, ValueError, FloatingPointError) as err:
+                decision = self._random_jump(
+                    position, f'fallback after {type(err).__name__}: {err}'
+                )
+        decision = Decision(
+            waypoint_m=decision.waypoint_m,
+            decision_index=self._k,
+            kind=decision.kind,
+            alpha=decision.alpha,
+            expected_source_m=decision.expected_source_m,
+            n_samples=decision.n_samples,
+            compute_time_s=time.perf_counter() - start,
+            detail=decision.detail,
+        )
+        self._k += 1
+        self._last_decision = decision
+        return decision
+
+    def _random_jump(self, position: np.ndarray, detail: str = '') -> Decision:
+        """Algorithm 1 lines 16-18: a random leg of length U(0.1, 0.9) V T, inside the arena."""
+        r1 = self._rng.uniform(0.0, 1.0)
+        r2 = self._rng.uniform(0.1, 0.9)
+        angle = 2.0 * math.pi * r1
+        waypoint = self._cfg.arena.clip(
+            position + r2 * self._cfg.max_leg_m * np.array([math.cos(angle), math.sin(angle)])
+        )
+        kind = DecisionKind.FALLBACK if detail else DecisionKind.RANDOM_JUMP
+        return Decision(waypoint, self._k, kind, detail=detail)
+
+    def _training_data(self) -> tuple[np.ndarray, np.ndarray]:
+        pts, vals = self._data.arrays()
+        cfg = self._cfg
+        if cfg.authors_floor_downsampling and pts.shape[0] >= cfg.n_max:
+            order = np.lexsort((vals, pts[:, 1], pts[:, 0]))
+            pts, vals = pts[order], vals[order]
+            keep = downsample_indices(pts.shape[0], cfg.n_max, floor_rule=True)
+            keep = keep[keep < pts.shape[0] - 1]
+        else:
+            keep = downsample_indices(pts.shape[0], cfg.n_max)
+        return pts[keep], vals[keep]
+
+    def _bayes_decision(self, position: np.ndarray, time_s: float) -> Decision:
+        cfg = self._cfg
+        pts, vals = self._training_data()
+        self._gp.fit(pts, vals)
+        expected = self._expected_source()
+        self._last_expected_source = expected
+        peers = list(self._peer_plans.values())
+        peer_starts = np.array([p[0] for p in peers]).reshape(-1, 2)
+        peer_waypoints = np.array([p[1] for p in peers]).reshape(-1, 2)
+        alpha = exploitation_weight(
+            expected,
+            peer_waypoints,
+            self.weaker_sources,
+            robot_size_m=cfg.robot_size_m,
+            time_s=time_s,
+            max_mission_time_s=cfg.max_mission_time_s,
+            time_scale=cfg.alpha_time_scale,
+        )
+        if cfg.authors_origin_paths:
+            starts = np.zeros_like(peer_starts)
+            ends = peer_waypoints - peer_starts
+        else:
+            starts, ends = peer_starts, peer_waypoints
+        extra = planned_path_points(starts, ends, cfg.step_m, cfg.max_peer_path_points)
+        ext = self._gp.extended_std(extra)
+        if cfg.penalty_enabled and peer_waypoints.shape[0]:
+            peer_mean, peer_std = self._gp.predict(peer_waypoints)
+            if cfg.authors_negated_m:
+                max_signal = -float(self._gp.predict_mean(expected.reshape(1, 2))[0])
+            else:
+                max_signal = cfg.max_signal
+        else:
+            peer_waypoints = np.zeros((0, 2))
+            peer_mean = peer_std = np.zeros(0)
+            max_signal = cfg.max_signal
+        problem = _OuterProblem(
+            cfg,
+            position,
+            expected,
+            alpha.value,
+            ext,
+            peer_waypoints,
+            peer_mean,
+            peer_std,
+            max_signal,
+        )
+        waypoint = problem.solve(self._rng)
+        kind = DecisionKind.ACQUISITION
+        if np.hypot(*(waypoint - position)) < cfg.step_m:
+            # Algorithm 1 lines 11-18: the robot would stay where it is.
+            distance_to_expected = float(np.hypot(*(expected - position)))
+            previous = self._last_decision.kind if self._last_decision else None
+            if distance_to_expected < 0.9 * cfg.detection_radius_m:
+                self._add_weaker(expected)
+                alpha = AlphaDecision(0.0, AlphaBranch.EXPLORE)
+                problem.alpha = 0.0
+                waypoint = problem.solve(self._rng)
+                kind = DecisionKind.EXPLORE
+                if np.hypot(*(waypoint - position)) < cfg.step_m:
+                    waypoint, kind = (
+                        self._random_jump(position).waypoint_m,
+                        DecisionKind.RANDOM_JUMP,
+                    )
+            elif distance_to_expected < cfg.step_m and previous is not DecisionKind.APPROACH:
+                # Not in Algorithm 1: the expected source is closer than one sampling step but
+                # outside 0.9 eps; the literal rule would jump away from it. Go there once.
+                waypoint, kind = expected.copy(), DecisionKind.APPROACH
+            else:
+                waypoint, kind = self._random_jump(position).waypoint_m, DecisionKind.RANDOM_JUMP
+        return Decision(
+            waypoint,
+            self._k,
+            kind,
+            alpha=alpha.value,
+            expected_source_m=expected,
+            n_samples=pts.shape[0],
+        )
+
+    def _expected_source(self) -> np.ndarray:
+        """Eq. 5: argmax of the GP mean in the arena (multi-start L-BFGS-B)."""
+        cfg = self._cfg
+        arena = cfg.arena
+        gx = np.linspace(arena.x_min_m, arena.x_max_m, _MEAN_GRID_SIZE)
+        gy = np.linspace(arena.y_min_m, arena.y_max_m, _MEAN_GRID_SIZE)
+        grid = np.stack(np.meshgrid(gx, gy), axis=-1).reshape(-1, 2)
+        candidates = np.vstack([grid, self._gp.training_inputs])
+        means = self._gp.predict_mean(candidates)
+        order = np.argsort(-means)
+        seeds = [candidates[order[0]]]
+        for idx in order[1:]:
+            if len(seeds) >= cfg.n_inner_starts - 1:
+                break
+            if min(np.hypot(*(candidates[idx] - s)) for s in seeds) > 0.05 * arena.diagonal_m:
+                seeds.append(candidates[idx])
+        previous = self._last_expected_source
+        if previous is not None and min(np.hypot(*(previous - s)) for s in seeds) > 0.05 * (
+            arena.diagonal_m
+        ):
+            seeds.append(previous)
+        seeds.append(self._rng.uniform(arena.lower, arena.upper))
+        bounds = list(zip(arena.lower, arena.upper, strict=True))
+        best_x, best_f = seeds[0], -math.inf
+        for seed in seeds:
+            result = minimize(
+                _negated_mean,
+                seed,
+                args=(self._gp,),
+                jac=True,
+                method='L-BFGS-B',
+                bounds=bounds,
+                options={'maxiter': 50},
+            )
+            value = -float(result.fun)
+            if np.isfinite(value) and value > best_f:
+                best_x, best_f = result.x, value
+        return arena.clip(np.asarray(best_x, dtype=float))
+
+
+def _negated_mean(x: np.ndarray, gp: GaussianProcess) -> tuple[float, np.ndarray]:
+    value, grad = gp.mean_and_gradient(x)
+    return -value, -grad
+
+
+class _OuterProblem:
+    """Eq. 1 subject to Eq. 2 for one decision, with its solvers."""
+
+    def __init__(
+        self,
+        cfg: BayesSwarmConfig,
+        position: np.ndarray,
+        expected: np.ndarray,
+        alpha: float,
+        ext: ExtendedVariance,
+        peer_waypoints: np.ndarray,
+        peer_mean: np.ndarray,
+        peer_std: np.ndarray,
+        max_signal: float,
+    ) -> None:
+        self.cfg = cfg
+        self.position = position
+        self.expected = expected
+        self.alpha = alpha
+        self.ext = ext
+        self.peer_waypoints = peer_waypoints
+        self.peer_mean = peer_mean
+        self.peer_std = peer_std
+        self.max_signal = max_signal
+        self.n_steps = max(1, min(_MAX_RAY_STEPS, math.ceil(cfg.max_leg_m / cfg.step_m)))
+        self.ray_step_m = cfg.max_leg_m / self.n_steps
+
+    def gamma(self, points: np.ndarray) -> np.ndarray:
+        return local_penalty(
+            points,
+            self.peer_waypoints,
+            self.peer_mean,
+            self.peer_std,
+            max_signal=self.max_signal,
+            lipschitz=self.cfg.lipschitz,
+            std_floor=self.cfg.penalty_std_floor,
+        )
+
+    def values(self, points: np.ndarray) -> np.ndarray:
+        """Acquisition (q,) at arbitrary (q, 2) reachable points (paths sampled uniformly)."""
+        pts = np.asarray(points, dtype=float).reshape(-1, 2)
+        u = np.linspace(0.0, 1.0, self.n_steps + 1)
+        base = np.zeros(2) if self.cfg.authors_origin_paths else self.position
+        offsets = pts - self.position
+        samples = base + u[None, :, None] * offsets[:, None, :]
+        std = self.ext.std(samples.reshape(-1, 2)).reshape(pts.shape[0], -1)
+        length = np.hypot(offsets[:, 0], offsets[:, 1])
+        sigma = length * np.trapezoid(std, u, axis=1)
+        return acquisition(self.alpha, omega(pts, self.expected), sigma, self.gamma(pts))
+
+    def grid(self) -> tuple[np.ndarray, np.ndarray]:
+        """Candidates (c, 2) on the polar grid of the reachable disk and their values (c,)."""
+        cfg = self.cfg
+        headings = np.linspace(0.0, 2.0 * math.pi, cfg.n_candidate_headings, endpoint=False)
+        toward = self.expected - self.position
+        if np.hypot(*toward) > 1e-9:
+            headings = np.append(headings, math.atan2(toward[1], toward[0]))
+        candidates, sigma = ray_integrals(
+            self.ext.std,
+            self.position,
+            headings,
+            self.ray_step_m,
+            self.n_steps,
+            from_origin=cfg.authors_origin_paths,
+        )
+        pts = candidates.reshape(-1, 2)
+        values = acquisition(
+            self.alpha, omega(pts, self.expected), sigma.reshape(-1), self.gamma(pts)
+        )
+        values[~cfg.arena.contains(pts)] = -np.inf
+        return pts, values
+
+    def _feasible(self, x: np.ndarray) -> bool:
+        return bool(
+            np.hypot(*(x - self.position)) <= self.cfg.max_leg_m + 1e-9
+            and self.cfg.arena.contains(x)
+        )
+
+    def _cobyla(self, x0: np.ndarray, rhobeg: float) -> np.ndarray:
+        cfg = self.cfg
+        arena = cfg.arena
+        constraints = [
+            {'type': 'ineq', 'fun': lambda x: cfg.max_leg_m - np.hypot(*(x - self.position))},
+            {'type': 'ineq', 'fun': lambda x: x[0] - arena.x_min_m},
+            {'type': 'ineq', 'fun': lambda x: arena.x_max_m - x[0]},
+            {'type': 'ineq', 'fun': lambda x: x[1] - arena.y_min_m},
+            {'type': 'ineq', 'fun': lambda x: arena.y_max_m - x[1]},
+        ]
+        result = minimize(
+            lambda x: -float(self.values(x)[0]),
+            x0,
+            method='COBYLA',
+            constraints=constraints,
+            options={'rhobeg': rhobeg, 'maxiter': cfg.cobyla_max_iterations, 'tol': 1e-4},
+        )
+        return np.asarray(result.x, dtype=float)
+
+    def _pso(self, rng: np.random.Generator) -> np.ndarray:
+        cfg = self.cfg
+        n = cfg.pso_particles
+        radius = cfg.max_leg_m * np.sqrt(rng.uniform(0.0, 1.0, n))
+        angle = rng.uniform(0.0, 2.0 * math.pi, n)
+        pos = cfg.arena.clip(self.position + radius[:, None] * np.c_[np.cos(angle), np.sin(angle)])
+        vel = np.zeros_like(pos)
+        best_pos, best_val = pos.copy(), self.values(pos)
+        g = int(np.argmax(best_val))
+        for _ in range(cfg.pso_iterations):
+            r1, r2 = rng.uniform(size=(2, n, 1))
+            vel = 0.7 * vel + 1.5 * r1 * (best_pos - pos) + 1.5 * r2 * (best_pos[g] - pos)
+            pos = pos + vel
+            offset = pos - self.position
+            dist = np.hypot(offset[:, 0], offset[:, 1])
+            scale = np.minimum(1.0, cfg.max_leg_m / np.maximum(dist, 1e-12))
+            pos = cfg.arena.clip(self.position + offset * scale[:, None])
+            val = self.values(pos)
+            improved = val > best_val
+            best_pos[improved], best_val[improved] = pos[improved], val[improved]
+            g = int(np.argmax(best_val))
+        return best_pos[g]
+
+    def _refine(self, x0: np.ndarray) -> np.ndarray:
+        """Local polar pattern search around a grid point: 3 x 3 stencils, halving the step."""
+        cfg = self.cfg
+        offset = x0 - self.position
+        radius = float(np.hypot(*offset))
+        heading = math.atan2(offset[1], offset[0])
+        best_value = float(self.values(x0)[0])
+        best = x0
+        d_r = 0.5 * self.ray_step_m
+        d_theta = math.pi / cfg.n_candidate_headings
+        stencil = np.array([(a, b) for a in (-1, 0, 1) for b in (-1, 0, 1) if a or b], float)
+        for _ in range(_REFINE_LEVELS):
+            radii = np.clip(radius + d_r * stencil[:, 0], 0.0, cfg.max_leg_m)
+            headings = heading + d_theta * stencil[:, 1]
+            pts = self.position + radii[:, None] * np.c_[np.cos(headings), np.sin(headings)]
+            pts = cfg.arena.clip(pts)
+            vals = self.values(pts)
+            i = int(np.argmax(vals))
+            if vals[i] > best_value:
+                best_value, best = float(vals[i]), pts[i]
+                offset = best - self.position
+                radius = float(np.hypot(*offset))
+                heading = math.atan2(offset[1], offset[0])
+            d_r *= 0.5
+            d_theta *= 0.5
+        return best
+
+    def solve(self, rng: np.random.Generator) -> np.ndarray:
+        """Best reachable waypoint (2,) [m]; infeasible or non-finite results fall back."""
+        cfg = self.cfg
+        if cfg.outer_optimizer == 'pso':
+            candidate = self._pso(rng)
+            best = candidate
+        elif cfg.outer_optimizer == 'cobyla':
+            best = cfg.arena.clip(self.position)
+            candidate = self._cobyla(best, rhobeg=min(1.0, cfg.max_leg_m))
+        else:
+            pts, values = self.grid()
+            best = pts[int(np.argmax(values))]
+            candidate = self._refine(best)
+        if not self._feasible(best):
+            best = cfg.arena.clip(self.position)
+        if (
+            np.all(np.isfinite(candidate))
+            and self._feasible(candidate)
+            and self.values(candidate)[0] >= self.values(best)[0]
+        ):
+            return candidate
+        return best
