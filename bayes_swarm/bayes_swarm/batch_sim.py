@@ -24,16 +24,16 @@ import numpy as np
 from bayes_swarm.baselines.exhaustive import sweep_paths
 from bayes_swarm.baselines.glowworm import GlowwormSwarm
 from bayes_swarm.baselines.levy import LevyWalk
-from bayes_swarm.config import (
+from bayes_swarm.errors import ConfigError
+from bayes_swarm.messages import Decision, DecisionKind, PeerUpdate
+from bayes_swarm.planner import BayesSwarmPlanner, first_waypoint
+from bayes_swarm.settings import (
     Arena,
     BayesSwarmConfig,
     ExhaustiveConfig,
     GlowwormConfig,
     LevyConfig,
 )
-from bayes_swarm.errors import ConfigError
-from bayes_swarm.messages import Decision, DecisionKind, PeerUpdate
-from bayes_swarm.planner import BayesSwarmPlanner, first_waypoint
 
 __all__ = [
     'ALGORITHMS',

@@ -24,8 +24,8 @@ from scipy.linalg import LinAlgError, cho_solve, cholesky, solve_triangular
 from scipy.linalg.lapack import dpotri
 from scipy.optimize import minimize
 
-from bayes_swarm.config import GpConfig
 from bayes_swarm.errors import GpFitError, ObservationError
+from bayes_swarm.settings import GpConfig
 
 __all__ = [
     'GaussianProcess',

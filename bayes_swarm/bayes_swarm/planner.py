@@ -29,12 +29,12 @@ from scipy.optimize import minimize
 
 from bayes_swarm.acquisition import acquisition, omega, planned_path_points, ray_integrals
 from bayes_swarm.alpha import AlphaBranch, AlphaDecision, exploitation_weight
-from bayes_swarm.config import BayesSwarmConfig
 from bayes_swarm.errors import BayesSwarmError, ObservationError
 from bayes_swarm.gp import ExtendedVariance, GaussianProcess, downsample_indices
 from bayes_swarm.messages import Decision, DecisionKind, PeerUpdate
 from bayes_swarm.observations import ObservationStore, finite_samples
 from bayes_swarm.penalty import local_penalty
+from bayes_swarm.settings import BayesSwarmConfig
 
 __all__ = ['BayesSwarmPlanner', 'first_waypoint']
 

@@ -13,7 +13,7 @@ import math
 
 import numpy as np
 
-from bayes_swarm.config import Arena
+from bayes_swarm.settings import Arena
 
 __all__ = ['partition_arena', 'strip_sweep', 'sweep_paths']
 

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from bayes_swarm.config import Arena, GlowwormConfig
+from bayes_swarm.settings import Arena, GlowwormConfig
 
 __all__ = ['GlowwormState', 'GlowwormSwarm', 'glowworm_step', 'select_leaders']
 

@@ -12,7 +12,7 @@ import math
 
 import numpy as np
 
-from bayes_swarm.config import Arena, LevyConfig
+from bayes_swarm.settings import Arena, LevyConfig
 
 __all__ = ['LevyWalk', 'pareto_step', 'wrapped_cauchy']
 

@@ -1,0 +1,140 @@
+"""GP belief: closed-form posteriors, likelihood gradient, downsampling, recovery."""
+
+import numpy as np
+import pytest
+from bayes_swarm.errors import ObservationError
+from bayes_swarm.gp import (
+    GaussianProcess,
+    Hyperparameters,
+    _negative_log_likelihood,
+    _squared_distances,
+    downsample_indices,
+)
+from bayes_swarm.settings import GpConfig
+from scipy.optimize import approx_fprime
+
+HYPER = Hyperparameters(signal_variance=0.7, length_scale_m=0.4)
+NOISE_STD = 0.05
+
+
+def closed_form(x, y, q, hyper, noise_var):
+    def k(a, b):
+        d2 = ((a[:, None, :] - b[None, :, :]) ** 2).sum(-1)
+        return hyper.signal_variance * np.exp(-0.5 * d2 / hyper.length_scale_m**2)
+
+    k_inv = np.linalg.inv(k(x, x) + noise_var * np.eye(len(x)))
+    kq = k(x, q)
+    mean = kq.T @ k_inv @ y
+    var = hyper.signal_variance - np.einsum('ij,ik,kj->j', kq, k_inv, kq)
+    return mean, np.sqrt(var)
+
+
+@pytest.fixture
+def data():
+    rng = np.random.default_rng(3)
+    x = rng.uniform(0, 2, size=(12, 2))
+    y = np.sin(2 * x[:, 0]) + x[:, 1] ** 2
+    q = rng.uniform(-0.5, 2.5, size=(9, 2))
+    return x, y, q
+
+
+def test_posterior_mean_and_std_match_the_closed_form(data):
+    x, y, q = data
+    gp = GaussianProcess(GpConfig(noise_std=NOISE_STD))
+    gp.fit(x, y, hyperparameters=HYPER)
+    mean, std = gp.predict(q)
+    ref_mean, ref_std = closed_form(x, y, q, HYPER, NOISE_STD**2)
+    np.testing.assert_allclose(mean, ref_mean, rtol=1e-8, atol=1e-10)
+    np.testing.assert_allclose(std, ref_std, rtol=1e-7, atol=1e-9)
+    np.testing.assert_allclose(gp.predict_mean(q), ref_mean, rtol=1e-8, atol=1e-10)
+
+
+def test_extended_std_equals_a_gp_conditioned_on_the_extra_locations(data):
+    x, y, q = data
+    extra = np.array([[0.3, 0.3], [1.7, 0.2], [2.2, 2.2]])
+    gp = GaussianProcess(GpConfig(noise_std=NOISE_STD))
+    gp.fit(x, y, hyperparameters=HYPER)
+    x_all = np.vstack([x, extra])
+    _, ref_std = closed_form(x_all, np.zeros(len(x_all)), q, HYPER, NOISE_STD**2)
+    np.testing.assert_allclose(gp.extended_std(extra).std(q), ref_std, rtol=1e-7, atol=1e-9)
+    # Extra observation locations can only reduce the uncertainty.
+    assert np.all(gp.extended_std(extra).std(q) <= gp.predict(q)[1] + 1e-12)
+
+
+def test_mean_gradient_matches_finite_differences(data):
+    x, y, _ = data
+    gp = GaussianProcess(GpConfig(noise_std=NOISE_STD))
+    gp.fit(x, y, hyperparameters=HYPER)
+    point = np.array([0.9, 1.1])
+    _, grad = gp.mean_and_gradient(point)
+    numeric = approx_fprime(point, lambda p: gp.mean_and_gradient(p)[0], 1e-7)
+    np.testing.assert_allclose(grad, numeric, rtol=1e-4, atol=1e-6)
+
+
+def test_likelihood_gradient_matches_finite_differences(data):
+    x, y, _ = data
+    sq = _squared_distances(x, x)
+    theta = np.log([0.8, 0.6])
+    _, grad = _negative_log_likelihood(theta, sq, y, 1e-3)
+    numeric = approx_fprime(theta, lambda t: _negative_log_likelihood(t, sq, y, 1e-3)[0], 1e-7)
+    np.testing.assert_allclose(grad, numeric, rtol=1e-4, atol=1e-5)
+
+
+def test_fit_recovers_the_length_scale_of_a_smooth_field():
+    rng = np.random.default_rng(0)
+    x = rng.uniform(0, 10, size=(120, 2))
+    y = np.exp(-((x - 5.0) ** 2).sum(1) / (2 * 2.0**2))  # a bump with width 2 m
+    gp = GaussianProcess(GpConfig(noise_std=1e-3))
+    gp.fit(x, y)
+    assert 1.0 < gp.hyperparameters.length_scale_m < 4.0
+    mean, _ = gp.predict(np.array([[5.0, 5.0], [1.0, 9.0]]))
+    np.testing.assert_allclose(mean, [1.0, np.exp(-32 / 8)], atol=0.02)
+
+
+def test_refit_happens_only_after_the_data_grew_by_the_growth_factor():
+    rng = np.random.default_rng(1)
+    x = rng.uniform(0, 3, size=(40, 2))
+    y = np.cos(x[:, 0])
+    gp = GaussianProcess(GpConfig(refit_growth_factor=1.5))
+    gp.fit(x[:20], y[:20])
+    first = gp.hyperparameters
+    gp.fit(x[:25], y[:25])
+    assert gp.hyperparameters == first
+    gp.fit(x[:30], y[:30])
+    assert gp.hyperparameters != first
+
+
+def test_ceil_downsampling_keeps_the_first_and_every_dth_sample_in_time_order():
+    kept = downsample_indices(2500, 1000)
+    assert kept[0] == 0
+    assert np.all(np.diff(kept) == 3)  # ceil(2500 / 1000)
+    assert len(kept) <= 1000
+
+
+def test_floor_downsampling_reproduces_the_authors_missing_reduction():
+    assert len(downsample_indices(1999, 1000, floor_rule=True)) == 1999
+    assert len(downsample_indices(1999, 1000)) == 1000
+
+
+def test_downsampling_rejects_n_max_below_one():
+    with pytest.raises(ObservationError, match='n_max'):
+        downsample_indices(10, 0)
+
+
+def test_duplicated_samples_with_a_tiny_noise_term_still_factor():
+    x = np.repeat(np.array([[0.0, 0.0], [0.5, 0.5], [1.0, 0.2]]), 20, axis=0)
+    y = np.repeat(np.array([0.1, 0.4, 0.3]), 20)
+    gp = GaussianProcess(GpConfig(noise_std=1e-9))
+    gp.fit(x, y, hyperparameters=Hyperparameters(1.0, 5.0))
+    mean, std = gp.predict(np.array([[0.5, 0.5]]))
+    assert np.isfinite(mean).all()
+    assert np.isfinite(std).all()
+    assert mean[0] == pytest.approx(0.4, abs=0.05)
+
+
+def test_non_finite_training_data_is_rejected():
+    gp = GaussianProcess(GpConfig())
+    with pytest.raises(ObservationError, match='non-finite'):
+        gp.fit(np.array([[0.0, 0.0], [1.0, np.nan]]), np.array([1.0, 2.0]))
+    with pytest.raises(ObservationError, match=r'\(n, 2\)'):
+        gp.fit(np.zeros((3, 3)), np.zeros(3))

@@ -1,0 +1,96 @@
+"""Local penalty (Eqs. 8-11) and the adaptive exploitation weight (Algorithm 2)."""
+
+import math
+
+import numpy as np
+import pytest
+from bayes_swarm.alpha import AlphaBranch, exploitation_weight, scheduled_alpha
+from bayes_swarm.penalty import local_penalty
+
+PEER = np.array([[1.0, 1.0]])
+
+
+def penalty(points, mean=0.4, std=0.05, max_signal=1.2, lipschitz=2.0):
+    return local_penalty(
+        np.asarray(points, float),
+        PEER,
+        np.array([mean]),
+        np.array([std]),
+        max_signal=max_signal,
+        lipschitz=lipschitz,
+    )
+
+
+def test_penalty_is_near_zero_at_a_peers_planned_waypoint_and_near_one_far_away():
+    near, far = penalty([[1.0, 1.0], [2.5, 2.5]])
+    assert near < 1e-6
+    assert far > 0.999
+
+
+def test_penalty_grows_with_the_distance_to_the_peer():
+    values = penalty([[1.0 + d, 1.0] for d in np.linspace(0, 1, 11)])
+    assert np.all(np.diff(values) >= 0)
+
+
+def test_penalty_is_one_half_at_the_ball_radius():
+    radius = (1.2 - 0.4) / 2.0
+    assert penalty([[1.0 + radius, 1.0]])[0] == pytest.approx(0.5)
+
+
+def test_penalty_multiplies_over_peers_and_is_one_without_peers():
+    pts = np.array([[1.2, 1.0]])
+    single = penalty(pts)[0]
+    double = local_penalty(
+        pts,
+        np.vstack([PEER, PEER]),
+        np.array([0.4, 0.4]),
+        np.array([0.05, 0.05]),
+        max_signal=1.2,
+        lipschitz=2.0,
+    )[0]
+    assert double == pytest.approx(single**2)
+    assert local_penalty(pts, np.zeros((0, 2)), [], [], max_signal=1.2, lipschitz=2.0)[0] == 1.0
+
+
+def test_negated_maximum_as_m_makes_the_penalty_inert():
+    # The authors' code passes M = -max(mu): every factor is then ~1 even at the waypoint.
+    assert penalty([[1.0, 1.0]], max_signal=-1.0)[0] > 0.999
+
+
+def test_schedule_is_one_half_at_a_third_of_t_max_and_near_point_97_at_70_percent():
+    assert scheduled_alpha(100.0, 300.0) == pytest.approx(0.5)
+    assert scheduled_alpha(70.0, 100.0) == pytest.approx(1 / (1 + math.exp(-10 * (0.7 - 1 / 3))))
+    assert scheduled_alpha(70.0, 100.0) == pytest.approx(0.975, abs=0.005)
+    assert scheduled_alpha(0.0, 100.0) == pytest.approx(1 / (1 + math.exp(10 / 3)))
+
+
+def test_time_scale_reproduces_the_authors_faster_schedule():
+    assert scheduled_alpha(10.0, 100.0, time_scale=0.1) == pytest.approx(0.9987, abs=1e-4)
+
+
+def weight(peers, weaker, t=20.0):
+    return exploitation_weight(
+        np.array([1.0, 2.0]),
+        np.asarray(peers, float).reshape(-1, 2),
+        np.asarray(weaker, float).reshape(-1, 2),
+        robot_size_m=0.1,
+        time_s=t,
+        max_mission_time_s=100.0,
+    )
+
+
+def test_alpha_is_low_when_the_expected_source_is_a_known_weaker_source():
+    result = weight([[1.0, 2.0]], [[1.1, 2.0]])
+    assert (result.value, result.branch) == (0.1, AlphaBranch.WEAKER_SOURCE)
+
+
+def test_alpha_is_point_eight_when_no_peer_heads_to_the_expected_source():
+    result = weight([[2.0, 0.5]], [])
+    assert (result.value, result.branch) == (0.8, AlphaBranch.NO_PEER_NEAR)
+    assert weight([], []).value == 0.8
+
+
+def test_alpha_follows_the_schedule_when_a_peer_heads_to_the_expected_source():
+    result = weight([[1.2, 2.1]], [], t=50.0)  # squared distance 0.05 < 2 l_robot
+    assert result.branch is AlphaBranch.SCHEDULE
+    assert result.value == pytest.approx(scheduled_alpha(50.0, 100.0))

@@ -1,0 +1,164 @@
+"""Algorithm 1 and 3 behaviour of the per-robot planner."""
+
+import math
+from dataclasses import replace
+
+import numpy as np
+import pytest
+from bayes_swarm.errors import ConfigError, GpFitError
+from bayes_swarm.messages import DecisionKind, PeerUpdate
+from bayes_swarm.planner import BayesSwarmPlanner, first_waypoint
+from bayes_swarm.settings import Arena, BayesSwarmConfig, GlowwormConfig, GpConfig, LevyConfig
+
+
+def case1_field(points):
+    """Appendix C, Eq. 19 (source at (1, 2), weaker bump at (2, 0.5))."""
+    p = np.asarray(points, dtype=float).reshape(-1, 2)
+    return np.exp(-((p - [1.0, 2.0]) ** 2).sum(1) / 3.0) + 0.5 * np.exp(
+        -2.0 * ((p - [2.0, 0.5]) ** 2).sum(1)
+    )
+
+
+def leg(planner, start, end, n=11):
+    pts = np.linspace(start, end, n)
+    planner.add_observations(pts, case1_field(pts))
+
+
+def test_first_decisions_fan_out_over_the_initial_direction_range():
+    headings = []
+    for r in range(5):
+        wp = BayesSwarmPlanner(BayesSwarmConfig(robot_index=r), f'r{r}').decide([0, 0], 0.0)
+        assert wp.kind is DecisionKind.FIRST
+        assert np.hypot(*wp.waypoint_m) == pytest.approx(1.0)
+        headings.append(math.degrees(math.atan2(wp.waypoint_m[1], wp.waypoint_m[0])))
+    np.testing.assert_allclose(headings, [15, 30, 45, 60, 75])
+
+
+def test_full_circle_fan_divides_by_the_swarm_size():
+    wp = first_waypoint(
+        np.zeros(2),
+        fan_index=1,
+        fan_size=10,
+        direction_range_deg=360.0,
+        direction_offset_deg=0.0,
+        leg_m=20.0,
+    )
+    assert math.degrees(math.atan2(wp[1], wp[0])) == pytest.approx(36.0)
+
+
+def test_decision_moves_toward_the_expected_source_within_the_leg_limit():
+    cfg = BayesSwarmConfig()
+    planner = BayesSwarmPlanner(cfg, 'r0', seed=1)
+    planner.decide([0, 0], 0.0)
+    for end in ([0.26, 0.97], [0.71, 0.71], [0.97, 0.26]):
+        leg(planner, [0, 0], end)
+    decision = planner.decide([0.71, 0.71], 10.0)
+    assert decision.kind is DecisionKind.ACQUISITION
+    assert np.hypot(*(decision.waypoint_m - [0.71, 0.71])) <= cfg.max_leg_m + 1e-9
+    assert cfg.arena.contains(decision.waypoint_m)
+    # The GP, fitted on three rising legs, expects the maximum up and to the right.
+    assert decision.expected_source_m[0] > 0.8
+    assert decision.expected_source_m[1] > 0.8
+    assert decision.compute_time_s > 0.0
+
+
+def test_receive_ignores_own_stale_and_duplicated_messages():
+    planner = BayesSwarmPlanner(BayesSwarmConfig(), 'r0')
+    pts = np.array([[0.1, 0.1], [0.2, 0.2]])
+    update = PeerUpdate('r1', 3, np.zeros(2), np.ones(2), pts, np.array([0.2, 0.3]))
+    assert planner.receive(update)
+    assert not planner.receive(update)  # duplicate
+    assert not planner.receive(replace(update, decision_index=2))  # stale
+    assert not planner.receive(replace(update, sender='r0', decision_index=9))  # own
+    assert planner.n_observations == 2
+    assert planner.receive(replace(update, decision_index=4, waypoint_m=np.array([2.0, 2.0])))
+    assert planner.peer_waypoints['r1'] == pytest.approx([2.0, 2.0])
+
+
+def test_non_finite_samples_are_dropped_and_the_rest_kept():
+    planner = BayesSwarmPlanner(BayesSwarmConfig(), 'r0')
+    kept = planner.add_observations(
+        np.array([[0.0, 0.0], [0.1, np.nan], [0.2, 0.2]]), np.array([0.1, 0.2, np.inf])
+    )
+    assert kept == 1
+    assert planner.n_observations == 1
+
+
+def test_broadcast_carries_only_the_samples_since_the_last_broadcast():
+    planner = BayesSwarmPlanner(BayesSwarmConfig(), 'r0')
+    planner.add_observations(np.zeros((1, 2)), np.array([0.2]))
+    planner.decide([0, 0], 0.0)
+    first = planner.broadcast(np.zeros(2))
+    assert len(first.sample_values) == 1
+    leg(planner, [0, 0], [0.97, 0.26])
+    planner.decide([0.97, 0.26], 10.0)
+    second = planner.broadcast(np.array([0.97, 0.26]))
+    assert len(second.sample_values) == 11
+    assert second.decision_index == 1
+    assert second.waypoint_m == pytest.approx(planner._last_decision.waypoint_m)
+
+
+def planner_with_data(penalty_enabled=True, peer_waypoint=None):
+    cfg = BayesSwarmConfig(penalty_enabled=penalty_enabled)
+    planner = BayesSwarmPlanner(cfg, 'r0', seed=4)
+    planner.decide([0, 0], 0.0)
+    for end in ([0.26, 0.97], [0.5, 0.87], [0.71, 0.71]):
+        leg(planner, [0, 0], end)
+    if peer_waypoint is not None:
+        planner.receive(PeerUpdate('r1', 1, np.array([0.5, 0.87]), np.asarray(peer_waypoint)))
+    return planner
+
+
+def test_penalty_pushes_the_waypoint_away_from_a_peers_planned_waypoint():
+    free = planner_with_data().decide([0.71, 0.71], 50.0).waypoint_m
+    penalised = planner_with_data(peer_waypoint=free).decide([0.71, 0.71], 50.0).waypoint_m
+    unpenalised = planner_with_data(penalty_enabled=False, peer_waypoint=free)
+    other = unpenalised.decide([0.71, 0.71], 50.0).waypoint_m
+    assert np.hypot(*(penalised - free)) > 0.1
+    assert np.hypot(*(other - free)) < np.hypot(*(penalised - free))
+
+
+def test_gp_failure_falls_back_to_a_waypoint_inside_the_arena(monkeypatch):
+    planner = planner_with_data()
+
+    def broken_fit(*args, **kwargs):
+        raise GpFitError('not positive definite')
+
+    monkeypatch.setattr(planner.gp, 'fit', broken_fit)
+    decision = planner.decide([0.71, 0.71], 20.0)
+    assert decision.kind is DecisionKind.FALLBACK
+    assert 'GpFitError' in decision.detail
+    assert planner.config.arena.contains(decision.waypoint_m)
+
+
+def test_reaching_an_expected_source_that_is_not_the_source_marks_it_weaker_and_explores():
+    cfg = BayesSwarmConfig(arena=Arena(0, 4, 0, 4))
+    planner = BayesSwarmPlanner(cfg, 'r0', seed=0)
+    planner.decide([2, 2], 0.0)
+    rng = np.random.default_rng(0)
+    pts = rng.uniform(0, 4, size=(80, 2))
+    planner.add_observations(pts, np.exp(-((pts - 2.0) ** 2).sum(1)))  # peak at (2, 2)
+    decision = planner.decide([2.0, 2.0], 20.0)
+    assert decision.kind in (DecisionKind.EXPLORE, DecisionKind.RANDOM_JUMP)
+    assert planner.weaker_sources.shape == (1, 2)
+    assert planner.weaker_sources[0] == pytest.approx([2.0, 2.0], abs=0.05)
+    assert np.hypot(*(decision.waypoint_m - 2.0)) >= cfg.step_m
+
+
+@pytest.mark.parametrize(
+    ('factory', 'match'),
+    [
+        (lambda: BayesSwarmConfig(velocity_mps=-0.1), 'velocity_mps'),
+        (lambda: BayesSwarmConfig(n_max=0), 'N_max'),
+        (lambda: BayesSwarmConfig(outer_optimizer='simplex'), 'outer_optimizer'),
+        (lambda: BayesSwarmConfig(robot_index=5, n_robots=5), 'robot_index'),
+        (lambda: BayesSwarmConfig(detection_radius_m=float('nan')), 'detection_radius_m'),
+        (lambda: GpConfig(length_scale_bounds_m=(1.0, 0.5)), 'length_scale_bounds_m'),
+        (lambda: Arena(1.0, 0.0, 0.0, 1.0), 'x_max_m'),
+        (lambda: GlowwormConfig(sensor_range_m=-20.0), 'sensor_range_m'),
+        (lambda: LevyConfig(mu=3.5), 'mu'),
+    ],
+)
+def test_invalid_parameters_are_rejected_with_the_field_named(factory, match):
+    with pytest.raises(ConfigError, match=match):
+        factory()
