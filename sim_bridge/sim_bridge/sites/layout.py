@@ -1,0 +1,603 @@
+"""ASCII ``.lay`` layouts: the OA-Bug authors' floor-plan format, read into a :class:`Site`.
+
+One character per grid vertex, 1 cell = 4/15 m (see :mod:`.lattice` for the geometry):
+
+===========  ================================================================================
+``%``        wall vertex; straight runs of them are wall lines
+`` ``        free space (corridors, and room interiors in unlabelled plans)
+``A``-``z``  interior of a room in a *labelled* layout, one letter per room (the authors'
+             generator continues past ``Z`` with ``[ \\ ] ^ _ ```` and lower case)
+``0``-``9``  interior of a room holding a victim (labelled layouts)
+``/``        door to a corridor (labelled); on the outer border: the site's single entrance
+``#``        door between two rooms (labelled)
+``D``        the departure point in an *unlabelled* plan (a room letter in labelled ones)
+===========  ================================================================================
+
+The first and last lines and columns are the enclosure: they hold only ``%``, except one run
+of ``/`` marking the entrance.
+
+*Labelled* layouts (the authors' generator output) name every room; each 4-connected group of
+one letter is a room. *Unlabelled* layouts (the authors' building plans) only draw walls;
+rooms are then found as the areas closed off by door gaps: a free vertex between two wall
+vertices of a straight line, with free space on both sides of the line that widens on at
+least one side (REFERENCE_OABUG_SIM.md §3: "a door is a missing vertex in a wall line").
+A one-cell-wide room whose door leads into another one-cell-wide room is found merged with
+it, and a one-cell-wide corridor behind a gap counts as a room.
+
+Departure points: an unlabelled plan marks one with ``D`` (a group of ``D`` marks its
+centre). Labelled layouts follow the authors' runner: "center" at the middle of the bounds
+and "edge" 2.5 cells inside the entrance (or above the middle of the bottom wall when there
+is no entrance), heading into the building.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from enum import StrEnum
+from pathlib import Path
+from typing import Final
+
+import numpy as np
+from scipy import ndimage
+
+from sim_bridge.sites import lattice
+from sim_bridge.sites.errors import LayoutError, SiteValidationError
+from sim_bridge.sites.model import CELL_M, NO_ROOM, DeparturePoint, Door, Room, Site
+from sim_bridge.sites.validation import validate_site
+
+__all__ = [
+    'CORRIDOR_DOOR',
+    'DEPARTURE',
+    'FREE',
+    'ROOM_DOOR',
+    'WALL',
+    'Layout',
+    'LayoutImport',
+    'LayoutMode',
+    'detect_mode',
+    'import_layout',
+    'layout_to_site',
+    'parse_layout',
+    'read_layout',
+    'write_layout',
+]
+
+WALL: Final = ord('%')
+FREE: Final = ord(' ')
+CORRIDOR_DOOR: Final = ord('/')
+ROOM_DOOR: Final = ord('#')
+DEPARTURE: Final = ord('D')
+_LABEL_FIRST: Final = ord('A')
+_LABEL_LAST: Final = ord('z')
+_DIGIT_FIRST: Final = ord('0')
+_DIGIT_LAST: Final = ord('9')
+EDGE_INSET_CELLS: Final = 2.5
+"""How far inside the entrance the "edge" departure point sits [cells] (authors' runner)."""
+
+_KNOWN_CHARACTERS = (
+    "'%' wall, ' ' free, 'A'-'z' room letters, '0'-'9' victim rooms, '/' and '#' doors, "
+    "'D' departure"
+)
+
+
+class LayoutMode(StrEnum):
+    """How rooms are given in a layout."""
+
+    AUTO = 'auto'
+    """Labelled if the layout has room letters, digits or door marks inside; else unlabelled."""
+    LABELLED = 'labelled'
+    """Rooms are letter/digit areas, doors are ``/`` and ``#``."""
+    UNLABELLED = 'unlabelled'
+    """Only walls; rooms are found behind door gaps; ``D`` marks the departure point."""
+
+
+@dataclass(frozen=True, eq=False)
+class Layout:
+    """A parsed layout.
+
+    Attributes:
+        codes: (H, W) uint8 character codes, row 0 = first line of the file (read-only).
+        source: where it came from, used in error messages (a file name).
+    """
+
+    codes: np.ndarray
+    source: str = '<layout>'
+
+    def __post_init__(self) -> None:
+        codes = np.array(self.codes, dtype=np.uint8, copy=True)
+        if codes.ndim != 2 or codes.shape[0] < 3 or codes.shape[1] < 3:
+            raise LayoutError(
+                self.source,
+                None,
+                None,
+                f'a layout needs at least 3 x 3 characters, got shape {codes.shape}',
+            )
+        codes.flags.writeable = False
+        object.__setattr__(self, 'codes', codes)
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        """(lines, columns)."""
+        return (int(self.codes.shape[0]), int(self.codes.shape[1]))
+
+    def to_text(self) -> str:
+        """The layout as file text, one line per row, ending with a newline."""
+        return ''.join(bytes(row).decode('ascii') + '\n' for row in self.codes)
+
+
+@dataclass(frozen=True)
+class LayoutImport:
+    """Result of importing a layout.
+
+    Attributes:
+        site: the validated site.
+        mode: the mode used (AUTO resolved).
+        rooms_found: number of rooms.
+        doors_found: number of doors (the entrance not counted).
+    """
+
+    site: Site
+    mode: LayoutMode
+    rooms_found: int
+    doors_found: int
+
+
+def _is_label(codes: np.ndarray) -> np.ndarray:
+    return (codes >= _LABEL_FIRST) & (codes <= _LABEL_LAST)
+
+
+def _is_digit(codes: np.ndarray) -> np.ndarray:
+    return (codes >= _DIGIT_FIRST) & (codes <= _DIGIT_LAST)
+
+
+def parse_layout(text: str, source: str = '<layout>') -> Layout:
+    """Parse layout text. Lines must all have the same length; trailing empty lines are
+    ignored; ``\\r\\n`` line ends are accepted.
+
+    Raises:
+        LayoutError: ragged lines or an unknown character, with its line and column.
+    """
+    lines = text.replace('\r\n', '\n').split('\n')
+    while lines and lines[-1] == '':
+        lines.pop()
+    if not lines:
+        raise LayoutError(source, None, None, 'the layout is empty')
+    width = len(lines[0])
+    for number, line in enumerate(lines, start=1):
+        if len(line) != width:
+            msg = (
+                f'line has {len(line)} characters, the first line has {width}; every line of '
+                'a layout must be equally long'
+            )
+            raise LayoutError(source, number, None, msg)
+        for column, char in enumerate(line, start=1):
+            code = ord(char)
+            known = code in (WALL, FREE, CORRIDOR_DOOR, ROOM_DOOR) or (
+                _LABEL_FIRST <= code <= _LABEL_LAST or _DIGIT_FIRST <= code <= _DIGIT_LAST
+            )
+            if not known:
+                msg = f'unknown character {char!r}; a layout uses {_KNOWN_CHARACTERS}'
+                raise LayoutError(source, number, column, msg)
+    codes = np.frombuffer(''.join(lines).encode('ascii'), dtype=np.uint8).reshape(len(lines), width)
+    return Layout(codes, source)
+
+
+def read_layout(path: str | Path) -> Layout:
+    """Read and parse a ``.lay`` file."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding='ascii')
+    except UnicodeDecodeError as err:
+        before = path.read_bytes()[: err.start]
+        line = before.count(b'\n') + 1
+        column = err.start - (before.rfind(b'\n') + 1) + 1
+        raise LayoutError(str(path), line, column, 'unknown non-ASCII character') from None
+    return parse_layout(text, str(path))
+
+
+def write_layout(layout: Layout, path: str | Path) -> None:
+    """Write a layout as a ``.lay`` file."""
+    Path(path).write_text(layout.to_text(), encoding='ascii')
+
+
+def detect_mode(layout: Layout) -> LayoutMode:
+    """LABELLED when room letters other than ``D``, digits or inner door marks appear."""
+    inner = layout.codes[1:-1, 1:-1]
+    labelled = (_is_label(inner) & (inner != DEPARTURE)) | _is_digit(inner)
+    labelled |= (inner == CORRIDOR_DOOR) | (inner == ROOM_DOOR)
+    return LayoutMode.LABELLED if bool(np.any(labelled)) else LayoutMode.UNLABELLED
+
+
+def import_layout(
+    path: str | Path,
+    *,
+    mode: LayoutMode | str = LayoutMode.AUTO,
+    cell_m: float = CELL_M,
+    name: str | None = None,
+    departure_name: str = 'edge',
+) -> LayoutImport:
+    """Read a ``.lay`` file and turn it into a validated site (see :func:`layout_to_site`)."""
+    layout = read_layout(path)
+    return layout_to_site(
+        layout,
+        mode=mode,
+        cell_m=cell_m,
+        name=name if name is not None else Path(path).stem,
+        departure_name=departure_name,
+    )
+
+
+def layout_to_site(
+    layout: Layout,
+    *,
+    mode: LayoutMode | str = LayoutMode.AUTO,
+    cell_m: float = CELL_M,
+    name: str | None = None,
+    departure_name: str = 'edge',
+    seed: int | None = None,
+) -> LayoutImport:
+    """Build and validate the site a layout describes.
+
+    Args:
+        layout: the parsed layout.
+        mode: labelled, unlabelled or auto (see :class:`LayoutMode`).
+        cell_m: grid spacing [m]; the paper's 4/15 m by default.
+        name: site name; defaults to the layout's source.
+        departure_name: name given to the ``D`` departure point of an unlabelled plan.
+        seed: generator seed to record in the site, if the layout was generated.
+
+    Raises:
+        LayoutError: malformed or invalid layout, naming the line and column.
+    """
+    mode = LayoutMode(mode)
+    if not (math.isfinite(cell_m) and cell_m > 0):
+        raise LayoutError(
+            layout.source, None, None, f'cell size must be positive, got {cell_m!r} m'
+        )
+    if mode is LayoutMode.AUTO:
+        mode = detect_mode(layout)
+    builder = _SiteBuilder(layout, cell_m)
+    entrance = builder.entrance()
+    if mode is LayoutMode.LABELLED:
+        rooms, doors = builder.labelled_rooms_and_doors()
+        departures = builder.runner_departure_points(entrance)
+    else:
+        departure = builder.marked_departure_point(departure_name)
+        rooms, doors = builder.rooms_behind_door_gaps(departure)
+        departures = [departure]
+    site = Site(
+        name=name if name is not None else layout.source,
+        width_m=(layout.shape[1] - 1) * cell_m,
+        height_m=(layout.shape[0] - 1) * cell_m,
+        walls=lattice.wall_segments(builder.wall, cell_m),
+        rooms=tuple(rooms),
+        doors=tuple(doors),
+        entrance=builder.entrance_door(entrance),
+        departure_points={p.name: p for p in departures},
+        grid_m=cell_m,
+        seed=seed,
+    )
+    try:
+        validate_site(site)
+    except SiteValidationError as err:
+        line, column = builder.line_column(err.position_m)
+        raise LayoutError(layout.source, line, column, err.message) from err
+    return LayoutImport(site=site, mode=mode, rooms_found=len(rooms), doors_found=len(doors))
+
+
+class _SiteBuilder:
+    """The steps of turning a layout into site parts; every error names line and column."""
+
+    def __init__(self, layout: Layout, cell_m: float) -> None:
+        self.layout = layout
+        self.codes = layout.codes
+        self.cell_m = cell_m
+        self.n_rows, self.n_cols = layout.shape
+        self.wall = self.codes == WALL
+        self.square_rooms = np.full((self.n_rows - 1, self.n_cols - 1), NO_ROOM, dtype=np.int64)
+
+    def error(self, row: int | None, col: int | None, message: str) -> LayoutError:
+        return LayoutError(
+            self.layout.source,
+            None if row is None else row + 1,
+            None if col is None else col + 1,
+            message,
+        )
+
+    def xy(self, row: float, col: float) -> tuple[float, float]:
+        return lattice.vertex_to_xy(row, col, self.n_rows, self.cell_m)
+
+    def line_column(self, position_m: tuple[float, float] | None) -> tuple[int | None, int | None]:
+        """1-based line and column of the vertex nearest to a world position."""
+        if position_m is None:
+            return (None, None)
+        row, col = lattice.xy_to_vertex(position_m[0], position_m[1], self.n_rows, self.cell_m)
+        row = min(max(round(row), 0), self.n_rows - 1)
+        col = min(max(round(col), 0), self.n_cols - 1)
+        return (row + 1, col + 1)
+
+    # Enclosure and entrance -------------------------------------------------------------
+
+    def _border_cells(self) -> list[tuple[int, int]]:
+        """Border vertices in order around the enclosure (clockwise from the top-left)."""
+        h, w = self.n_rows, self.n_cols
+        top = [(0, c) for c in range(w)]
+        right = [(r, w - 1) for r in range(1, h)]
+        bottom = [(h - 1, c) for c in range(w - 2, -1, -1)]
+        left = [(r, 0) for r in range(h - 2, 0, -1)]
+        return top + right + bottom + left
+
+    def entrance(self) -> list[tuple[int, int]]:
+        """Border vertices marked ``/`` (one straight run, or empty)."""
+        ring = self._border_cells()
+        corners = {
+            (0, 0),
+            (0, self.n_cols - 1),
+            (self.n_rows - 1, 0),
+            (self.n_rows - 1, self.n_cols - 1),
+        }
+        runs: list[list[tuple[int, int]]] = []
+        previous_was_door = False
+        for row, col in ring:
+            code = int(self.codes[row, col])
+            if code == CORRIDOR_DOOR:
+                if (row, col) in corners:
+                    raise self.error(
+                        row, col, 'the entrance cannot be at a corner of the enclosure'
+                    )
+                if previous_was_door:
+                    runs[-1].append((row, col))
+                else:
+                    runs.append([(row, col)])
+                previous_was_door = True
+                continue
+            previous_was_door = False
+            if code != WALL:
+                what = 'a gap' if code == FREE else f'{chr(code)!r}'
+                msg = (
+                    f'the enclosure is open: the outer wall has {what} here; the first and last '
+                    "lines and columns must be '%', except one run of '/' marking the entrance"
+                )
+                raise self.error(row, col, msg)
+        if len(runs) > 1:
+            first = runs[0][0]
+            row, col = runs[1][0]
+            msg = (
+                f'a second entrance; a site has a single entrance (the first is at line '
+                f'{first[0] + 1}, column {first[1] + 1})'
+            )
+            raise self.error(row, col, msg)
+        return runs[0] if runs else []
+
+    def entrance_door(self, cells: list[tuple[int, int]]) -> Door | None:
+        if not cells:
+            return None
+        rows = [r for r, _ in cells]
+        cols = [c for _, c in cells]
+        if len(set(rows)) == 1:  # top or bottom wall
+            row = rows[0]
+            a, b = self.xy(row, min(cols) - 1), self.xy(row, max(cols) + 1)
+            inner_square = (0 if row == 0 else self.n_rows - 2, min(cols))
+        else:
+            col = cols[0]
+            a, b = self.xy(min(rows) - 1, col), self.xy(max(rows) + 1, col)
+            inner_square = (min(rows), 0 if col == 0 else self.n_cols - 2)
+        room_id = int(self.square_rooms[inner_square])
+        return Door((*a, *b), () if room_id == NO_ROOM else (room_id,))
+
+    # Labelled layouts -------------------------------------------------------------------
+
+    def labelled_rooms_and_doors(self) -> tuple[list[Room], list[Door]]:
+        codes = self.codes
+        inner = np.zeros_like(self.wall)
+        inner[1:-1, 1:-1] = True
+        interior = (_is_label(codes) | _is_digit(codes)) & inner
+        found: list[tuple[int, int, np.ndarray]] = []  # (first flat index, code, vertex mask)
+        for code in np.unique(codes[interior]).tolist():
+            components, count = ndimage.label(codes == code)
+            for k in range(1, count + 1):
+                mask = components == k
+                found.append((int(np.flatnonzero(mask)[0]), code, mask))
+        found.sort(key=lambda item: item[0])
+        vertex_rooms = np.full(codes.shape, NO_ROOM, dtype=np.int64)
+        first_cell: dict[int, tuple[int, int]] = {}
+        for index, (first, _, mask) in enumerate(found):
+            vertex_rooms[mask] = index + 1
+            first_cell[index + 1] = divmod(first, self.n_cols)
+        self._square_rooms_from_vertices(vertex_rooms)
+        rooms = []
+        for index, (_, code, _) in enumerate(found):
+            room_id = index + 1
+            rects = lattice.square_to_rects(self.square_rooms == room_id, self.cell_m)
+            is_digit = _DIGIT_FIRST <= code <= _DIGIT_LAST
+            rooms.append(Room(room_id, rects, label=chr(code), has_victim=is_digit))
+        self._check_rooms_have_openings(rooms, first_cell)
+        return rooms, self._marked_doors()
+
+    def _square_rooms_from_vertices(self, vertex_rooms: np.ndarray) -> None:
+        """A square belongs to the room one of its corners is inside of: a room's area spans
+        its wall lines."""
+        corners = np.stack(
+            [
+                vertex_rooms[:-1, :-1],
+                vertex_rooms[:-1, 1:],
+                vertex_rooms[1:, :-1],
+                vertex_rooms[1:, 1:],
+            ]
+        )
+        square_rooms = corners.max(axis=0)
+        clash = np.any((corners != NO_ROOM) & (corners != square_rooms), axis=0)
+        if np.any(clash):
+            i, j = (int(v) for v in np.argwhere(clash)[0])
+            block = self.codes[i : i + 2, j : j + 2]
+            labels = sorted({chr(c) for c in block.ravel().tolist() if c not in (WALL, FREE)})
+            msg = f'rooms {" and ".join(map(repr, labels))} touch without a wall between them'
+            raise self.error(i, j, msg)
+        self.square_rooms = square_rooms
+
+    def _check_rooms_have_openings(
+        self, rooms: list[Room], first_cell: dict[int, tuple[int, int]]
+    ) -> None:
+        areas, _ = lattice.square_labels(self.wall)
+        for room in rooms:
+            mine = self.square_rooms == room.room_id
+            reachable = np.isin(areas, np.unique(areas[mine]))
+            if not np.any(reachable & ~mine):
+                row, col = first_cell[room.room_id]
+                raise self.error(row, col, f'room {room.label!r} has no door')
+
+    def _marked_doors(self) -> list[Door]:
+        codes = self.codes
+        marks = np.zeros_like(self.wall)
+        marks[1:-1, 1:-1] = (codes[1:-1, 1:-1] == CORRIDOR_DOOR) | (codes[1:-1, 1:-1] == ROOM_DOOR)
+        components, count = ndimage.label(marks)
+        doors = []
+        for k in range(1, count + 1):
+            cells = np.argwhere(components == k)
+            rows, cols = cells[:, 0], cells[:, 1]
+            r0, c0 = int(rows.min()), int(cols.min())
+            r1, c1 = int(rows.max()), int(cols.max())
+            wall = self.wall
+            horizontal = r0 == r1 and bool(wall[r0, c0 - 1] and wall[r0, c1 + 1])
+            vertical = c0 == c1 and bool(wall[r0 - 1, c0] and wall[r1 + 1, c0])
+            if horizontal == vertical:
+                row, col = (int(v) for v in cells[0])
+                msg = (
+                    f'door {chr(int(codes[row, col]))!r} is not a gap in a straight wall line '
+                    "(it needs '%' on both ends along one line)"
+                )
+                raise self.error(row, col, msg)
+            if horizontal:
+                segment = (*self.xy(r0, c0 - 1), *self.xy(r0, c1 + 1))
+                sides = (self.square_rooms[r0 - 1, c0], self.square_rooms[r0, c0])
+            else:
+                segment = (*self.xy(r1 + 1, c0), *self.xy(r0 - 1, c0))
+                sides = (self.square_rooms[r0, c0 - 1], self.square_rooms[r0, c0])
+            room_ids = tuple(sorted({int(s) for s in sides} - {NO_ROOM}))
+            doors.append(Door(segment, room_ids))
+        return doors
+
+    def runner_departure_points(self, entrance: list[tuple[int, int]]) -> list[DeparturePoint]:
+        """The authors' runner: centre of the bounds, and 2.5 cells inside the entrance."""
+        h, w = self.n_rows, self.n_cols
+        centre = DeparturePoint('center', *self.xy((h - 1) / 2, (w - 1) / 2))
+        if entrance:
+            rows = [r for r, _ in entrance]
+            cols = [c for _, c in entrance]
+            row, col = (min(rows) + max(rows)) / 2, (min(cols) + max(cols)) / 2
+        else:
+            row, col = h - 1, (w - 1) / 2
+        if row == h - 1:
+            row, heading = row - EDGE_INSET_CELLS, math.pi / 2
+        elif row == 0:
+            row, heading = row + EDGE_INSET_CELLS, -math.pi / 2
+        elif col == 0:
+            col, heading = col + EDGE_INSET_CELLS, 0.0
+        else:
+            col, heading = col - EDGE_INSET_CELLS, math.pi
+        return [centre, DeparturePoint('edge', *self.xy(row, col), heading_rad=heading)]
+
+    # Unlabelled plans -------------------------------------------------------------------
+
+    def marked_departure_point(self, name: str) -> DeparturePoint:
+        codes = self.codes
+        inner = np.zeros_like(self.wall)
+        inner[1:-1, 1:-1] = True
+        letters = (
+            (_is_label(codes) & (codes != DEPARTURE)) | _is_digit(codes) | (codes == ROOM_DOOR)
+        )
+        letters |= (codes == CORRIDOR_DOOR) & inner
+        if np.any(letters):
+            row, col = (int(v) for v in np.argwhere(letters)[0])
+            msg = (
+                f'{chr(int(codes[row, col]))!r} belongs to labelled layouts; an unlabelled plan '
+                "has only '%', ' ', 'D' and the entrance '/'"
+            )
+            raise self.error(row, col, msg)
+        marks, count = ndimage.label(codes == DEPARTURE)
+        if count == 0:
+            raise self.error(None, None, "an unlabelled plan needs a departure point marked 'D'")
+        if count > 1:
+            first = np.argwhere(marks == 1)[0]
+            row, col = (int(v) for v in np.argwhere(marks == 2)[0])
+            msg = (
+                "a second departure mark 'D'; the first is at line "
+                f'{first[0] + 1}, column {first[1] + 1}'
+            )
+            raise self.error(row, col, msg)
+        cells = np.argwhere(marks == 1)
+        row, col = cells.mean(axis=0)
+        return DeparturePoint(name, *self.xy(float(row), float(col)))
+
+    def rooms_behind_door_gaps(self, departure: DeparturePoint) -> tuple[list[Room], list[Door]]:
+        free = ~self.wall
+        free_up, free_down = free[:-2, 1:-1], free[2:, 1:-1]
+        free_left, free_right = free[1:-1, :-2], free[1:-1, 2:]
+        wall_left, wall_right = self.wall[1:-1, :-2], self.wall[1:-1, 2:]
+        wall_up, wall_down = self.wall[:-2, 1:-1], self.wall[2:, 1:-1]
+        diagonal_up = free[:-2, :-2] | free[:-2, 2:]
+        diagonal_down = free[2:, :-2] | free[2:, 2:]
+        diagonal_left = free[:-2, :-2] | free[2:, :-2]
+        diagonal_right = free[:-2, 2:] | free[2:, 2:]
+        centre = free[1:-1, 1:-1] & (self.codes[1:-1, 1:-1] != DEPARTURE)
+        gap_h = np.zeros_like(self.wall)
+        gap_v = np.zeros_like(self.wall)
+        gap_h[1:-1, 1:-1] = (
+            centre & wall_left & wall_right & free_up & free_down & (diagonal_up | diagonal_down)
+        )
+        gap_v[1:-1, 1:-1] = (
+            centre & wall_up & wall_down & free_left & free_right & (diagonal_left | diagonal_right)
+        )
+        closed_h = np.zeros((self.n_rows, self.n_cols - 1), dtype=bool)
+        closed_v = np.zeros((self.n_rows - 1, self.n_cols), dtype=bool)
+        rows, cols = np.nonzero(gap_h)
+        closed_h[rows, cols - 1] = True
+        closed_h[rows, cols] = True
+        rows, cols = np.nonzero(gap_v)
+        closed_v[rows - 1, cols] = True
+        closed_v[rows, cols] = True
+        sealed = self.wall | (self.codes == CORRIDOR_DOOR)  # the entrance is closed too
+        areas, _ = lattice.square_labels(sealed, gap_h | gap_v, closed_h, closed_v)
+        row, col = lattice.xy_to_vertex(departure.x_m, departure.y_m, self.n_rows, self.cell_m)
+        start_area = int(areas[min(int(row), self.n_rows - 2), min(int(col), self.n_cols - 2)])
+        gaps = [(int(r), int(c), True) for r, c in np.argwhere(gap_h)]
+        gaps += [(int(r), int(c), False) for r, c in np.argwhere(gap_v)]
+        gaps.sort()
+        sides: list[tuple[int, int]] = []
+        for r, c, horizontal in gaps:
+            if horizontal:
+                sides.append((int(areas[r - 1, c]), int(areas[r, c])))
+            else:
+                sides.append((int(areas[r, c - 1]), int(areas[r, c])))
+        behind_doors = {a for pair in sides if pair[0] != pair[1] for a in pair} - {start_area}
+        self._check_enclosed_areas(areas, behind_doors | {start_area})
+        ordered = sorted(behind_doors, key=lambda a: int(np.flatnonzero(areas == a)[0]))
+        room_of_area = {area: index + 1 for index, area in enumerate(ordered)}
+        rooms = []
+        for area, room_id in room_of_area.items():
+            mask = areas == area
+            self.square_rooms[mask] = room_id
+            rooms.append(Room(room_id, lattice.square_to_rects(mask, self.cell_m)))
+        doors = []
+        for (r, c, horizontal), (a, b) in zip(gaps, sides, strict=True):
+            if a == b:
+                continue
+            if horizontal:
+                segment = (*self.xy(r, c - 1), *self.xy(r, c + 1))
+            else:
+                segment = (*self.xy(r + 1, c), *self.xy(r - 1, c))
+            room_ids = tuple(sorted(room_of_area[x] for x in (a, b) if x in room_of_area))
+            doors.append(Door(segment, room_ids))
+        return rooms, doors
+
+    def _check_enclosed_areas(self, areas: np.ndarray, known: set[int]) -> None:
+        """Every area that is neither solid wall mesh, nor the departure's, nor behind a door
+        gap is a closed room without a door."""
+        solid = lattice.solid_squares(self.wall | (self.codes == CORRIDOR_DOOR))
+        stray = ~solid & ~np.isin(areas, list(known))
+        if np.any(stray):
+            i, j = (int(v) for v in np.argwhere(stray)[0])
+            corners = [(i, j), (i, j + 1), (i + 1, j), (i + 1, j + 1)]
+            row, col = next(((r, c) for r, c in corners if not self.wall[r, c]), (i, j))
+            raise self.error(row, col, 'an enclosed area has no door (no gap in its walls)')
