@@ -15,6 +15,7 @@ command is older than ``pump_timeout_s`` switches off.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -38,14 +39,18 @@ class SiteGeometry:
     """What the engine needs of a site.
 
     Attributes:
-        walls: (M, 2, 2) wall centre lines [m].
-        room_rects: (K, 4) x_min, y_min, x_max, y_max of each room's interior [m].
+        walls: (M, 2, 2) wall centre lines [m] (the entrance closed).
+        room_rects: per room, a (Ki, 4) array of interior rectangles x_min, y_min, x_max,
+            y_max [m]; the room order is the room index of coverage messages.
         name: a label for logs and plots.
+        room_index_at: optional (N, 2) points -> (N,) room index lookup (-1 outside) for rooms
+            that are not unions of rectangles.
     """
 
     walls: np.ndarray
-    room_rects: np.ndarray
+    room_rects: tuple[np.ndarray, ...] | np.ndarray
     name: str = 'site'
+    room_index_at: Callable[[np.ndarray], np.ndarray] | None = None
 
 
 @dataclass(frozen=True)
@@ -169,7 +174,9 @@ class SimEngine:
         poses = self.world.poses
         self.imu = GyroYawModel(poses[:, 2], cfg.imu, rngs[3])
         self.odometry = WheelOdometry(poses, cfg.odometry, rngs[4])
-        self.coverage = CoverageTracker(site.room_rects, cfg.body.robot_radius_m)
+        self.coverage = CoverageTracker(
+            site.room_rects, cfg.body.robot_radius_m, site.room_index_at
+        )
         self._schedules = {
             'scan': _Schedule(cfg.lidar.rate_hz),
             'gas': _Schedule(cfg.gas.rate_hz),
@@ -192,6 +199,11 @@ class SimEngine:
     def num_robots(self) -> int:
         """Number of robots N."""
         return self.world.num_robots
+
+    @property
+    def step_index(self) -> int:
+        """Number of physics steps taken so far."""
+        return self._step_index
 
     def _check_robot(self, robot: int) -> None:
         if not 0 <= robot < self.num_robots:

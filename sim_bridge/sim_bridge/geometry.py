@@ -20,6 +20,7 @@ from sim_bridge.errors import WorldGeometryError
 
 __all__ = [
     'RayCaster',
+    'WallGrid',
     'as_segments',
     'count_crossings',
     'point_segment_distance',
@@ -66,39 +67,95 @@ def point_segment_distance(points: np.ndarray, segments: np.ndarray) -> np.ndarr
     Returns:
         (K, M) array of Euclidean distances [m].
     """
-    a = segments[:, 0]
-    ab = segments[:, 1] - a
-    ab_len2 = np.einsum('ij,ij->i', ab, ab)
-    ap = points[:, None, :] - a[None, :, :]
-    t = np.clip(np.einsum('kmj,mj->km', ap, ab) / ab_len2, 0.0, 1.0)
-    closest = a[None, :, :] + t[:, :, None] * ab[None, :, :]
-    return np.linalg.norm(points[:, None, :] - closest, axis=2)
+    ax, ay = segments[:, 0, 0], segments[:, 0, 1]
+    abx, aby = segments[:, 1, 0] - ax, segments[:, 1, 1] - ay
+    inv_len2 = 1.0 / (abx * abx + aby * aby)
+    apx = points[:, 0, None] - ax
+    apy = points[:, 1, None] - ay
+    t = np.clip((apx * abx + apy * aby) * inv_len2, 0.0, 1.0)
+    dx = apx - t * abx
+    dy = apy - t * aby
+    return np.sqrt(dx * dx + dy * dy)
 
 
-def count_crossings(starts: np.ndarray, ends: np.ndarray, segments: np.ndarray) -> np.ndarray:
+def count_crossings(
+    starts: np.ndarray,
+    ends: np.ndarray,
+    segments: np.ndarray,
+    candidates: np.ndarray | None = None,
+) -> np.ndarray:
     """Number of wall segments each straight path crosses.
 
     Args:
         starts: (K, 2) path start points [m].
         ends: (K, 2) path end points [m].
         segments: (M, 2, 2) wall segments [m].
+        candidates: optional (K, W) indices into ``segments`` of the only walls path k can
+            cross (e.g. from :meth:`WallGrid.candidates`); index M means "no wall".
 
     Returns:
         (K,) int array: how many segments each path properly intersects.
     """
     if len(segments) == 0 or len(starts) == 0:
         return np.zeros(len(starts), dtype=int)
-    p = starts[:, None, :]
-    r = (ends - starts)[:, None, :]
-    q = segments[None, :, 0, :]
-    s = (segments[:, 1] - segments[:, 0])[None, :, :]
-    r_cross_s = r[..., 0] * s[..., 1] - r[..., 1] * s[..., 0]
-    qp = q - p
-    with np.errstate(divide='ignore', invalid='ignore'):
-        t = (qp[..., 0] * s[..., 1] - qp[..., 1] * s[..., 0]) / r_cross_s
-        u = (qp[..., 0] * r[..., 1] - qp[..., 1] * r[..., 0]) / r_cross_s
-    hit = (r_cross_s != 0.0) & (t >= 0.0) & (t <= 1.0) & (u >= 0.0) & (u <= 1.0)
+    qx, qy = segments[:, 0, 0], segments[:, 0, 1]
+    sx, sy = segments[:, 1, 0] - qx, segments[:, 1, 1] - qy
+    if candidates is not None:
+        # A zero-length "wall" far away stands for the padding index M.
+        pad = np.array([_FAR])
+        qx, qy = np.append(qx, pad)[candidates], np.append(qy, pad)[candidates]
+        sx, sy = np.append(sx, 0.0)[candidates], np.append(sy, 0.0)[candidates]
+    px, py = starts[:, 0, None], starts[:, 1, None]
+    rx, ry = (ends[:, 0] - starts[:, 0])[:, None], (ends[:, 1] - starts[:, 1])[:, None]
+    denom = rx * sy - ry * sx
+    qpx, qpy = qx - px, qy - py
+    t_num = qpx * sy - qpy * sx
+    u_num = qpx * ry - qpy * rx
+    # Proper intersection: 0 <= t <= 1 and 0 <= u <= 1 with t = t_num/denom, u = u_num/denom,
+    # tested without dividing (the sign of denom flips both inequalities).
+    sign = np.sign(denom)
+    t_s, u_s, d_s = t_num * sign, u_num * sign, np.abs(denom)
+    hit = (d_s > 0.0) & (t_s >= 0.0) & (t_s <= d_s) & (u_s >= 0.0) & (u_s <= d_s)
     return hit.sum(axis=1)
+
+
+_FAR = 1e12
+
+
+class WallGrid:
+    """Uniform grid telling which walls lie within ``reach_m`` of any point of a cell."""
+
+    def __init__(self, segments: np.ndarray, *, cell_m: float, reach_m: float) -> None:
+        """Index ``segments`` ((M, 2, 2) [m]) on square cells of ``cell_m`` metres."""
+        segments = as_segments(segments)
+        self.cell_m = float(cell_m)
+        self.num_segments = len(segments)
+        if len(segments) == 0:
+            self._origin = np.zeros(2)
+            self._shape = (1, 1)
+            self._table = np.zeros((1, 1), dtype=int)
+            return
+        lo = segments.reshape(-1, 2).min(axis=0) - reach_m
+        hi = segments.reshape(-1, 2).max(axis=0) + reach_m
+        shape = np.maximum(np.ceil((hi - lo) / self.cell_m).astype(int), 1)
+        self._origin = lo
+        self._shape = (int(shape[0]), int(shape[1]))
+        ix, iy = np.meshgrid(np.arange(shape[0]), np.arange(shape[1]), indexing='ij')
+        centres = lo + (np.column_stack([ix.ravel(), iy.ravel()]) + 0.5) * self.cell_m
+        near = point_segment_distance(centres, segments) <= reach_m + self.cell_m * math.sqrt(0.5)
+        width = max(int(near.sum(axis=1).max()), 1)
+        table = np.full((len(centres), width), len(segments), dtype=int)
+        for c in np.flatnonzero(near.any(axis=1)):
+            idx = np.flatnonzero(near[c])
+            table[c, : len(idx)] = idx
+        self._table = table
+
+    def candidates(self, points: np.ndarray) -> np.ndarray:
+        """(K, W) indices of the walls near each of the (K, 2) points; padding is M."""
+        cell = np.floor((np.asarray(points, dtype=float) - self._origin) / self.cell_m).astype(int)
+        cx = np.clip(cell[:, 0], 0, self._shape[0] - 1)
+        cy = np.clip(cell[:, 1], 0, self._shape[1] - 1)
+        return self._table[cx * self._shape[1] + cy]
 
 
 def _expand_intervals(starts: np.ndarray, counts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

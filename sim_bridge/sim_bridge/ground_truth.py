@@ -7,6 +7,7 @@ box overlaps the room rectangle inset 3 px, about 2.5 cm, from the wall lines).
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -34,25 +35,39 @@ class RoomEntry:
 class CoverageTracker:
     """Records the first robot to enter each room."""
 
-    def __init__(self, room_rects: np.ndarray, robot_radius_m: float) -> None:
-        """Track coverage of rooms given as an (K, 4) array of interior rectangles.
+    def __init__(
+        self,
+        room_rects: Sequence[np.ndarray] | np.ndarray,
+        robot_radius_m: float,
+        room_index_at: Callable[[np.ndarray], np.ndarray] | None = None,
+    ) -> None:
+        """Track coverage of K rooms.
 
         Args:
-            room_rects: (K, 4) x_min, y_min, x_max, y_max of each room's interior [m].
+            room_rects: per room, a (Ki, 4) array of interior rectangles x_min, y_min, x_max,
+                y_max [m] (a room may be a union of rectangles; Ki may be 0 for a room that
+                only ``room_index_at`` knows). A (K, 4) array means one rectangle per room.
             robot_radius_m: radius of the robot discs [m].
+            room_index_at: optional lookup from (N, 2) points to (N,) room indices (-1 outside
+                every room), for rooms that are not rectangles: a robot is in such a room
+                when its centre is.
         """
-        rects = np.asarray(room_rects, dtype=float).reshape(-1, 4)
+        per_room = [np.asarray(r, dtype=float).reshape(-1, 4) for r in room_rects]
+        rects = np.concatenate(per_room) if per_room else np.zeros((0, 4))
         if np.any(rects[:, 2] <= rects[:, 0]) or np.any(rects[:, 3] <= rects[:, 1]):
             raise WorldGeometryError('every room rectangle needs x_max > x_min and y_max > y_min')
         self._rects = rects
+        self._rect_room = np.repeat(np.arange(len(per_room)), [len(r) for r in per_room])
+        self._num_rooms = len(per_room)
+        self._room_index_at = room_index_at
         self._radius_m = float(robot_radius_m)
-        self._first_robot = np.full(len(rects), -1, dtype=int)
+        self._first_robot = np.full(self._num_rooms, -1, dtype=int)
         self._entries: list[RoomEntry] = []
 
     @property
     def rooms_total(self) -> int:
         """Number of rooms K."""
-        return len(self._rects)
+        return self._num_rooms
 
     @property
     def rooms_covered(self) -> int:
@@ -78,13 +93,18 @@ class CoverageTracker:
         """(N, K) bool: robot disc i overlaps the interior of room k."""
         xy = np.asarray(positions, dtype=float)[:, :2]
         r = self._rects
-        dx = np.maximum(
-            np.maximum(r[None, :, 0] - xy[:, None, 0], xy[:, None, 0] - r[None, :, 2]), 0
-        )
-        dy = np.maximum(
-            np.maximum(r[None, :, 1] - xy[:, None, 1], xy[:, None, 1] - r[None, :, 3]), 0
-        )
-        return dx * dx + dy * dy < self._radius_m**2
+        x, y = xy[:, None, 0], xy[:, None, 1]
+        dx = np.maximum(np.maximum(r[None, :, 0] - x, x - r[None, :, 2]), 0.0)
+        dy = np.maximum(np.maximum(r[None, :, 1] - y, y - r[None, :, 3]), 0.0)
+        in_rect = dx * dx + dy * dy < self._radius_m**2
+        result = np.zeros((len(xy), self._num_rooms), dtype=bool)
+        for k in range(len(r)):
+            result[:, self._rect_room[k]] |= in_rect[:, k]
+        if self._room_index_at is not None:
+            index = np.asarray(self._room_index_at(xy), dtype=int)
+            robots = np.flatnonzero((index >= 0) & (index < self._num_rooms))
+            result[robots, index[robots]] = True
+        return result
 
     def update(self, positions: np.ndarray, time_s: float) -> list[RoomEntry]:
         """Record first entries at ``time_s`` from (N, 2+) robot positions; return the new ones.

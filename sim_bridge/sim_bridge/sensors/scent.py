@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from sim_bridge.errors import ConfigurationError
-from sim_bridge.geometry import as_segments, count_crossings
+from sim_bridge.geometry import WallGrid, as_segments, count_crossings
 
 __all__ = ['PumpDepositor', 'ScentConfig', 'ScentField']
 
@@ -80,6 +80,8 @@ class ScentField:
     def __init__(self, config: ScentConfig, walls: np.ndarray | None = None) -> None:
         self.config = config
         self._walls = as_segments(walls if walls is not None else np.zeros((0, 2, 2)))
+        reach = config.cutoff_sigmas * config.final_spread_m
+        self._grid = WallGrid(self._walls, cell_m=0.5, reach_m=reach) if len(self._walls) else None
         self._xy = np.zeros((256, 2))
         self._time_s = np.zeros(256)
         self._mass = np.zeros(256)
@@ -140,8 +142,10 @@ class ScentField:
         q_idx, p_idx = np.nonzero(near)
         if len(q_idx) == 0:
             return out
-        if cfg.walls_block and len(self._walls):
-            open_path = count_crossings(points[q_idx], xy[p_idx], self._walls) == 0
+        if cfg.walls_block and self._grid is not None:
+            near_walls = self._grid.candidates(points)[q_idx]
+            crossed = count_crossings(points[q_idx], xy[p_idx], self._walls, near_walls)
+            open_path = crossed == 0
             q_idx, p_idx = q_idx[open_path], p_idx[open_path]
         a = age[p_idx]
         sigma2 = self.spread_m(a) ** 2

@@ -1,0 +1,342 @@
+"""The sim bridge node: publishes every robot's sensor topics from the simulated world.
+
+Per robot ``<name>`` (r0, r1, ...) it publishes ``/<name>/scan``, ``gas``, ``bearings``,
+``imu`` and ``odom`` (sensor-data QoS) and subscribes ``/<name>/cmd_vel`` and ``pump``;
+swarm-wide it publishes ``/clock`` and the ground truth ``/sim/poses``, ``/sim/coverage``
+(and ``/sim/site`` when the site model can be converted). With ``peer_msg_type`` set it
+relays ``/<name>/peers/out`` to the other robots' ``peers/in`` within ``comm_range_m``.
+
+The node holds no simulation logic: :class:`sim_bridge.engine.SimEngine` does the work and
+:mod:`sim_bridge.conversions` builds the messages. It steps the engine on a wall timer of one
+physics period divided by ``real_time_factor``; in the built-in runtime that timer runs on a
+virtual clock, so a headless simulation goes as fast as the machine allows.
+
+Standalone: ``ros2 run sim_bridge sim_bridge --ros-args -p site_file:=site.yaml
+-p robot_count:=6 -p departure:=center``; the mission runner (:mod:`sim_bridge.mission`)
+builds it in-process with a site object and start poses instead.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from typing import Any
+
+import numpy as np
+from swarm_runtime.ros import (
+    ExternalShutdownException,
+    Node,
+    QoSDurabilityPolicy,
+    QoSProfile,
+    message_module,
+    qos_profile_sensor_data,
+    rclpy,
+)
+
+from sim_bridge import conversions
+from sim_bridge.bridge_parameters import ENGINE_PARAMETERS, config_from_values, values_from_config
+from sim_bridge.departure import departure_poses
+from sim_bridge.engine import EngineConfig, SimEngine, SiteGeometry, StepOutput
+from sim_bridge.errors import ConfigurationError, SimBridgeError
+from sim_bridge.extensions import RobotStates, SimExtension
+from sim_bridge.peer_relay import RelayConfig, RelayModel, parse_message_type
+from sim_bridge.site_geometry import geometry_from_site
+
+__all__ = ['SimBridgeNode', 'main']
+
+_rcl = message_module('rcl_interfaces')
+_geometry = message_module('geometry_msgs')
+_std = message_module('std_msgs')
+_sensor = message_module('sensor_msgs')
+_nav = message_module('nav_msgs')
+_rosgraph = message_module('rosgraph_msgs')
+_swarm = message_module('swarm_interfaces')
+
+_LATCHED = QoSProfile(depth=1, durability=QoSDurabilityPolicy.TRANSIENT_LOCAL)
+
+
+def _descriptor(description: str) -> Any:
+    return _rcl.ParameterDescriptor(description=description)
+
+
+class SimBridgeNode(Node):
+    """Simulated world of N robots behind the robots' own topic contract."""
+
+    def __init__(
+        self,
+        *,
+        site: Any = None,
+        initial_poses: np.ndarray | None = None,
+        engine_config: EngineConfig | None = None,
+        extensions: Sequence[SimExtension] = (),
+        **node_kwargs: Any,
+    ) -> None:
+        """Build the bridge.
+
+        Args:
+            site: a :class:`sim_bridge.sites.model.Site` or a :class:`SiteGeometry`; None
+                loads the ``site_file`` parameter.
+            initial_poses: (N, 3) start poses; None places ``robot_count`` robots on the
+                ``departure`` fan of the site.
+            engine_config: defaults of the engine parameters (parameter overrides win).
+            extensions: mission-specific world parts, attached in order.
+            node_kwargs: passed to rclpy's Node (namespace, parameter_overrides, ...).
+        """
+        super().__init__('sim_bridge', **node_kwargs)
+        base = engine_config or EngineConfig()
+        for spec in ENGINE_PARAMETERS:
+            default = values_from_config(base)[spec.name]
+            self.declare_parameter(spec.name, default, _descriptor(spec.description))
+        declare = self.declare_parameter
+        declare('robot_count', 1, _descriptor('Robots r0..r{n-1} (ignored with start poses).'))
+        declare('site_file', '', _descriptor('Site file to load when no site is given.'))
+        declare('departure', 'center', _descriptor("Departure point of the site: 'center'/'edge'."))
+        declare('heading_bias_rad', 0.0, _descriptor('Common bias of the departure fan [rad].'))
+        declare('real_time_factor', 1.0, _descriptor('Sim seconds per wall second (wall timer).'))
+        declare('peer_msg_type', '', _descriptor("Peer message type to relay; '' = no relay."))
+        declare('comm_range_m', math.inf, _descriptor('Peer relay range [m]; inf = unlimited.'))
+        declare('peer_loss_probability', 0.0, _descriptor('Chance one relayed message is lost.'))
+        declare('coverage_rate_hz', 1.0, _descriptor('Rate of periodic /sim/coverage [Hz].'))
+
+        values = {s.name: self.get_parameter(s.name).value for s in ENGINE_PARAMETERS}
+        self.config = config_from_values(values, base)
+        self._site_model = site if site is not None and not isinstance(site, SiteGeometry) else None
+        geometry = self._resolve_site(site)
+        poses = self._resolve_poses(initial_poses)
+        self.engine = SimEngine(geometry, poses, self.config)
+        n = self.engine.num_robots
+        self.robot_names: tuple[str, ...] = tuple(f'r{i}' for i in range(n))
+        self.step_listeners: list[Callable[[StepOutput], None]] = []
+        self._yaw_variance = 0.0
+
+        self._clock_pub = self.create_publisher(_rosgraph.Clock, '/clock', 10)
+        self._poses_pub = self.create_publisher(_swarm.TruePoseArray, '/sim/poses', 10)
+        self._coverage_pub = self.create_publisher(_swarm.Coverage, '/sim/coverage', _LATCHED)
+        sensor_qos = qos_profile_sensor_data
+        self._scan_pubs = []
+        self._gas_pubs = []
+        self._bearing_pubs = []
+        self._imu_pubs = []
+        self._odom_pubs = []
+        for i, name in enumerate(self.robot_names):
+            self._scan_pubs.append(
+                self.create_publisher(_sensor.LaserScan, f'/{name}/scan', sensor_qos)
+            )
+            self._gas_pubs.append(
+                self.create_publisher(_swarm.GasReading, f'/{name}/gas', sensor_qos)
+            )
+            self._bearing_pubs.append(
+                self.create_publisher(_swarm.PeerBearingArray, f'/{name}/bearings', sensor_qos)
+            )
+            self._imu_pubs.append(self.create_publisher(_sensor.Imu, f'/{name}/imu', sensor_qos))
+            self._odom_pubs.append(
+                self.create_publisher(_nav.Odometry, f'/{name}/odom', sensor_qos)
+            )
+            self.create_subscription(
+                _geometry.Twist, f'/{name}/cmd_vel', self._make_cmd_callback(i), 10
+            )
+            self.create_subscription(_std.Bool, f'/{name}/pump', self._make_pump_callback(i), 10)
+        self._publish_site()
+        self._relay = self._setup_relay()
+
+        self.extensions = tuple(extensions)
+        for ext in self.extensions:
+            ext.attach(self, self.robot_names)
+
+        rtf = float(self.get_parameter('real_time_factor').value)
+        if not (math.isfinite(rtf) and rtf > 0.0):
+            msg = f'real_time_factor must be positive, got {rtf}'
+            raise ConfigurationError(msg)
+        coverage_rate = float(self.get_parameter('coverage_rate_hz').value)
+        if not coverage_rate > 0.0:
+            raise ConfigurationError('coverage_rate_hz must be positive')
+        self._coverage_every = max(1, round(self.config.physics_rate_hz / coverage_rate))
+        self._timer = self.create_timer(self.config.physics_period_s / rtf, self._on_tick)
+        self._publish_coverage()
+        self.get_logger().info(
+            f'simulating {n} robots in {geometry.name!r} '
+            f'({len(self.engine.world.walls)} walls, {self.engine.coverage.rooms_total} rooms), '
+            f'physics {self.config.physics_rate_hz:g} Hz, seed {self.config.seed}'
+        )
+
+    # Set-up helpers -------------------------------------------------------------------
+
+    def _resolve_site(self, site: Any) -> SiteGeometry:
+        if isinstance(site, SiteGeometry):
+            return site
+        if site is None:
+            path = str(self.get_parameter('site_file').value)
+            if not path:
+                raise ConfigurationError('no site given: set the site_file parameter')
+            from sim_bridge.site_loading import load_site
+
+            site = load_site(path)
+            self._site_model = site
+        return geometry_from_site(site)
+
+    def _resolve_poses(self, initial_poses: np.ndarray | None) -> np.ndarray:
+        if initial_poses is not None:
+            return np.asarray(initial_poses, dtype=float)
+        if self._site_model is None:
+            raise ConfigurationError('initial_poses are required when the site is a geometry')
+        count = int(self.get_parameter('robot_count').value)
+        name = str(self.get_parameter('departure').value)
+        point = self._site_model.departure(name)
+        bias = float(self.get_parameter('heading_bias_rad').value)
+        return departure_poses(point.xy, name, count, bias)
+
+    def _publish_site(self) -> None:
+        if self._site_model is None:
+            return
+        try:
+            from sim_bridge.sites.site_msgs import site_to_ros
+        except ImportError:
+            self.get_logger().warning('no Site message conversion available: /sim/site is off')
+            return
+        msg = site_to_ros(self._site_model)
+        self._site_pub = self.create_publisher(type(msg), '/sim/site', _LATCHED)
+        self._site_pub.publish(msg)
+
+    def _setup_relay(self) -> RelayModel | None:
+        config = RelayConfig(
+            msg_type=str(self.get_parameter('peer_msg_type').value),
+            comm_range_m=float(self.get_parameter('comm_range_m').value),
+            loss_probability=float(self.get_parameter('peer_loss_probability').value),
+        )
+        if not config.enabled:
+            return None
+        package, name = parse_message_type(config.msg_type)
+        try:
+            msg_class = getattr(message_module(package), name)
+        except (ImportError, AttributeError, LookupError) as err:
+            msg = f'unknown peer message type {config.msg_type!r}'
+            raise ConfigurationError(msg) from err
+        relay_rng = np.random.default_rng(np.random.SeedSequence([self.config.seed, 7]))
+        relay = RelayModel(config, relay_rng)
+        self._peer_in_pubs = [
+            self.create_publisher(msg_class, f'/{name}/peers/in', 10) for name in self.robot_names
+        ]
+        for i, robot in enumerate(self.robot_names):
+            self.create_subscription(
+                msg_class, f'/{robot}/peers/out', self._make_relay_callback(i), 10
+            )
+        return relay
+
+    # Callbacks --------------------------------------------------------------------------
+
+    def _make_cmd_callback(self, robot: int) -> Callable[[Any], None]:
+        def on_cmd_vel(msg: Any) -> None:
+            speed, yaw_rate = conversions.twist_from_ros(msg)
+            if not (math.isfinite(speed) and math.isfinite(yaw_rate)):
+                self.get_logger().warning(
+                    f'{self.robot_names[robot]}: non-finite cmd_vel ignored, robot stops',
+                    throttle_duration_sec=5.0,
+                )
+            self.engine.set_velocity_command(robot, speed, yaw_rate)
+
+        return on_cmd_vel
+
+    def _make_pump_callback(self, robot: int) -> Callable[[Any], None]:
+        def on_pump(msg: Any) -> None:
+            self.engine.set_pump(robot, bool(msg.data))
+
+        return on_pump
+
+    def _make_relay_callback(self, sender: int) -> Callable[[Any], None]:
+        def on_peer_out(msg: Any) -> None:
+            assert self._relay is not None
+            for receiver in self._relay.receivers(sender, self.engine.world.poses):
+                self._peer_in_pubs[int(receiver)].publish(msg)
+
+        return on_peer_out
+
+    def _on_tick(self) -> None:
+        out = self.engine.step()
+        t = out.time_s
+        self._clock_pub.publish(conversions.clock_to_ros(t))
+        names = self.robot_names
+        cfg = self.config
+        if out.scans is not None:
+            for i, name in enumerate(names):
+                msg = conversions.scan_to_ros(out.scans[i], t, f'{name}/laser', cfg.lidar)
+                self._scan_pubs[i].publish(msg)
+        if out.gas_raw is not None:
+            for i, name in enumerate(names):
+                self._gas_pubs[i].publish(
+                    conversions.gas_to_ros(int(out.gas_raw[i]), t, f'{name}/gas_sensor')
+                )
+        if out.bearings is not None:
+            for i, name in enumerate(names):
+                self._bearing_pubs[i].publish(
+                    conversions.bearings_to_ros(out.bearings[i], names, t, f'{name}/base_link')
+                )
+        if out.imu is not None:
+            yaw, rate = out.imu
+            density = cfg.imu.noise_density_radps_per_sqrt_hz
+            bias = cfg.imu.residual_bias_std_radps
+            self._yaw_variance = density**2 * t + (bias * t) ** 2
+            for i, name in enumerate(names):
+                self._imu_pubs[i].publish(
+                    conversions.imu_to_ros(
+                        float(yaw[i]), float(rate[i]), t, f'{name}/imu_link', self._yaw_variance
+                    )
+                )
+        if out.odometry is not None:
+            poses, twists = out.odometry
+            for i, name in enumerate(names):
+                self._odom_pubs[i].publish(
+                    conversions.odometry_to_ros(
+                        poses[i], twists[i], t, f'{name}/odom', f'{name}/base_link'
+                    )
+                )
+        if out.ground_truth_due:
+            self._poses_pub.publish(conversions.true_poses_to_ros(names, out.poses, t))
+        if out.new_room_entries or self.engine.step_index % self._coverage_every == 0:
+            self._publish_coverage()
+        if self.extensions:
+            states = RobotStates(names, out.poses, self.engine.world.velocities)
+            for ext in self.extensions:
+                ext.on_step(t, states)
+        for listener in self.step_listeners:
+            listener(out)
+
+    def _publish_coverage(self) -> None:
+        cov = self.engine.coverage
+        self._coverage_pub.publish(
+            conversions.coverage_to_ros(
+                cov.rooms_total, cov.entries, self.robot_names, self.engine.time_s
+            )
+        )
+
+    @property
+    def sim_time_s(self) -> float:
+        """Sim time of the last physics step [s]."""
+        return self.engine.time_s
+
+    def extensions_done(self) -> bool:
+        """True when some extension reports its mission's stop condition."""
+        return any(ext.is_done() for ext in self.extensions)
+
+
+def main(args: list[str] | None = None) -> None:
+    """Entry point of ``ros2 run sim_bridge sim_bridge``."""
+    rclpy.init(args=args)
+    node = None
+    try:
+        node = SimBridgeNode()
+        rclpy.spin(node)
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    except SimBridgeError as err:
+        if node is None:
+            rclpy.logging.get_logger('sim_bridge').error(str(err))
+        else:
+            node.get_logger().error(str(err))
+    finally:
+        if node is not None:
+            node.destroy_node()
+        rclpy.try_shutdown()
+
+
+if __name__ == '__main__':
+    main()
