@@ -34,6 +34,8 @@ setup(
     ),
     license='Apache-2.0',
     entry_points={
-        'console_scripts': [],
+        'console_scripts': [
+            'bayes_swarm_node = bayes_swarm.node:main',
+        ],
     },
 )

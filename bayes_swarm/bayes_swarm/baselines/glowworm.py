@@ -20,7 +20,7 @@ import numpy as np
 
 from bayes_swarm.settings import Arena, GlowwormConfig
 
-__all__ = ['GlowwormState', 'GlowwormSwarm', 'glowworm_step', 'select_leaders']
+__all__ = ['GlowwormAgent', 'GlowwormState', 'GlowwormSwarm', 'glowworm_step', 'select_leaders']
 
 
 @dataclass(frozen=True)
@@ -129,3 +129,57 @@ class GlowwormSwarm:
             self.state, signal, self._cfg, self._arena, self.step_m, self._rng
         )
         return self.state.positions_m
+
+
+class GlowwormAgent:
+    """GSO decisions of one robot from its own signal and its neighbours' broadcasts.
+
+    The same update as :func:`glowworm_step`, seen from one agent: peers' luciferins are the
+    latest they broadcast, so decisions are asynchronous.
+    """
+
+    def __init__(
+        self, config: GlowwormConfig, arena: Arena, velocity_mps: float, seed: int | None = None
+    ) -> None:
+        self._cfg = config
+        self._arena = arena
+        self._rng = np.random.default_rng(seed)
+        self.step_m = min(config.step_m, velocity_mps / config.decision_rate_hz)
+        self.luciferin = config.initial_luciferin
+        self.decision_range_m = config.sensor_range_m
+
+    def update_luciferin(self, signal: float) -> float:
+        """Step 1 with the latest measured signal; returns the new luciferin."""
+        cfg = self._cfg
+        self.luciferin = (1.0 - cfg.luciferin_decay) * self.luciferin + (
+            cfg.luciferin_enhancement * signal
+        )
+        return self.luciferin
+
+    def next_waypoint(
+        self, position_m: np.ndarray, peer_positions_m: np.ndarray, peer_luciferin: np.ndarray
+    ) -> np.ndarray:
+        """Steps 2-5 for this agent; returns the (2,) next position [m]."""
+        own = np.asarray(position_m, dtype=float).reshape(1, 2)
+        positions = np.vstack([own, np.asarray(peer_positions_m, dtype=float).reshape(-1, 2)])
+        luciferin = np.concatenate([[self.luciferin], np.asarray(peer_luciferin, dtype=float)])
+        ranges = np.full(positions.shape[0], self.decision_range_m)
+        leaders, counts = select_leaders(
+            positions, luciferin, ranges, self._rng, deterministic=self._cfg.deterministic
+        )
+        cfg = self._cfg
+        self.decision_range_m = min(
+            cfg.sensor_range_m,
+            max(
+                0.0,
+                self.decision_range_m + cfg.range_gain * (cfg.desired_neighbours - counts[0]),
+            ),
+        )
+        if leaders[0] < 0:
+            return own[0].copy()
+        toward = positions[leaders[0]] - own[0]
+        norm = float(np.hypot(*toward))
+        if norm <= 0.0:
+            return own[0].copy()
+        target = own[0] + self.step_m * toward / norm
+        return target if self._arena.contains(target) else own[0].copy()
