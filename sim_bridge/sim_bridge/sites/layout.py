@@ -33,6 +33,7 @@ is no entrance), heading into the building.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
 from enum import StrEnum
 from pathlib import Path
@@ -216,6 +217,7 @@ def import_layout(
     cell_m: float = CELL_M,
     name: str | None = None,
     departure_name: str = 'edge',
+    departures: Mapping[str, tuple[float, float]] | None = None,
 ) -> LayoutImport:
     """Read a ``.lay`` file and turn it into a validated site (see :func:`layout_to_site`)."""
     layout = read_layout(path)
@@ -225,6 +227,7 @@ def import_layout(
         cell_m=cell_m,
         name=name if name is not None else Path(path).stem,
         departure_name=departure_name,
+        departures=departures,
     )
 
 
@@ -235,6 +238,7 @@ def layout_to_site(
     cell_m: float = CELL_M,
     name: str | None = None,
     departure_name: str = 'edge',
+    departures: Mapping[str, tuple[float, float]] | None = None,
     seed: int | None = None,
 ) -> LayoutImport:
     """Build and validate the site a layout describes.
@@ -245,6 +249,9 @@ def layout_to_site(
         cell_m: grid spacing [m]; the paper's 4/15 m by default.
         name: site name; defaults to the layout's source.
         departure_name: name given to the ``D`` departure point of an unlabelled plan.
+        departures: explicit departure points, name -> (line, column) in the file (1-based,
+            fractional values allowed: (15.5, 30.5) lies between four characters). They
+            replace the ``D`` mark or the runner's "center"/"edge".
         seed: generator seed to record in the site, if the layout was generated.
 
     Raises:
@@ -259,13 +266,14 @@ def layout_to_site(
         mode = detect_mode(layout)
     builder = _SiteBuilder(layout, cell_m)
     entrance = builder.entrance()
+    explicit = [builder.departure_at(n, line, col) for n, (line, col) in (departures or {}).items()]
     if mode is LayoutMode.LABELLED:
         rooms, doors = builder.labelled_rooms_and_doors()
-        departures = builder.runner_departure_points(entrance)
+        points = explicit or builder.runner_departure_points(entrance)
     else:
-        departure = builder.marked_departure_point(departure_name)
-        rooms, doors = builder.rooms_behind_door_gaps(departure)
-        departures = [departure]
+        builder.check_unlabelled_characters()
+        points = explicit or [builder.marked_departure_point(departure_name)]
+        rooms, doors = builder.rooms_behind_door_gaps(points[0])
     site = Site(
         name=name if name is not None else layout.source,
         width_m=(layout.shape[1] - 1) * cell_m,
@@ -274,7 +282,7 @@ def layout_to_site(
         rooms=tuple(rooms),
         doors=tuple(doors),
         entrance=builder.entrance_door(entrance),
-        departure_points={p.name: p for p in departures},
+        departure_points={p.name: p for p in points},
         grid_m=cell_m,
         seed=seed,
     )
@@ -361,6 +369,7 @@ class _SiteBuilder:
                 )
                 raise self.error(row, col, msg)
         if len(runs) > 1:
+            runs = sorted(sorted(run) for run in runs)
             first = runs[0][0]
             row, col = runs[1][0]
             msg = (
@@ -498,9 +507,19 @@ class _SiteBuilder:
             col, heading = col - EDGE_INSET_CELLS, math.pi
         return [centre, DeparturePoint('edge', *self.xy(row, col), heading_rad=heading)]
 
+    def departure_at(self, name: str, line: float, column: float) -> DeparturePoint:
+        """A departure point given by 1-based (line, column) in the file."""
+        row, col = line - 1, column - 1
+        if not (0 <= row <= self.n_rows - 1 and 0 <= col <= self.n_cols - 1):
+            msg = (
+                f'departure point {name!r} at line {line}, column {column} lies outside the layout'
+            )
+            raise LayoutError(self.layout.source, None, None, msg)
+        return DeparturePoint(name, *self.xy(row, col))
+
     # Unlabelled plans -------------------------------------------------------------------
 
-    def marked_departure_point(self, name: str) -> DeparturePoint:
+    def check_unlabelled_characters(self) -> None:
         codes = self.codes
         inner = np.zeros_like(self.wall)
         inner[1:-1, 1:-1] = True
@@ -515,7 +534,9 @@ class _SiteBuilder:
                 "has only '%', ' ', 'D' and the entrance '/'"
             )
             raise self.error(row, col, msg)
-        marks, count = ndimage.label(codes == DEPARTURE)
+
+    def marked_departure_point(self, name: str) -> DeparturePoint:
+        marks, count = ndimage.label(self.codes == DEPARTURE)
         if count == 0:
             raise self.error(None, None, "an unlabelled plan needs a departure point marked 'D'")
         if count > 1:
@@ -536,10 +557,18 @@ class _SiteBuilder:
         free_left, free_right = free[1:-1, :-2], free[1:-1, 2:]
         wall_left, wall_right = self.wall[1:-1, :-2], self.wall[1:-1, 2:]
         wall_up, wall_down = self.wall[:-2, 1:-1], self.wall[2:, 1:-1]
-        diagonal_up = free[:-2, :-2] | free[:-2, 2:]
-        diagonal_down = free[2:, :-2] | free[2:, 2:]
-        diagonal_left = free[:-2, :-2] | free[2:, :-2]
-        diagonal_right = free[:-2, 2:] | free[2:, 2:]
+        # A diagonal neighbour widens the space beside a gap unless it is itself a gap in a
+        # wall line across it (a door of a one-cell-wide room is not room to turn in).
+        in_vertical_gap = np.zeros_like(self.wall)
+        in_vertical_gap[1:-1, :] = self.wall[:-2, :] & self.wall[2:, :]
+        in_horizontal_gap = np.zeros_like(self.wall)
+        in_horizontal_gap[:, 1:-1] = self.wall[:, :-2] & self.wall[:, 2:]
+        widens_h = free & ~in_vertical_gap  # beside a horizontal gap
+        widens_v = free & ~in_horizontal_gap  # beside a vertical gap
+        diagonal_up = widens_h[:-2, :-2] | widens_h[:-2, 2:]
+        diagonal_down = widens_h[2:, :-2] | widens_h[2:, 2:]
+        diagonal_left = widens_v[:-2, :-2] | widens_v[2:, :-2]
+        diagonal_right = widens_v[:-2, 2:] | widens_v[2:, 2:]
         centre = free[1:-1, 1:-1] & (self.codes[1:-1, 1:-1] != DEPARTURE)
         gap_h = np.zeros_like(self.wall)
         gap_v = np.zeros_like(self.wall)

@@ -148,6 +148,7 @@ def validate_site(site: Site, *, robot_radius_m: float = DEFAULT_ROBOT_RADIUS_M)
     )
     door_rooms = {room_id for door in site.doors for room_id in door.room_ids}
     for name, point in site.departure_points.items():
+        x, y = point.xy
         label = raster.label_at(point.xy)
         if label in ring:
             where = _leak_position(raster, label, site, point.xy)
@@ -158,6 +159,13 @@ def validate_site(site: Site, *, robot_radius_m: float = DEFAULT_ROBOT_RADIUS_M)
             )
             raise SiteValidationError(msg, position_m=where, key_path=('walls',))
         reached = np.argwhere(raster.labels == label)[:, ::-1]
+        free_area_m2 = len(reached) * raster.resolution_m**2
+        if free_area_m2 < math.pi * (3 * robot_radius_m) ** 2:
+            msg = (
+                f'departure point {name!r} at ({x:.3f}, {y:.3f}) m is walled in: it can reach '
+                f'only {free_area_m2:.2f} m^2 of free space'
+            )
+            raise SiteValidationError(msg, position_m=point.xy, key_path=('departure_points', name))
         reached_rooms = set(np.unique(lookup.room_ids(raster.cell_centres(reached))).tolist())
         reached_rooms.discard(NO_ROOM)
         for index, room in enumerate(site.rooms):
