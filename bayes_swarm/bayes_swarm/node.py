@@ -69,7 +69,7 @@ class BayesSwarmNode(Node):
         self._last_signal: float | None = None
         self._rejected_samples = 0
         self._decisions = 0
-        self.last_decision: Decision | None = None
+        self.decisions: list[Decision] = []
 
         self._planner: BayesSwarmPlanner | None = None
         self._levy: LevyWalk | None = None
@@ -112,6 +112,11 @@ class BayesSwarmNode(Node):
             f'{s.algorithm} robot {self.robot_name} ({s.planner.robot_index + 1} of '
             f'{s.planner.n_robots}), V {s.planner.velocity_mps:g} m/s, T {s.planner.horizon_s:g} s'
         )
+
+    @property
+    def planner(self) -> BayesSwarmPlanner | None:
+        """The Bayes-Swarm planner (None for the baselines)."""
+        return self._planner
 
     # ----------------------------------------------------------------- inputs
     def _now_s(self) -> float:
@@ -208,7 +213,7 @@ class BayesSwarmNode(Node):
             decision = Decision(waypoint, 0, DecisionKind.FIRST)
         self._decisions += 1
         self._waypoint = np.asarray(decision.waypoint_m, dtype=float)
-        self.last_decision = decision
+        self.decisions.append(decision)
         self._state_pub.publish(
             conversions.decision_to_state(self.robot_name, s.algorithm, position, decision, now)
         )

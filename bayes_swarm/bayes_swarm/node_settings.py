@@ -156,6 +156,7 @@ def settings_from_values(values: dict[str, Any]) -> NodeSettings:
             speed_mps=float(v['velocity_mps']),
             arrival_tolerance_m=float(v['arrival_tolerance_m']),
             max_turn_rate_radps=float(v['max_turn_rate_radps']),
+            slow_down_m=2.0 * float(v['velocity_mps']) / float(v['control_rate_hz']),
         ),
         control_rate_hz=float(v['control_rate_hz']),
         odom_timeout_s=float(v['odom_timeout_s']),
