@@ -1,0 +1,17 @@
+"""Exceptions raised by the msc_pf library (nodes catch them and log)."""
+
+from __future__ import annotations
+
+__all__ = ['ConfigError', 'MscPfError', 'ObservationError']
+
+
+class MscPfError(Exception):
+    """Base class of every error the msc_pf package raises."""
+
+
+class ConfigError(MscPfError, ValueError):
+    """A configuration value is out of range or inconsistent with another one."""
+
+
+class ObservationError(MscPfError, ValueError):
+    """An observation handed to the core is malformed (wrong shape, not finite)."""

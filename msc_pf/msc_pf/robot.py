@@ -1,0 +1,567 @@
+"""One robot's controller: the per-step decision of all three schemes.
+
+:class:`RobotController` is what the ROS node and the batch simulator both call once per
+control period. It takes the robot's position, this period's RSSI samples, the peer
+messages that arrived and any capture notices, and returns the displacement to make, the
+peer message to broadcast and a status record. It holds no ROS and no I/O.
+
+Order of one step (spec 1.1-1.9):
+
+1. peers, captured targets and RSSI samples are merged into the robot's memory;
+2. the particle filters fold in the robot's own samples and every neighbour's (PF schemes);
+3. swarms are formed on the first step with peers, then kept by the join/split rules;
+4. the robot selects a target (MSC evaluation value, or R * N_r after a capture in the
+   proposed scheme) and a phase, and computes its movement vector (leader: its phase's law;
+   follower: the leader's vector, its formation slot or the MSC follower update).
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from msc_pf.errors import ObservationError
+from msc_pf.mobility import (
+    avoidance_vector,
+    count_closer_heading_to,
+    direct_approach_vector,
+    evaluation_value,
+    far_field_leader_vector,
+    follower_slot,
+    msc_follower_vector,
+    msc_gradient_leader_vector,
+    msc_leader_vector,
+    rssi_gradient,
+    step_displacement,
+)
+from msc_pf.particle_filter import ParticleFilterBank, TargetEstimate
+from msc_pf.peers import NO_TARGET, PeerInfo, Phase, Role
+from msc_pf.search import HistorySearch
+from msc_pf.settings import MscPfConfig
+from msc_pf.swarm import SwarmMembership
+from msc_pf.targeting import Candidate, select_retarget
+
+__all__ = ['RobotController', 'RobotStatus', 'StepOutput']
+
+_GOAL_PHASES = (Phase.DIRECT_APPROACH,)
+_MSC_PHASES = (Phase.MSC_APPROACH, Phase.FINAL_APPROACH, Phase.WORK)
+
+
+@dataclass(frozen=True)
+class RobotStatus:
+    """What the robot reports about itself (the content of MscPfState).
+
+    Attributes:
+        robot_id: the robot's numeric ID.
+        stamp_s: time of the step [s].
+        phase: current phase.
+        role: LEADER or FOLLOWER.
+        swarm_id: the leader's ID.
+        target_id: selected target (NO_TARGET for none).
+        target_rssi_dbm: smoothed RSSI of that target (NaN when not heard) [dBm].
+        goal_m: (2,) goal of eq. (8) in phase DIRECT_APPROACH, else NaN [m].
+        estimates: current estimates of every tracked target.
+        captured_ids: targets known to be captured.
+    """
+
+    robot_id: int
+    stamp_s: float
+    phase: Phase
+    role: Role
+    swarm_id: int
+    target_id: int
+    target_rssi_dbm: float
+    goal_m: np.ndarray
+    estimates: tuple[TargetEstimate, ...]
+    captured_ids: tuple[int, ...]
+
+
+@dataclass(frozen=True)
+class StepOutput:
+    """Result of one control step.
+
+    Attributes:
+        displacement_m: (2,) displacement to make during the next period [m] (at most
+            max_speed * period).
+        movement: (2,) the movement vector before step limiting.
+        broadcast: the peer message to send.
+        status: the state record to publish.
+        events: human-readable notes worth logging (swarm changes, filter re-initialisations).
+    """
+
+    displacement_m: np.ndarray
+    movement: np.ndarray
+    broadcast: PeerInfo
+    status: RobotStatus
+    events: tuple[str, ...]
+
+
+class RobotController:
+    """Per-robot decision logic of MSC, MSC+PF and the proposed swarm control."""
+
+    def __init__(self, robot_id: int, config: MscPfConfig, seed: int) -> None:
+        """Create the controller of robot ``robot_id``; ``seed`` makes it reproducible."""
+        self.robot_id = int(robot_id)
+        self.config = config
+        pf_seed, motion_seed, search_seed = np.random.SeedSequence([seed, robot_id]).spawn(3)
+        self._rng = np.random.default_rng(motion_seed)
+        self._search = HistorySearch(
+            config.search, config.field_size_m, np.random.default_rng(search_seed)
+        )
+        self._bank: ParticleFilterBank | None = None
+        if config.scheme.uses_particle_filter:
+            self._bank = ParticleFilterBank(
+                config.particle_filter,
+                config.radio,
+                config.field_size_m,
+                np.random.default_rng(pf_seed),
+            )
+        self.membership = SwarmMembership(self.robot_id, config.swarm)
+        self._peers: dict[int, PeerInfo] = {}
+        self._rssi: dict[int, deque[float]] = {}
+        self._last_heard_s: dict[int, float] = {}
+        self._captured: set[int] = set()
+        self._samples: dict[int, deque[tuple[float, float, float, float]]] = {}
+        self._pbest: deque[tuple[np.ndarray, float]] = deque(maxlen=config.msc.pbest_window)
+        self._pbest_target = NO_TARGET
+        self._velocity = np.zeros(2)
+        self.phase = Phase.FORMING
+        self.target_id = NO_TARGET
+        self._committed = NO_TARGET
+        self._goal = np.full(2, np.nan)
+        self._start_s: float | None = None
+        self._last_step_s = -math.inf
+        self._work_since_s = 0.0
+        self._work_blocked_until_s = -math.inf
+        self._far_since_s: float | None = None
+
+    # ------------------------------------------------------------------ memory
+    @property
+    def captured_ids(self) -> frozenset[int]:
+        """Targets this robot knows to be captured."""
+        return frozenset(self._captured)
+
+    @property
+    def filters(self) -> ParticleFilterBank | None:
+        """The particle filters (None in the MSC scheme)."""
+        return self._bank
+
+    def smoothed_rssi(self, target_id: int, now_s: float) -> float | None:
+        """Moving average of the last samples of ``target_id``, None when not detected now."""
+        last = self._last_heard_s.get(target_id)
+        if last is None or now_s - last > self.config.msc.detection_memory_s:
+            return None
+        samples = self._rssi[target_id]
+        return sum(samples) / len(samples)
+
+    def _merge_peers(self, now_s: float, peers: Sequence[PeerInfo]) -> list[PeerInfo]:
+        fresh: list[PeerInfo] = []
+        for peer in sorted(peers, key=lambda p: (p.robot_id, p.stamp_s)):
+            if peer.robot_id == self.robot_id:
+                continue
+            known = self._peers.get(peer.robot_id)
+            if known is not None and peer.stamp_s <= known.stamp_s:
+                continue
+            self._peers[peer.robot_id] = peer
+            fresh.append(peer)
+        timeout = self.config.swarm.peer_timeout_s
+        for robot in [r for r, p in self._peers.items() if now_s - p.stamp_s > timeout]:
+            del self._peers[robot]
+        return fresh
+
+    def _merge_captured(self, ids: Iterable[int]) -> set[int]:
+        new = {int(t) for t in ids} - self._captured
+        for target in new:
+            self._captured.add(target)
+            self._rssi.pop(target, None)
+            self._samples.pop(target, None)
+            self._last_heard_s.pop(target, None)
+            if self._bank is not None:
+                self._bank.forget(target)
+        return new
+
+    def _in_my_swarm(self, peer: PeerInfo) -> bool:
+        leader = self.membership.leader_id
+        return peer.leader_id == leader or peer.robot_id == leader
+
+    # ------------------------------------------------------------------ step
+    def step(
+        self,
+        now_s: float,
+        position_m: Sequence[float] | np.ndarray,
+        readings: Mapping[int, float],
+        peers: Sequence[PeerInfo] = (),
+        captured_ids: Iterable[int] = (),
+    ) -> StepOutput:
+        """Run one control period.
+
+        Args:
+            now_s: current time [s]; steps must advance in time.
+            position_m: (2,) own position in the field frame [m].
+            readings: RSSI samples of this period by target ID [dBm]; non-finite values and
+                captured targets are ignored.
+            peers: peer messages received since the last step (own messages are ignored,
+                older duplicates dropped).
+            captured_ids: targets this robot learned are captured (e.g. its task finished).
+
+        Raises:
+            ObservationError: position not finite, or time not advancing.
+        """
+        position = np.asarray(position_m, dtype=np.float64)
+        if position.shape != (2,) or not np.all(np.isfinite(position)):
+            raise ObservationError(f'position must be 2 finite numbers, got {position_m!r}')
+        if not now_s > self._last_step_s:
+            raise ObservationError(f'time {now_s} s does not advance past {self._last_step_s} s')
+        self._last_step_s = now_s
+        if self._start_s is None:
+            self._start_s = now_s
+        events: list[str] = []
+
+        fresh = self._merge_peers(now_s, peers)
+        newly_captured = self._merge_captured(captured_ids)
+        for peer in fresh:
+            newly_captured |= self._merge_captured(peer.captured_ids)
+        own = {
+            int(t): float(v)
+            for t, v in readings.items()
+            if math.isfinite(v) and int(t) not in self._captured
+        }
+        for target, value in sorted(own.items()):
+            self._rssi.setdefault(target, deque(maxlen=self.config.msc.rssi_window)).append(value)
+            self._last_heard_s[target] = now_s
+
+        self._record_samples(now_s, position, own, fresh)
+        own_cell = self._search.swarm_history.cell_of(position)
+        self._search.record_swarm_visit(own_cell)
+        for peer in fresh:
+            if self._in_my_swarm(peer):
+                self._search.record_swarm_visit(peer.visited_cell)
+            else:
+                self._search.record_other_visit(peer.visited_cell)
+
+        if self._bank is not None:
+            events += self._update_filters(position, own, fresh)
+
+        if not self.membership.formed:
+            waited = now_s - self._start_s
+            if self._peers or waited >= self.config.swarm.formation_timeout_s:
+                self.membership.form(position, self._peers)
+                self.phase = Phase.SEARCH
+        if not self.membership.formed:
+            return self._finish(now_s, position, own, np.zeros(2), False, own_cell, events)
+
+        if self.target_id in newly_captured or self._committed in newly_captured:
+            self._after_capture(now_s, position, events)
+        own_target = self._own_target(now_s)
+        self._update_work(now_s, own_target)
+        change = self.membership.update(self._peers, own_target, self.phase)
+        if change:
+            events.append(change)
+
+        neighbours = np.array([p.position_m for p in self._peers.values()]).reshape(-1, 2)
+        avoidance = avoidance_vector(position, neighbours, self.config.avoidance)
+        leader = self._peers.get(self.membership.leader_id)
+        if self.phase == Phase.WORK:
+            self.target_id = own_target
+            vector, is_goal = np.zeros(2), False
+        elif self.membership.role is Role.FOLLOWER and leader is not None:
+            vector, is_goal = self._follower_vector(now_s, position, leader, avoidance)
+        else:
+            self.target_id = own_target
+            self.phase = self._leader_phase(now_s, position, own_target)
+            vector, is_goal = self._leader_vector(now_s, position, avoidance)
+        self._velocity = vector
+        return self._finish(now_s, position, own, vector, is_goal, own_cell, events)
+
+    def _record_samples(
+        self,
+        now_s: float,
+        position: np.ndarray,
+        own: Mapping[int, float],
+        fresh: Sequence[PeerInfo],
+    ) -> None:
+        """Keep every (time, x, y, RSSI) sample of the recent window, own and neighbours'."""
+        horizon = now_s - self.config.msc.pbest_window * self.config.period_s
+        batches = [(position[0], position[1], own.items())]
+        batches += [(p.position_m[0], p.position_m[1], p.readings) for p in fresh]
+        for x, y, readings in batches:
+            for target, value in readings:
+                if target in self._captured or not math.isfinite(value):
+                    continue
+                self._samples.setdefault(target, deque()).append((now_s, x, y, value))
+        for samples in self._samples.values():
+            while samples and samples[0][0] <= horizon:
+                samples.popleft()
+
+    def _gradient(self, target: int) -> np.ndarray:
+        samples = self._samples.get(target)
+        if not samples:
+            return np.zeros(2)
+        data = np.array(samples)
+        return rssi_gradient(data[:, 1:3], data[:, 3])
+
+    # ------------------------------------------------------------------ filters
+    def _update_filters(
+        self, position: np.ndarray, own: Mapping[int, float], fresh: Sequence[PeerInfo]
+    ) -> list[str]:
+        assert self._bank is not None
+        events: list[str] = []
+        batches = [(position, own)]
+        for peer in fresh:
+            batch = {t: v for t, v in peer.readings if math.isfinite(v) and t not in self._captured}
+            batches.append((np.asarray(peer.position_m, dtype=np.float64), batch))
+        for where, batch in batches:
+            if not batch or not np.all(np.isfinite(where)):
+                continue
+            ids = sorted(batch)
+            for target in self._bank.update(where, ids, [batch[t] for t in ids]):
+                events.append(f'filter of target {target} degenerated: re-initialised')
+        self._bank.end_step()
+        return events
+
+    # ------------------------------------------------------------------ targets
+    def _own_target(self, now_s: float) -> int:
+        """Target this robot would pursue by itself this step."""
+        if self._committed != NO_TARGET and self._committed not in self._captured:
+            return self._committed
+        self._committed = NO_TARGET
+        msc = self.config.msc
+        best, best_value = NO_TARGET, -math.inf
+        for target in sorted(self._last_heard_s):
+            mean = self.smoothed_rssi(target, now_s)
+            if mean is None:
+                continue
+            others = [
+                p.target_rssi_dbm
+                for p in self._peers.values()
+                if p.target_id == target and math.isfinite(p.target_rssi_dbm)
+            ]
+            n_closer = count_closer_heading_to(mean, others)
+            value = evaluation_value(
+                mean, n_closer, msc.dispersion_degree, msc.dispersion_threshold
+            )
+            if value > best_value:
+                best, best_value = target, value
+        return best
+
+    def _evaluation(self, target: int, now_s: float) -> float:
+        mean = self.smoothed_rssi(target, now_s)
+        if mean is None:
+            return math.nan
+        msc = self.config.msc
+        others = [
+            p.target_rssi_dbm
+            for p in self._peers.values()
+            if p.target_id == target and math.isfinite(p.target_rssi_dbm)
+        ]
+        n_closer = count_closer_heading_to(mean, others)
+        return evaluation_value(mean, n_closer, msc.dispersion_degree, msc.dispersion_threshold)
+
+    def _after_capture(self, now_s: float, position: np.ndarray, events: list[str]) -> None:
+        """(c-2): re-target on stored converged estimates (proposed scheme only)."""
+        captured = self.target_id
+        self._committed = NO_TARGET
+        self.target_id = NO_TARGET
+        if self.phase == Phase.WORK:
+            self.phase = Phase.SEARCH
+        if not self.config.scheme.uses_stored_estimates or self._bank is None:
+            return
+        candidates = [
+            Candidate(e.target_id, e.position_m, self.smoothed_rssi(e.target_id, now_s))
+            for e in self._bank.estimates()
+            if e.converged and e.target_id not in self._captured
+        ]
+        neighbours = np.array([p.position_m for p in self._peers.values()]).reshape(-1, 2)
+        choice = select_retarget(
+            candidates, position, neighbours, self.config.radio, self.config.phases
+        )
+        if choice is not None:
+            self._committed = choice
+            events.append(f'target {captured} captured: re-targets {choice} from its estimate')
+
+    def _update_work(self, now_s: float, own_target: int) -> None:
+        """(c-1): stop when the own target is louder than gamma3; give up after a timeout."""
+        phases = self.config.phases
+        if self.phase == Phase.WORK:
+            if own_target == NO_TARGET:
+                self.phase = Phase.SEARCH
+            elif now_s - self._work_since_s >= phases.work_timeout_s:
+                self.phase = Phase.FINAL_APPROACH
+                self._work_blocked_until_s = now_s + phases.work_block_s
+            return
+        mean = self.smoothed_rssi(own_target, now_s) if own_target != NO_TARGET else None
+        if mean is not None and mean > phases.gamma3_dbm and now_s >= self._work_blocked_until_s:
+            self.phase = Phase.WORK
+            self._work_since_s = now_s
+
+    def _leader_phase(self, now_s: float, position: np.ndarray, target: int) -> Phase:
+        if target == NO_TARGET:
+            return Phase.SEARCH
+        scheme, phases = self.config.scheme, self.config.phases
+        previous = self.phase
+        mean = self.smoothed_rssi(target, now_s)
+        hysteresis = phases.hysteresis_db
+        final_above = phases.gamma2_dbm - (
+            hysteresis if previous in (Phase.FINAL_APPROACH, Phase.WORK) else 0.0
+        )
+        if mean is not None and mean > final_above:
+            return Phase.FINAL_APPROACH
+        bank = self._bank
+        if scheme.uses_direct_approach and bank is not None and bank.is_converged(target):
+            goal = bank.estimate(target).position_m
+            near = float(np.hypot(*(goal - position))) < phases.task_area_m
+            if not (near and mean is not None):
+                self._goal = goal
+                return Phase.DIRECT_APPROACH
+        if scheme.uses_far_formation and bank is not None and bank.is_tracked(target):
+            far_below = phases.gamma1_dbm - (
+                0.0 if previous == Phase.FAR_LOCALISATION else hysteresis
+            )
+            if mean is None or mean < far_below:
+                return Phase.FAR_LOCALISATION
+        return Phase.MSC_APPROACH if mean is not None else Phase.SEARCH
+
+    # ------------------------------------------------------------------ motion
+    def _personal_best(self, now_s: float, position: np.ndarray) -> np.ndarray:
+        if self._pbest_target != self.target_id:
+            self._pbest.clear()
+            self._pbest_target = self.target_id
+        mean = self.smoothed_rssi(self.target_id, now_s)
+        if mean is not None:
+            self._pbest.append((position.copy(), mean))
+        if not self._pbest:
+            return position
+        return max(self._pbest, key=lambda item: item[1])[0]
+
+    def _leader_vector(
+        self, now_s: float, position: np.ndarray, avoidance: np.ndarray
+    ) -> tuple[np.ndarray, bool]:
+        cfg = self.config
+        alpha = cfg.search.alpha_outside
+        if self.phase == Phase.SEARCH:
+            return self._search.vector(now_s, position, avoidance), False
+        if self.phase == Phase.FAR_LOCALISATION:
+            assert self._bank is not None
+            best = self._bank.estimate(self.target_id).best_particle_m
+            return far_field_leader_vector(position, best, avoidance, alpha), False
+        if self.phase == Phase.DIRECT_APPROACH:
+            if float(np.hypot(*(self._goal - position))) < cfg.phases.task_area_m:
+                alpha = cfg.search.alpha_inside
+            return direct_approach_vector(position, self._goal, avoidance, alpha), True
+        return self._msc_leader_vector(now_s, position, avoidance), False
+
+    def _msc_leader_vector(
+        self, now_s: float, position: np.ndarray, avoidance: np.ndarray
+    ) -> np.ndarray:
+        msc = self.config.msc
+        if msc.leader_rule == 'gradient':
+            gradient = self._gradient(self.target_id)
+            return msc_gradient_leader_vector(self._velocity, gradient, avoidance, msc, self._rng)
+        pbest = self._personal_best(now_s, position)
+        return msc_leader_vector(self._velocity, position, pbest, avoidance, msc, self._rng)
+
+    def _follower_vector(
+        self, now_s: float, position: np.ndarray, leader: PeerInfo, avoidance: np.ndarray
+    ) -> tuple[np.ndarray, bool]:
+        self.phase = Phase(leader.phase) if leader.phase != Phase.FORMING else Phase.SEARCH
+        self.target_id = leader.target_id
+        leader_move = np.asarray(leader.movement, dtype=np.float64)
+        if self.phase != Phase.FAR_LOCALISATION:
+            self._far_since_s = None
+        if self.phase == Phase.SEARCH:
+            return leader_move, False
+        if self.phase == Phase.DIRECT_APPROACH:
+            return leader_move, True
+        if self.phase == Phase.FAR_LOCALISATION:
+            if self._far_since_s is None:
+                self._far_since_s = now_s
+            if now_s - self._far_since_s >= self.config.phases.slot_time_s:
+                return leader_move, False
+            slot_index = (
+                leader.members.index(self.robot_id) if self.robot_id in leader.members else 0
+            )
+            step = step_displacement(
+                leader_move, self.config.max_speed_m_s * self.config.period_s, False
+            )
+            slot = follower_slot(
+                np.asarray(leader.position_m) + step,
+                leader_move,
+                slot_index,
+                self.config.phases.follower_offset_m,
+            )
+            return slot - position, True
+        # MSC phases (and a working leader): head for the best neighbour.
+        msc = self.config.msc
+        best_position, best_value = position, self._evaluation(self.target_id, now_s)
+        for peer in sorted(self._peers.values(), key=lambda p: p.robot_id):
+            if peer.target_id != self.target_id or not math.isfinite(peer.evaluation):
+                continue
+            if not math.isfinite(best_value) or peer.evaluation > best_value:
+                best_position = np.asarray(peer.position_m, dtype=np.float64)
+                best_value = peer.evaluation
+        if best_position is position:
+            return self._msc_leader_vector(now_s, position, avoidance), False
+        pbest = self._personal_best(now_s, position)
+        return msc_follower_vector(
+            self._velocity,
+            position,
+            best_position,
+            avoidance,
+            msc,
+            self._rng,
+            personal_best_m=pbest if msc.full_pso else None,
+        ), False
+
+    # ------------------------------------------------------------------ output
+    def _finish(
+        self,
+        now_s: float,
+        position: np.ndarray,
+        own: Mapping[int, float],
+        vector: np.ndarray,
+        is_goal: bool,
+        own_cell: int,
+        events: list[str],
+    ) -> StepOutput:
+        cfg = self.config
+        max_step = cfg.max_speed_m_s * cfg.period_s
+        displacement = step_displacement(vector, max_step, is_goal)
+        target = self.target_id
+        mean = self.smoothed_rssi(target, now_s) if target != NO_TARGET else None
+        rssi = math.nan if mean is None else mean
+        evaluation = self._evaluation(target, now_s) if target != NO_TARGET else math.nan
+        role = self.membership.role
+        broadcast = PeerInfo(
+            robot_id=self.robot_id,
+            stamp_s=float(now_s),
+            position_m=(float(position[0]), float(position[1])),
+            movement=(float(vector[0]), float(vector[1])),
+            role=role,
+            leader_id=self.membership.leader_id,
+            members=self.membership.members if role is Role.LEADER else (),
+            phase=self.phase,
+            target_id=target,
+            target_rssi_dbm=rssi,
+            evaluation=evaluation,
+            readings=tuple(sorted(own.items())),
+            captured_ids=tuple(sorted(self._captured)),
+            visited_cell=own_cell,
+        )
+        goal = self._goal.copy() if self.phase == Phase.DIRECT_APPROACH else np.full(2, np.nan)
+        status = RobotStatus(
+            robot_id=self.robot_id,
+            stamp_s=float(now_s),
+            phase=self.phase,
+            role=role,
+            swarm_id=self.membership.leader_id,
+            target_id=target,
+            target_rssi_dbm=rssi,
+            goal_m=goal,
+            estimates=tuple(self._bank.estimates()) if self._bank is not None else (),
+            captured_ids=tuple(sorted(self._captured)),
+        )
+        return StepOutput(displacement, vector.copy(), broadcast, status, tuple(events))

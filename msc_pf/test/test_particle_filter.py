@@ -1,0 +1,182 @@
+"""Particle filter: convergence, its two tests at their thresholds, resampling, degeneracy."""
+
+import numpy as np
+import pytest
+from msc_pf.errors import ObservationError
+from msc_pf.particle_filter import (
+    ParticleFilterBank,
+    estimates_converged,
+    lattice,
+    systematic_counts,
+)
+from msc_pf.settings import ParticleFilterConfig, RadioConfig
+
+RADIO = RadioConfig()
+FIELD_M = 2000.0
+
+
+def make_bank(seed: int = 0, **overrides) -> ParticleFilterBank:
+    return ParticleFilterBank(
+        ParticleFilterConfig(**overrides), RADIO, FIELD_M, np.random.default_rng(seed)
+    )
+
+
+def noisy_rssi(observer: np.ndarray, target: np.ndarray, rng: np.random.Generator) -> float:
+    return RADIO.mean_rssi_dbm(float(np.hypot(*(target - observer)))) + rng.normal()
+
+
+@pytest.mark.parametrize('seed', [0, 1, 2])
+def test_filter_converges_on_static_target_from_moving_observers(seed):
+    # Three robots abreast 20 m apart (the (b-1) formation) drive past a target ~190 m away.
+    # The ring ambiguity of one RSSI sample is resolved after a few tens of metres of
+    # baseline, and eq. (7) needs a window of 10 steps: expect ~30 steps, allow 60.
+    target = np.array([1150.0, 1120.0])
+    rng = np.random.default_rng(100 + seed)
+    bank = make_bank(seed)
+    offsets = np.array([[0.0, 0.0], [0.0, 20.0], [0.0, -20.0]])
+    for step in range(1, 61):
+        for offset in offsets:
+            observer = np.array([1000.0 + step, 1000.0]) + offset
+            bank.update(observer, [3], [noisy_rssi(observer, target, rng)])
+        bank.end_step()
+        if bank.is_converged(3):
+            break
+    estimate = bank.estimate(3)
+    assert estimate.converged, f'not converged after {step} steps'
+    assert step >= bank_window()
+    assert estimate.spread_m <= 20.0
+    # 1 dB of noise is ~8 % of the range at 190 m: the estimate is good to a few tens of metres.
+    assert np.hypot(*(estimate.position_m - target)) < 50.0
+
+
+def bank_window() -> int:
+    return ParticleFilterConfig().window
+
+
+def test_convergence_needs_spread_at_most_r_conv():
+    window = np.zeros((10, 2))
+    assert estimates_converged(20.0, window, r_conv_m=20.0, r_err_m=10.0)
+    assert not estimates_converged(20.001, window, r_conv_m=20.0, r_err_m=10.0)
+
+
+def test_convergence_needs_every_recent_estimate_within_r_err_of_their_mean():
+    # Two estimates at +-d around the mean: deviation exactly d.
+    at_limit = np.array([[10.0, 0.0], [-10.0, 0.0]] * 5)
+    beyond = np.array([[10.01, 0.0], [-10.01, 0.0]] * 5)
+    assert estimates_converged(5.0, at_limit, r_conv_m=20.0, r_err_m=10.0)
+    assert not estimates_converged(5.0, beyond, r_conv_m=20.0, r_err_m=10.0)
+
+
+def test_filter_does_not_converge_before_its_window_is_full():
+    bank = make_bank()
+    target = np.array([1000.0, 1010.0])
+    rng = np.random.default_rng(5)
+    converged_at = None
+    for step in range(1, 40):
+        for dx in (-15.0, 0.0, 15.0):
+            observer = np.array([1000.0 + dx, 1000.0 + 0.5 * step])
+            bank.update(observer, [1], [noisy_rssi(observer, target, rng)])
+        bank.end_step()
+        if bank.is_converged(1) and converged_at is None:
+            converged_at = step
+    assert converged_at is not None
+    assert converged_at >= ParticleFilterConfig().window
+
+
+def test_filter_reinitialises_when_all_weights_vanish():
+    bank = make_bank()
+    bank.track(4, (300.0, 300.0))
+    far_observer = np.array([1500.0, 1500.0])
+    # -30 dBm means ~1 m away, but every particle is > 1000 m from this observer.
+    reinitialised = bank.update(far_observer, [4], [-30.0])
+    assert reinitialised == [4]
+    particles = bank.particles(4)
+    assert np.allclose(particles.mean(axis=0), far_observer, atol=1.0)
+    assert not bank.estimate(4).converged
+    assert bank.estimate(4).n_updates == 0
+
+
+def test_update_rejects_non_finite_rssi_and_keeps_the_filter():
+    bank = make_bank()
+    bank.track(1, (1000.0, 1000.0))
+    before = bank.particles(1)
+    with pytest.raises(ObservationError, match='finite'):
+        bank.update((1000.0, 1000.0), [1], [float('nan')])
+    with pytest.raises(ObservationError, match='observer'):
+        bank.update((float('inf'), 1000.0), [1], [-80.0])
+    np.testing.assert_array_equal(bank.particles(1), before)
+
+
+def test_initial_lattice_is_71_by_71_over_the_detection_square():
+    x, y = lattice(np.array([1000.0, 1000.0]), RADIO.detection_range_m, FIELD_M, 5041)
+    assert len(np.unique(x)) == 71
+    assert len(np.unique(y)) == 71
+    spacing = np.diff(np.unique(x))
+    assert np.allclose(spacing, 2 * RADIO.detection_range_m / 70, atol=1e-3)
+
+
+def test_initial_lattice_is_clipped_to_the_field():
+    x, y = lattice(np.array([10.0, 1990.0]), 292.0, FIELD_M, 5041)
+    assert x.min() == 0.0
+    assert y.max() == FIELD_M
+    assert x.max() == pytest.approx(302.0)
+    assert y.min() == pytest.approx(1698.0)
+
+
+def test_systematic_resampling_copies_in_proportion_to_weight():
+    n = 5041
+    weights = np.zeros((2, n), np.float32)
+    weights[0, [10, 20]] = (0.75, 0.25)
+    weights[1, :] = 1.0 / n
+    counts = systematic_counts(weights, np.array([[0.3], [0.999]]))
+    assert counts.sum(axis=1).tolist() == [n, n]
+    assert abs(int(counts[0, 10]) - 0.75 * n) <= 1
+    assert abs(int(counts[0, 20]) - 0.25 * n) <= 1
+    assert counts.min() >= 0
+    # Uniform weights: every particle survives once (up to float32 rounding of the sum).
+    assert np.count_nonzero(counts[1] == 1) > 0.99 * n
+
+
+def test_forgetting_a_target_leaves_the_other_filters_intact():
+    bank = make_bank()
+    for tid, where in ((1, (500.0, 500.0)), (2, (1000.0, 1000.0)), (3, (1500.0, 1500.0))):
+        bank.track(tid, where)
+    kept = {tid: bank.particles(tid) for tid in (1, 3)}
+    bank.forget(2)
+    assert bank.tracked_ids == (1, 3)
+    for tid, particles in kept.items():
+        np.testing.assert_array_equal(bank.particles(tid), particles)
+    bank.update((520.0, 480.0), [3, 1], [-95.0, -60.0])
+    assert bank.estimate(1).n_updates == 1
+    assert bank.estimate(3).n_updates == 1
+
+
+def ring_width_m(gaussian: bool) -> float:
+    bank = make_bank(gaussian_likelihood=gaussian, init_half_width_m=150.0)
+    observer = np.array([1000.0, 1000.0])
+    bank.update(observer, [1], [RADIO.mean_rssi_dbm(100.0)])
+    distances = np.hypot(*(bank.particles(1) - observer).T)
+    return float(np.std(distances))
+
+
+def test_paper_likelihood_keeps_a_thinner_ring_than_the_gaussian_flag():
+    # exp(-e^2/sigma^2) is the Gaussian with variance sigma^2/2: width ratio 1/sqrt(2).
+    paper, gaussian = ring_width_m(False), ring_width_m(True)
+    assert paper < 0.85 * gaussian
+    assert paper > 0.55 * gaussian
+
+
+def test_batched_update_gives_each_target_the_same_estimate_as_a_lone_update():
+    # The estimate comes from the pre-resampling weights, so the first update from the
+    # deterministic lattice is free of randomness and must not depend on the batch.
+    observer = np.array([1100.0, 900.0])
+    together, alone = make_bank(1), make_bank(2)
+    for bank in (together, alone):
+        bank.track(1, (1000.0, 1000.0))
+    together.track(2, (1500.0, 500.0))
+    together.track(3, (200.0, 200.0))
+    together.update(observer, [3, 1, 2], [-70.0, -80.0, -90.0])
+    alone.update(observer, [1], [-80.0])
+    a, b = together.estimate(1), alone.estimate(1)
+    np.testing.assert_allclose(a.position_m, b.position_m, atol=1e-3)
+    assert a.spread_m == pytest.approx(b.spread_m, abs=1e-3)
