@@ -8,9 +8,11 @@ the observation rate.
 
 Choices where the paper is silent or inconsistent (see docs/bayes_swarm.md):
 
-* Case 3: the text gives -24 <= x_i <= 24, but its sources lie up to 125 m out and its depots
-  at (+-120, +-120), so the arena is taken as [-120, 120]^2, which contains every source and
-  depot.
+* Case 3: the text gives -24 <= x_i <= 24, but its bumps lie up to 125 m out and its depots
+  at the arena corners (+-120, +-120), so the arena is taken as [-120, 120]^2 (the bump c6 at
+  x = 125 m lies just outside and still shapes the field). The main bump is so wide (divisor
+  6500 m^2) that the weaker bumps shift the global maximum from c1 = (55, 45) to
+  (65.52, 44.31); the source to find is that maximum, what Bayes-Swarm seeks.
 * Avalanche: the beacon lies flat (moment along world x) ``depth_m`` = 2 m below the UAVs'
   sensing plane at (20, 20); the moment is scaled so that the maximum |H| directly above the
   beacon is the paper's 47. The depot is the corner (0, 0), which gives the paper's
@@ -201,7 +203,7 @@ def _case3() -> SignalCase:
     return SignalCase(
         name='case3',
         field=_mixture(_CASE3_CENTRES, 6500.0, 1600.0),
-        source_m=np.array([55.0, 45.0]),
+        source_m=np.array([65.5195, 44.3059]),  # numerical argmax of Eq. 21
         arena_m=(-120.0, 120.0, -120.0, 120.0),
         depots_m=np.array([[-120.0, -120.0], [120.0, -120.0], [120.0, 120.0], [-120.0, 120.0]]),
         velocity_mps=1.0,
