@@ -205,6 +205,17 @@ def _check_within_bounds(site: Site) -> None:
                 position_m=(float(walls[index, 0]), float(walls[index, 1])),
                 key_path=('walls', index),
             )
+    known_rooms = set(site.room_ids)
+    doors = [('doors', i, door) for i, door in enumerate(site.doors)]
+    if site.entrance is not None:
+        doors.append(('entrance', -1, site.entrance))
+    for key, index, door in doors:
+        unknown = sorted(set(door.room_ids) - known_rooms)
+        if unknown:
+            path = (key,) if index < 0 else (key, index)
+            x, y = door.midpoint
+            msg = f'door at ({x:.3f}, {y:.3f}) m names unknown rooms {unknown}'
+            raise SiteValidationError(msg, position_m=door.midpoint, key_path=path)
     for index, room in enumerate(site.rooms):
         x0, y0, x1, y1 = room.bounding_rect
         if x0 < -tol or y0 < -tol or x1 > w + tol or y1 > h + tol:
