@@ -1,0 +1,183 @@
+"""A node that replays a bag into the running graph and drives sim time from it.
+
+Nodes under test are started with ``use_sim_time`` and a :class:`BagPlayer` is added to the
+same executor. The player publishes the recorded messages (as CDR bytes, with the recorded
+QoS) and ``/clock`` with the bag's log times, so the nodes see the recording's time: for every
+instant of the bag (messages sharing a log time) ``/clock`` is published first, then the
+messages, in the bag's order.
+
+Pacing runs on the player's own clock, which must not be sim time: each instant is scheduled
+at ``start + (log_time - bag_start) / rate``. On real ROS that is real time; the built-in
+runtime's executor jumps its virtual wall clock from one instant to the next, so a replay runs
+as fast as the callbacks allow and always the same way. :meth:`BagPlayer.step` publishes the
+next instant at once, for callers that drive the replay themselves.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Iterator
+from pathlib import Path
+from typing import Any
+
+from ..ros import Node, QoSProfile, message_module, rclpy
+from .conversions import qos_from_rosbags
+from .reader import BagMessage, read_bag_info, read_messages
+
+__all__ = ['CLOCK_TOPIC', 'BagPlayer']
+
+CLOCK_TOPIC = '/clock'
+_DEFAULT_QOS_DEPTH = 10
+
+
+class BagPlayer(Node):
+    """Publish the messages of ``bag`` and ``/clock`` from its log times.
+
+    Args:
+        bag: Bag directory (or .mcap file) to replay.
+        topics: Topic names or glob patterns to replay; None replays all (except ``/clock``,
+            which the player publishes itself when ``publish_clock`` is set).
+        rate: Playback speed factor (2.0 replays twice as fast).
+        publish_clock: Publish ``/clock`` (rosgraph_msgs/Clock) with the bag's time.
+        start_paused: Do not schedule playback; call :meth:`play` or :meth:`step`.
+        allow_truncated: Replay a damaged bag up to its damage.
+        node_name: Name of the player node.
+        **node_kwargs: Passed to ``Node`` (namespace, context ...).
+
+    Raises:
+        BagError: the bag cannot be read.
+        ValueError: ``rate`` is not positive, or the node runs on sim time.
+    """
+
+    def __init__(
+        self,
+        bag: str | Path,
+        *,
+        topics: Iterable[str] | None = None,
+        rate: float = 1.0,
+        publish_clock: bool = True,
+        start_paused: bool = False,
+        allow_truncated: bool = False,
+        node_name: str = 'bag_player',
+        **node_kwargs: Any,
+    ) -> None:
+        if rate <= 0.0:
+            msg = f'rate must be positive, got {rate}'
+            raise ValueError(msg)
+        info = read_bag_info(bag) if not allow_truncated else None
+        super().__init__(node_name, **node_kwargs)
+        if self.get_parameter('use_sim_time').value:
+            self.destroy_node()
+            msg = 'the bag player paces itself and publishes /clock: it cannot run on sim time'
+            raise ValueError(msg)
+        self._rate = rate
+        self._publish_clock = publish_clock
+        self._qos = {
+            topic: summary.offered_qos_profiles[0]
+            for topic, summary in (info.topics.items() if info is not None else ())
+            if summary.offered_qos_profiles
+        }
+        replayed = (lambda topic: topic != CLOCK_TOPIC) if publish_clock else (lambda topic: True)
+        self._messages: Iterator[BagMessage] = (
+            m
+            for m in read_messages(bag, topics, allow_truncated=allow_truncated, raw=True)
+            if replayed(m.topic)
+        )
+        self._publishers_by_topic: dict[str, Any] = {}
+        self._clock_publisher = (
+            self.create_publisher(
+                message_module('rosgraph_msgs').Clock, CLOCK_TOPIC, QoSProfile(depth=1)
+            )
+            if publish_clock
+            else None
+        )
+        self._pending: BagMessage | None = next(self._messages, None)
+        self._bag_start_ns = self._pending.log_time_ns if self._pending else 0
+        self._last_clock_ns = -1
+        self._published = 0
+        self._timer: Any = None
+        self._wall_start_ns: int | None = None
+        if not start_paused:
+            self.play()
+
+    @property
+    def finished(self) -> bool:
+        """True once every message has been published."""
+        return self._pending is None
+
+    @property
+    def published_count(self) -> int:
+        """Number of bag messages published so far (``/clock`` not counted)."""
+        return self._published
+
+    @property
+    def bag_time_ns(self) -> int:
+        """Log time of the last published instant (the bag's current time) [ns]."""
+        return max(self._last_clock_ns, 0)
+
+    def play(self) -> None:
+        """Schedule playback on the player's clock from the next pending instant."""
+        if self._pending is None or self._timer is not None:
+            return
+        now = self.get_clock().now().nanoseconds
+        self._wall_start_ns = now - int(
+            (self._pending.log_time_ns - self._bag_start_ns) / self._rate
+        )
+        self._schedule()
+
+    def pause(self) -> None:
+        """Stop scheduled playback; :meth:`play` resumes it."""
+        if self._timer is not None:
+            self.destroy_timer(self._timer)
+            self._timer = None
+
+    def step(self) -> int | None:
+        """Publish the next instant now; return its log time [ns], or None when finished."""
+        pending = self._pending
+        if pending is None:
+            return None
+        log_time = pending.log_time_ns
+        if self._clock_publisher is not None and log_time > self._last_clock_ns:
+            stamp = message_module('builtin_interfaces').Time(
+                sec=log_time // 1_000_000_000, nanosec=log_time % 1_000_000_000
+            )
+            self._clock_publisher.publish(message_module('rosgraph_msgs').Clock(clock=stamp))
+        self._last_clock_ns = max(self._last_clock_ns, log_time)
+        while pending is not None and pending.log_time_ns == log_time:
+            self._publisher_for(pending).publish(pending.message)
+            self._published += 1
+            pending = next(self._messages, None)
+        self._pending = pending
+        return log_time
+
+    def _publisher_for(self, message: BagMessage) -> Any:
+        publisher = self._publishers_by_topic.get(message.topic)
+        if publisher is None:
+            package, _, name = message.typename.split('/')
+            recorded = self._qos.get(message.topic)
+            qos = (
+                qos_from_rosbags(recorded, rclpy)
+                if recorded is not None
+                else QoSProfile(depth=_DEFAULT_QOS_DEPTH)
+            )
+            publisher = self.create_publisher(
+                getattr(message_module(package), name), message.topic, qos
+            )
+            self._publishers_by_topic[message.topic] = publisher
+        return publisher
+
+    def _schedule(self) -> None:
+        """(Re)arm the one-shot timer for the pending instant."""
+        if self._timer is not None:
+            self.destroy_timer(self._timer)
+            self._timer = None
+        if self._pending is None or self._wall_start_ns is None:
+            return
+        due = self._wall_start_ns + int(
+            (self._pending.log_time_ns - self._bag_start_ns) / self._rate
+        )
+        delay_ns = max(due - self.get_clock().now().nanoseconds, 1)
+        self._timer = self.create_timer(delay_ns / 1e9, self._on_timer)
+
+    def _on_timer(self) -> None:
+        self.step()
+        self._schedule()
