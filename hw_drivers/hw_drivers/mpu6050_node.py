@@ -1,0 +1,212 @@
+"""MPU6050 node: publishes ``imu`` (sensor_msgs/Imu, orientation = integrated yaw) and
+/diagnostics.
+
+At start the robot must stand still for ``calibration_s`` while the gyro-Z bias is measured;
+nothing is published before that (a wrong bias would make every heading wrong). If the robot
+moves during calibration, it is repeated. After a reconnect (brown-out, loose cable) the yaw
+continues from where it was.
+
+Run: ``ros2 run hw_drivers mpu6050_node --ros-args -r __ns:=/r0 -p i2c_bus:=1``.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections import deque
+from collections.abc import Callable
+from typing import Any
+
+from swarm_runtime.ros import (
+    ExternalShutdownException,
+    Node,
+    message_module,
+    qos_profile_sensor_data,
+    rclpy,
+)
+
+from hw_drivers.backoff import BackoffConfig
+from hw_drivers.conversions import imu_to_ros
+from hw_drivers.errors import ConfigurationError
+from hw_drivers.fakes.i2c import FakeMpu6050, FakeSMBus
+from hw_drivers.heading import CalibrationConfig
+from hw_drivers.i2c_transport import SMBusLike, open_smbus
+from hw_drivers.mpu6050_device import HeadingState, ImuReading, ImuSession, Mounting, Mpu6050
+from hw_drivers.mpu6050_protocol import Mpu6050Config
+from hw_drivers.node_common import (
+    DIAGNOSTICS_TOPIC,
+    DeviceMonitor,
+    DevicePoller,
+    ParamSpec,
+    declare_parameter_table,
+    publish_diagnostics,
+    seconds_clock,
+)
+from hw_drivers.worker import DeviceWorker, DiagnosticLevel
+
+__all__ = ['PARAMETERS', 'Mpu6050Node', 'main']
+
+sensor_msgs = message_module('sensor_msgs')
+diagnostic_msgs = message_module('diagnostic_msgs')
+
+PARAMETERS: list[ParamSpec] = [
+    ('i2c_bus', 1, 'I2C bus number (/dev/i2c-N)'),
+    ('i2c_address', 0x68, 'I2C address: 0x68 (AD0 low) or 0x69 (AD0 high)'),
+    ('accepted_who_am_i', [0x68], 'WHO_AM_I values accepted (genuine MPU6050: 0x68)'),
+    ('dlpf_cfg', 3, 'digital low-pass filter setting 0..6 (3: 42 Hz gyro bandwidth)'),
+    ('sample_rate_div', 9, 'SMPLRT_DIV: internal rate = 1 kHz / (1 + div) with the DLPF on'),
+    ('gyro_fs_sel', 0, 'gyro range 0..3 = +-250, 500, 1000, 2000 deg/s'),
+    ('accel_afs_sel', 0, 'accelerometer range 0..3 = +-2, 4, 8, 16 g'),
+    ('rate_hz', 100.0, 'polling and publishing rate [Hz]'),
+    ('mounting', 'z_up', 'board orientation: z_up, or z_down (upside down)'),
+    ('calibration_s', 4.0, 'still time for the gyro-Z bias calibration at start [s]'),
+    ('calibration_max_std_dps', 0.3, 'gyro-Z spread above which the robot moved [deg/s]'),
+    ('frame_id', 'imu_link', 'frame of the published messages'),
+    ('stale_timeout_s', 0.5, 'no message published for this long is reported stale [s]'),
+    ('device_thread', True, 'run the device loop in its own thread (false: from a timer)'),
+    ('fake_device', False, 'use a simulated, motionless MPU6050'),
+]
+
+
+class Mpu6050Node(Node):
+    """Publishes calibrated IMU readings with the integrated yaw on ``imu``."""
+
+    def __init__(self, **kwargs: Any) -> None:
+        super().__init__('mpu6050_node', **kwargs)
+        values = declare_parameter_table(self, PARAMETERS)
+        self._values = values
+        self._chip_config = Mpu6050Config(
+            address=int(values['i2c_address']),
+            accepted_who_am_i=tuple(int(v) for v in values['accepted_who_am_i']),
+            dlpf_cfg=int(values['dlpf_cfg']),
+            sample_rate_div=int(values['sample_rate_div']),
+            gyro_fs_sel=int(values['gyro_fs_sel']),
+            accel_afs_sel=int(values['accel_afs_sel']),
+        )
+        try:
+            self._mounting = Mounting(str(values['mounting']))
+        except ValueError as err:
+            raise ConfigurationError(f'mounting must be z_up or z_down: {err}') from err
+        self._rate_hz = float(values['rate_hz'])
+        if not self._rate_hz > 0.0:
+            raise ConfigurationError(f'rate_hz must be > 0, got {self._rate_hz}')
+        self._heading = HeadingState(
+            CalibrationConfig(
+                duration_s=float(values['calibration_s']),
+                max_std_radps=math.radians(float(values['calibration_max_std_dps'])),
+            )
+        )
+        self._frame_id = str(values['frame_id'])
+        self._threaded = bool(values['device_thread'])
+        self._device_clock: Callable[[], float] = (
+            time.monotonic if self._threaded else seconds_clock(self)
+        )
+        self._sleep: Callable[[float], None] = time.sleep if self._threaded else _no_sleep
+        self._fake_chip = (
+            FakeMpu6050(self._device_clock, noise_dps=0.02, seed=1)
+            if values['fake_device']
+            else None
+        )
+        self._readings: deque[ImuReading] = deque(maxlen=50)
+        self._session: ImuSession | None = None
+        self._imu_pub = self.create_publisher(sensor_msgs.Imu, 'imu', qos_profile_sensor_data)
+        self._diag_pub = self.create_publisher(
+            diagnostic_msgs.DiagnosticArray, DIAGNOSTICS_TOPIC, 10
+        )
+        hardware_id = f'/dev/i2c-{values["i2c_bus"]} 0x{self._chip_config.address:02X}'
+        self._monitor = DeviceMonitor(
+            f'{self.get_fully_qualified_name()}: imu',
+            'fake' if self._fake_chip else hardware_id,
+            float(values['stale_timeout_s']),
+            self.get_logger(),
+        )
+        worker = DeviceWorker(
+            'imu', self._connect, backoff=BackoffConfig(), clock=self._device_clock
+        )
+        self._poller = DevicePoller(
+            self, worker, threaded=self._threaded, poll_period_s=1.0 / self._rate_hz
+        )
+        self.create_timer(1.0 / self._rate_hz, self._publish_readings)
+        self.create_timer(1.0, self._publish_diagnostics)
+
+    def _open_bus(self) -> SMBusLike:
+        if self._fake_chip is not None:
+            return FakeSMBus({self._chip_config.address: self._fake_chip})
+        return open_smbus(int(self._values['i2c_bus']))
+
+    def _connect(self) -> ImuSession:
+        bus = self._open_bus()
+        device = Mpu6050(bus, self._chip_config, sleep=self._sleep)
+        try:
+            device.initialise()
+        except BaseException:
+            bus.close()
+            raise
+        self._session = ImuSession(
+            device,
+            self._heading,
+            self._readings.append,
+            rate_hz=self._rate_hz,
+            mounting=self._mounting,
+            sleep=self._sleep,
+            clock=self._device_clock,
+        )
+        return self._session
+
+    def _publish_readings(self) -> None:
+        while self._readings:
+            reading = self._readings.popleft()
+            now_ns = self.get_clock().now().nanoseconds
+            age_ns = round(max(self._device_clock() - reading.time_s, 0.0) * 1e9)
+            self._imu_pub.publish(
+                imu_to_ros(reading, stamp_ns=now_ns - age_ns, frame_id=self._frame_id)
+            )
+            self._monitor.mark_data(now_ns)
+
+    def _publish_diagnostics(self) -> None:
+        now_ns = self.get_clock().now().nanoseconds
+        heading = self._heading
+        note = None
+        extra = {'calibration_failures': str(heading.calibration_failures)}
+        if not heading.calibrated:
+            text = 'calibrating gyro bias: keep the robot still'
+            if heading.last_calibration_error:
+                text += f' (last attempt: {heading.last_calibration_error})'
+            note = (DiagnosticLevel.WARN, text)
+        elif heading.integrator is not None:
+            extra['gyro_z_bias_dps'] = f'{math.degrees(heading.integrator.bias_radps):.4f}'
+            extra['yaw_deg'] = f'{math.degrees(heading.integrator.yaw_rad):.2f}'
+            extra['dt_outliers'] = str(heading.integrator.dt_outliers)
+        if self._session is not None:
+            extra['read_errors'] = str(self._session.read_errors)
+            extra['saturations'] = str(self._session.saturations)
+        entry = self._monitor.entry(now_ns, self._poller.worker, extra, note=note)
+        publish_diagnostics(self._diag_pub, [entry], now_ns)
+
+    def destroy_node(self) -> None:
+        """Stop the device loop and close the bus before the node goes."""
+        self._poller.stop()
+        super().destroy_node()
+
+
+def _no_sleep(_duration_s: float) -> None:
+    """Fakes polled from a timer must not block the executor."""
+
+
+def main(args: list[str] | None = None) -> None:
+    """Entry point of ``ros2 run hw_drivers mpu6050_node``."""
+    rclpy.init(args=args)
+    node = None
+    try:
+        node = Mpu6050Node()
+        rclpy.spin(node)
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        if node is not None:
+            node.destroy_node()
+        rclpy.try_shutdown()
+
+
+if __name__ == '__main__':
+    main()

@@ -1,0 +1,211 @@
+"""RPLidar A1 driver node: publishes ``scan`` (sensor_msgs/LaserScan) and /diagnostics.
+
+The device loop (open, health, info, scan, resync, reconnect with back-off) runs in its own
+thread; a 20 Hz timer publishes the revolutions it completed. A revolution is published once,
+never repeated: when the lidar stalls or is unplugged, ``scan`` goes quiet and /diagnostics
+says why.
+
+Run: ``ros2 run hw_drivers rplidar_node --ros-args -r __ns:=/r0 -p port:=/dev/rplidar``.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections import deque
+from collections.abc import Callable
+from typing import Any
+
+from swarm_runtime.ros import (
+    ExternalShutdownException,
+    Node,
+    message_module,
+    qos_profile_sensor_data,
+    rclpy,
+)
+
+from hw_drivers.backoff import BackoffConfig
+from hw_drivers.conversions import scan_to_ros
+from hw_drivers.errors import ConfigurationError
+from hw_drivers.fakes.lidar import FakeRPLidar, FakeRPLidarPort
+from hw_drivers.node_common import (
+    DIAGNOSTICS_TOPIC,
+    DeviceMonitor,
+    DevicePoller,
+    ParamSpec,
+    declare_parameter_table,
+    publish_diagnostics,
+    seconds_clock,
+)
+from hw_drivers.rplidar_device import RPLidarConfig, RPLidarSession, connect_rplidar
+from hw_drivers.rplidar_protocol import Revolution, ScanBinning, bin_revolution
+from hw_drivers.worker import DeviceWorker
+
+__all__ = ['PARAMETERS', 'RPLidarNode', 'main']
+
+sensor_msgs = message_module('sensor_msgs')
+diagnostic_msgs = message_module('diagnostic_msgs')
+
+PARAMETERS: list[ParamSpec] = [
+    ('port', '/dev/rplidar', 'serial device of the lidar (udev symlink or /dev/serial/by-id/...)'),
+    ('baudrate', 115200, 'serial speed [baud] (A1: 115200)'),
+    ('motor_on_dtr', False, 'DTR level that runs the motor (Slamtec adapters: false)'),
+    ('frame_id', 'laser', 'frame of the published scans'),
+    ('bins', 360, 'LaserScan bins over [-pi, pi)'),
+    ('angle_direction', -1, 'ROS angle = offset + direction * device angle; -1: device is CW'),
+    ('zero_offset_rad', math.pi, 'ROS angle of the device 0 deg mark [rad]; pi = Slamtec mapping'),
+    ('range_min_m', 0.15, 'shortest valid range [m]; shorter readings become NaN'),
+    ('range_max_m', 12.0, 'longest valid range [m]; longer readings become +inf'),
+    ('stall_timeout_s', 1.0, 'no revolution for this long restarts the motor and scan [s]'),
+    ('stale_timeout_s', 1.0, 'no scan published for this long is reported stale [s]'),
+    ('publish_rate_hz', 20.0, 'rate of the timer that publishes completed revolutions [Hz]'),
+    ('device_thread', True, 'run the device loop in its own thread (false: from a timer)'),
+    ('fake_device', False, 'use a synthetic lidar in a 4 m x 3 m room instead of the port'),
+]
+
+
+def config_from_parameters(values: dict[str, Any]) -> tuple[RPLidarConfig, ScanBinning]:
+    """Validate parameter values into the device and binning configurations.
+
+    Raises:
+        ConfigurationError: a value is out of range.
+    """
+    device = RPLidarConfig(
+        port=str(values['port']),
+        baudrate=int(values['baudrate']),
+        motor_on_dtr=bool(values['motor_on_dtr']),
+        stall_timeout_s=float(values['stall_timeout_s']),
+    )
+    binning = ScanBinning(
+        bins=int(values['bins']),
+        angle_direction=int(values['angle_direction']),
+        zero_offset_rad=float(values['zero_offset_rad']),
+        range_min_m=float(values['range_min_m']),
+        range_max_m=float(values['range_max_m']),
+    )
+    for name in ('stale_timeout_s', 'publish_rate_hz'):
+        if not float(values[name]) > 0.0:
+            raise ConfigurationError(f'{name} must be > 0, got {values[name]}')
+    return device, binning
+
+
+class RPLidarNode(Node):
+    """Publishes the lidar's revolutions as LaserScan on ``scan``."""
+
+    def __init__(self, **kwargs: Any) -> None:
+        super().__init__('rplidar_node', **kwargs)
+        values = declare_parameter_table(self, PARAMETERS)
+        self._device_config, self._binning = config_from_parameters(values)
+        self._frame_id = str(values['frame_id'])
+        threaded = bool(values['device_thread'])
+        self._threaded = threaded
+        self._device_clock: Callable[[], float] = (
+            time.monotonic if threaded else seconds_clock(self)
+        )
+        self._revolutions: deque[Revolution] = deque(maxlen=2)
+        self._fake = FakeRPLidar() if values['fake_device'] else None
+        self._session: RPLidarSession | None = None
+        self._scan_pub = self.create_publisher(
+            sensor_msgs.LaserScan, 'scan', qos_profile_sensor_data
+        )
+        self._diag_pub = self.create_publisher(
+            diagnostic_msgs.DiagnosticArray, DIAGNOSTICS_TOPIC, 10
+        )
+        hardware_id = 'fake' if self._fake else self._device_config.port
+        self._monitor = DeviceMonitor(
+            f'{self.get_fully_qualified_name()}: lidar',
+            hardware_id,
+            float(values['stale_timeout_s']),
+            self.get_logger(),
+        )
+        worker = DeviceWorker(
+            'lidar', self._connect, backoff=BackoffConfig(), clock=self._device_clock
+        )
+        self._poller = DevicePoller(self, worker, threaded=threaded)
+        self.create_timer(1.0 / float(values['publish_rate_hz']), self._publish_scans)
+        self.create_timer(1.0, self._publish_diagnostics)
+
+    def _connect(self) -> RPLidarSession:
+        open_port = None
+        sleep: Callable[[float], None] = time.sleep
+        if self._fake is not None:
+            fake = self._fake
+
+            def open_port(_cfg: RPLidarConfig) -> FakeRPLidarPort:
+                return FakeRPLidarPort(fake, clock=self._device_clock)
+
+            if not self._threaded:
+                sleep = _no_sleep
+        self._session = connect_rplidar(
+            self._device_config,
+            self._revolutions.append,
+            open_port=open_port,
+            sleep=sleep,
+            clock=self._device_clock,
+        )
+        self.get_logger().info(
+            f'lidar model {self._session.info.model} firmware {self._session.info.firmware}'
+            f' hardware {self._session.info.hardware} serial {self._session.info.serial_number}'
+        )
+        return self._session
+
+    def _publish_scans(self) -> None:
+        while self._revolutions:
+            revolution = self._revolutions.popleft()
+            now_ns = self.get_clock().now().nanoseconds
+            age_s = max(self._device_clock() - revolution.start_time_s, 0.0)
+            ranges, intensities = bin_revolution(revolution, self._binning)
+            msg = scan_to_ros(
+                ranges,
+                intensities,
+                stamp_ns=now_ns - round(age_s * 1e9),
+                frame_id=self._frame_id,
+                binning=self._binning,
+                scan_time_s=revolution.period_s,
+            )
+            self._scan_pub.publish(msg)
+            self._monitor.mark_data(now_ns)
+
+    def _publish_diagnostics(self) -> None:
+        now_ns = self.get_clock().now().nanoseconds
+        extra: dict[str, str] = {}
+        session = self._session
+        if session is not None:
+            extra = {
+                'rejected_bytes': str(session.decoder.rejected_bytes),
+                'scan_restarts': str(session.scan_restarts),
+                'dropped_backlogs': str(session.dropped_backlogs),
+                'dropped_revolutions': str(session.assembler.dropped_revolutions),
+                'health': session.health.status.name,
+                'firmware': session.info.firmware,
+            }
+        entry = self._monitor.entry(now_ns, self._poller.worker, extra)
+        publish_diagnostics(self._diag_pub, [entry], now_ns)
+
+    def destroy_node(self) -> None:
+        """Stop the device loop (STOP, motor off, close) before the node goes."""
+        self._poller.stop()
+        super().destroy_node()
+
+
+def _no_sleep(_duration_s: float) -> None:
+    """Fakes polled from a timer must not block the executor."""
+
+
+def main(args: list[str] | None = None) -> None:
+    """Entry point of ``ros2 run hw_drivers rplidar_node``."""
+    rclpy.init(args=args)
+    node = None
+    try:
+        node = RPLidarNode()
+        rclpy.spin(node)
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        if node is not None:
+            node.destroy_node()
+        rclpy.try_shutdown()
+
+
+if __name__ == '__main__':
+    main()

@@ -1,0 +1,270 @@
+"""Pump safety: controller limits, fail-safe line, node behaviour, signals and exits."""
+
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+
+import pytest
+from hw_drivers.errors import ConfigurationError, FatalDeviceError
+from hw_drivers.fakes.gpio import FakePumpOutput
+from hw_drivers.pump_control import PumpController, PumpLimits
+from hw_drivers.pump_node import PumpNode
+from hw_drivers.pump_output import GpiodPumpOutput, SafePumpLine, parse_line_id
+from swarm_runtime.ros import (
+    Node,
+    Parameter,
+    SingleThreadedExecutor,
+    message_module,
+    rclpy,
+)
+from swarm_runtime.simulation import spin_until, wall_time_s
+
+std_msgs = message_module('std_msgs')
+
+
+def _run(controller, commands, until_s, step_s=0.01):
+    """Feed commands {time: level} and tick every step; return the output transitions."""
+    transitions = []
+    last = False
+    t = 0.0
+    pending = dict(commands)
+    while t <= until_s + 1e-9:
+        for when in [w for w in pending if w <= t + 1e-9]:
+            controller.command(pending.pop(when), t)
+        out = controller.update(t)
+        if out != last:
+            transitions.append((round(t, 3), out))
+            last = out
+        t += step_s
+    return transitions
+
+
+def _heartbeat(level_at, until_s, period_s=0.1):
+    """A controller republishing level_at(t) every period."""
+    return {round(k * period_s, 3): level_at(k * period_s) for k in range(int(until_s / period_s))}
+
+
+def test_commanded_pulse_passes_through():
+    controller = PumpController(PumpLimits(max_on_s=1.0, min_off_s=1.0))
+    commands = _heartbeat(lambda t: 1.0 <= t < 1.5, 3.0)
+    assert _run(controller, commands, 3.0) == [(1.0, True), (1.5, False)]
+
+
+def test_max_on_time_cuts_a_stuck_on_command_and_does_not_refire():
+    controller = PumpController(PumpLimits(max_on_s=0.5, min_off_s=0.2))
+    commands = _heartbeat(lambda t: t >= 1.0, 4.0)
+    assert _run(controller, commands, 4.0) == [(1.0, True), (1.5, False)]
+    assert controller.forced_stops == 1
+
+
+def test_a_new_pulse_after_an_off_command_is_allowed_again():
+    controller = PumpController(PumpLimits(max_on_s=0.5, min_off_s=0.2))
+    commands = _heartbeat(lambda t: t < 1.0 or t >= 1.3, 3.0)
+    assert _run(controller, commands, 3.0) == [(0.0, True), (0.5, False), (1.3, True), (1.8, False)]
+
+
+def test_min_off_time_delays_the_next_pulse():
+    controller = PumpController(PumpLimits(max_on_s=1.0, min_off_s=1.0))
+    commands = _heartbeat(lambda t: t < 0.3 or 0.5 <= t < 2.0, 3.0)
+    # Off at 0.3; the request at 0.5 has to wait until 1.3.
+    assert _run(controller, commands, 3.0) == [(0.0, True), (0.3, False), (1.3, True), (2.0, False)]
+
+
+def test_stale_commands_turn_the_pump_off():
+    controller = PumpController(PumpLimits(max_on_s=5.0, command_timeout_s=0.5))
+    commands = {0.0: True}  # the controller dies after one "on"
+    transitions = _run(controller, commands, 2.0)
+    assert [level for _, level in transitions] == [True, False]
+    assert transitions[1][0] == pytest.approx(0.5, abs=0.011)
+    assert controller.stale_stops == 1
+
+
+def test_no_command_at_all_keeps_the_pump_off():
+    assert _run(PumpController(), {}, 2.0) == []
+
+
+@pytest.mark.parametrize(
+    'kwargs', [{'max_on_s': 0.0}, {'min_off_s': -1.0}, {'command_timeout_s': 0}]
+)
+def test_impossible_limits_are_refused(kwargs):
+    with pytest.raises(ConfigurationError):
+        PumpLimits(**kwargs)
+
+
+def test_safe_line_off_never_raises_and_counts_failures():
+    output = FakePumpOutput()
+    line = SafePumpLine(output)
+    line.set(True)
+    output.fail_on_set = False
+    line.off()
+    assert line.off_failures == 1
+    line.close()
+    assert line.closed
+
+
+def test_line_ids_parse_as_offsets_or_names():
+    assert parse_line_id('17') == 17
+    assert parse_line_id(' GPIO17 ') == 'GPIO17'
+
+
+def test_missing_gpio_chip_is_a_fatal_error():
+    with pytest.raises(FatalDeviceError, match='gpiochip99'):
+        GpiodPumpOutput('/dev/gpiochip99', 17)
+
+
+@pytest.fixture
+def pump_setup():
+    rclpy.init()
+    output = FakePumpOutput(lambda: wall_time_s())
+    node = PumpNode(
+        output=output,
+        parameter_overrides=[Parameter('max_on_s', value=0.5), Parameter('min_off_s', value=0.5)],
+    )
+    controller = Node('controller')
+    pub = controller.create_publisher(std_msgs.Bool, 'pump', 10)
+    executor = SingleThreadedExecutor()
+    executor.add_node(node)
+    executor.add_node(controller)
+    yield node, output, pub, controller, executor
+    node.destroy_node()
+    controller.destroy_node()
+    rclpy.try_shutdown()
+
+
+def _publish_for(executor, controller, pub, level, duration_s, period_s=0.1):
+    """Republish a level every period for a duration (a controller's heartbeat)."""
+    start = wall_time_s()
+    timer = controller.create_timer(period_s, lambda: pub.publish(std_msgs.Bool(data=level)))
+    pub.publish(std_msgs.Bool(data=level))
+    spin_until(executor, lambda: wall_time_s() - start >= duration_s, max_wall_time_s=duration_s)
+    controller.destroy_timer(timer)
+
+
+def test_node_follows_commands_within_limits_and_fails_safe_when_they_stop(pump_setup):
+    _node, output, pub, controller, executor = pump_setup
+    _publish_for(executor, controller, pub, True, 0.3)
+    assert output.level is True
+    _publish_for(executor, controller, pub, True, 0.5)
+    assert output.level is False  # max_on_s = 0.5 cut the pulse
+    _publish_for(executor, controller, pub, False, 0.6)
+    _publish_for(executor, controller, pub, True, 0.2)
+    assert output.level is True
+    # The controller goes silent: off within command_timeout_s (0.5 s) + one tick.
+    start = wall_time_s()
+    spin_until(executor, lambda: not output.level, max_wall_time_s=2.0)
+    assert wall_time_s() - start <= 0.5 + 0.03
+    on_times = [t for t, level in output.transitions if level]
+    off_times = [t for t, level in output.transitions if not level]
+    assert all(off - on <= 0.5 + 0.03 for on, off in zip(on_times, off_times, strict=False))
+
+
+def test_destroying_the_node_turns_the_pump_off(pump_setup):
+    node, output, pub, controller, executor = pump_setup
+    _publish_for(executor, controller, pub, True, 0.2)
+    assert output.level is True
+    node.shutdown_pump()
+    assert output.level is False
+    assert output.closed
+
+
+def test_exception_in_a_callback_leaves_the_pump_off(pump_setup):
+    node, output, pub, controller, executor = pump_setup
+    _publish_for(executor, controller, pub, True, 0.2)
+    assert output.level is True
+
+    def broken(now_s):
+        raise RuntimeError('controller bug')
+
+    node._controller.update = broken
+    with pytest.raises(RuntimeError, match='controller bug'):
+        spin_until(executor, lambda: False, max_wall_time_s=0.1)
+    assert output.level is False
+
+
+def test_guard_thread_cuts_a_pulse_when_the_executor_stalls():
+    output = FakePumpOutput()
+    rclpy.init()
+    try:
+        node = PumpNode(output=output, parameter_overrides=[Parameter('max_on_s', value=0.05)])
+        node._controller.command(True, 0.0)
+        node._apply(lambda now_s: True)  # on, guard armed; then nothing runs the executor
+        assert output.level is True
+        deadline = 100
+        while output.level and deadline:
+            time.sleep(0.01)
+            deadline -= 1
+        assert output.level is False
+        assert node.guard_trips == 1
+        node._apply(lambda now_s: True)  # a stale "on" decision cannot re-fire it
+        assert output.level is False
+        node.destroy_node()
+    finally:
+        rclpy.try_shutdown()
+
+
+_CHILD = textwrap.dedent(
+    """
+    import sys, time
+    from swarm_runtime.ros import rclpy, Parameter
+    from hw_drivers.fakes.gpio import FakePumpOutput
+    from hw_drivers.pump_node import PumpNode, install_signal_handlers
+
+    class Reporting(FakePumpOutput):
+        def set(self, on):
+            super().set(on)
+            print('LEVEL', int(on), flush=True)
+
+    rclpy.init()
+    node = PumpNode(output=Reporting())
+    node._controller.command(True, node._now_s())
+    node._apply(node._controller.update)
+    mode = sys.argv[1]
+    if mode == 'signal':
+        install_signal_handlers(node.shutdown_pump)
+        try:
+            print('READY', flush=True)
+            while True:
+                time.sleep(0.01)
+        except KeyboardInterrupt:
+            print('INTERRUPTED', flush=True)
+    elif mode == 'atexit':
+        print('READY', flush=True)
+        sys.exit(3)
+    """
+)
+
+
+def _child(mode, tmp_path):
+    script = tmp_path / 'pump_child.py'
+    script.write_text(_CHILD)
+    env = {**os.environ, 'PYTHONUNBUFFERED': '1'}
+    return subprocess.Popen(
+        [sys.executable, str(script), mode], stdout=subprocess.PIPE, text=True, env=env
+    )
+
+
+@pytest.mark.parametrize('signum', [signal.SIGTERM, signal.SIGINT])
+def test_signals_turn_the_pump_off_before_the_process_exits(tmp_path, signum):
+    child = _child('signal', tmp_path)
+    lines = []
+    for line in child.stdout:
+        lines.append(line.strip())
+        if line.startswith('READY'):
+            child.send_signal(signum)
+    child.wait(10)
+    assert lines[0] == 'LEVEL 1'
+    assert 'LEVEL 0' in lines
+    assert lines.index('LEVEL 0') < lines.index('INTERRUPTED')
+
+
+def test_atexit_turns_the_pump_off_on_an_unplanned_exit(tmp_path):
+    child = _child('atexit', tmp_path)
+    out, _ = child.communicate(timeout=10)
+    assert child.returncode == 3
+    lines = out.splitlines()
+    assert lines[:2] == ['LEVEL 1', 'READY']
+    assert lines[2:]
+    assert set(lines[2:]) == {'LEVEL 0'}
