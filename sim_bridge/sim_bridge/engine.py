@@ -69,7 +69,7 @@ class EngineConfig:
     physics_rate_hz: float = 20.0
     cmd_vel_timeout_s: float = 0.5
     pump_timeout_s: float = 1.0
-    pump_offset_m: float = 0.1
+    pump_offset_m: float = 0.12
     ground_truth_rate_hz: float = 2.0
     seed: int = 0
     body: BodyConfig = field(default_factory=BodyConfig)

@@ -13,6 +13,7 @@ docs/simulation.md for the measurement).
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -167,6 +168,38 @@ def _expand_intervals(starts: np.ndarray, counts: np.ndarray) -> tuple[np.ndarra
     return owner, np.repeat(starts, counts) + offsets
 
 
+@dataclass(frozen=True)
+class _Pairs:
+    """(robot, wall face) pairs of one scan and the bins each face covers."""
+
+    robot: np.ndarray
+    normal: np.ndarray
+    face_m: np.ndarray
+    first: np.ndarray
+    counts: np.ndarray
+    distance_m: np.ndarray
+
+    @classmethod
+    def empty(cls) -> _Pairs:
+        z = np.zeros(0)
+        zi = np.zeros(0, dtype=int)
+        return cls(zi, np.zeros((0, 2)), z, zi, zi, z)
+
+    @property
+    def size(self) -> int:
+        return len(self.robot)
+
+    def select(self, mask: np.ndarray) -> _Pairs:
+        return _Pairs(
+            self.robot[mask],
+            self.normal[mask],
+            self.face_m[mask],
+            self.first[mask],
+            self.counts[mask],
+            self.distance_m[mask],
+        )
+
+
 class RayCaster:
     """360-degree planar range caster against thick wall segments and other robots' discs.
 
@@ -182,6 +215,7 @@ class RayCaster:
         wall_thickness_m: float,
         robot_radius_m: float,
         num_bins: int,
+        near_range_m: float = 2.0,
     ) -> None:
         """Prepare the caster.
 
@@ -190,6 +224,8 @@ class RayCaster:
             wall_thickness_m: full wall thickness [m]; rays stop at the wall's face.
             robot_radius_m: radius of every robot disc [m].
             num_bins: number of equally spaced rays per revolution.
+            near_range_m: faces closer than this are cast first; farther faces are skipped
+                where the near ones already hide them (a speed-up only: results are exact).
         """
         if num_bins < 4:
             msg = f'num_bins must be at least 4, got {num_bins}'
@@ -215,10 +251,23 @@ class RayCaster:
                 cap_normal = np.column_stack([cap_ab[:, 1], -cap_ab[:, 0]])
                 outward = np.concatenate([-direction, direction])
                 self._cap_outward = np.sign(np.einsum('ij,ij->i', cap_normal, outward))
-        self._segments = segments
-        self._caps = caps
+                # An end face buried in another wall (corner, T-junction) is never hit.
+                centre_ends = np.concatenate([segments[:, 0], segments[:, 1]]) + np.concatenate(
+                    [direction, -direction]
+                ) * (half * 1.5)
+                owner = np.concatenate([np.arange(len(segments)), np.arange(len(segments))])
+                reach = point_segment_distance(centre_ends, segments)
+                reach[np.arange(len(owner)), owner] = np.inf
+                exposed = reach.min(axis=1) > half
+                caps = caps[exposed]
+                self._cap_outward = self._cap_outward[exposed]
         if len(caps) == 0:
             self._cap_outward = np.zeros(0)
+        self._all_segments = np.concatenate([segments, caps]) if len(caps) else segments
+        self._all_half = np.concatenate([np.full(len(segments), half), np.zeros(len(caps))])
+        self._all_outward = np.concatenate([np.zeros(len(segments)), self._cap_outward])
+        self.near_range_m = near_range_m
+        self._sector_bins = max(1, num_bins // 36)
         self._half_thickness_m = half
         self._robot_radius_m = float(robot_radius_m)
         self.num_bins = int(num_bins)
@@ -267,74 +316,94 @@ class RayCaster:
         yaw = poses[:, 2]
         theta = (yaw[:, None] + self._bin_offsets_rad[None, :]).ravel()
         ray_dir = (np.cos(theta), np.sin(theta))
-        self._scan_segments(
-            self._segments, self._half_thickness_m, None, origin, yaw, ray_dir, max_range_m, best
-        )
-        self._scan_segments(
-            self._caps, 0.0, self._cap_outward, origin, yaw, ray_dir, max_range_m, best
-        )
+        pairs = self._segment_pairs(origin, yaw, max_range_m)
+        near = pairs.distance_m <= self.near_range_m
+        self._fill(pairs.select(near), ray_dir, best)
         if n > 1:
             self._scan_discs(origin, yaw, ray_dir, max_range_m, best)
+        far = pairs.select(~near)
+        if far.size:
+            self._fill(far.select(self._may_be_visible(far, best)), ray_dir, best)
         best[best > max_range_m] = np.inf
         return best.reshape(n, nb)
 
-    def _scan_segments(
-        self,
-        segs: np.ndarray,
-        half_thickness_m: float,
-        outward: np.ndarray | None,
-        origin: np.ndarray,
-        yaw: np.ndarray,
-        ray_dir: tuple[np.ndarray, np.ndarray],
-        max_range_m: float,
-        best: np.ndarray,
-    ) -> None:
-        """Lower ``best`` (flat N * num_bins ranges) with the hits on ``segs``' near faces.
-
-        ``outward`` (one sign per segment) marks one-sided segments (the walls' end faces):
-        only robots on that side see them.
-        """
+    def _segment_pairs(self, origin: np.ndarray, yaw: np.ndarray, max_range_m: float) -> _Pairs:
+        """Every (robot, segment face) pair within range, with the face's bin interval."""
+        segs = self._all_segments
         if len(segs) == 0:
-            return
+            return _Pairs.empty()
         dist = point_segment_distance(origin, segs)
-        near = dist <= max_range_m + half_thickness_m
-        if outward is not None:
-            # An end face is seen only from in front of it: cull the pairs where it faces away.
-            a = segs[:, 0]
-            ab = segs[:, 1] - a
-            facing = np.column_stack([ab[:, 1], -ab[:, 0]])
-            rel = origin[:, None, :] - a[None, :, :]
-            side = rel[..., 0] * facing[None, :, 0] + rel[..., 1] * facing[None, :, 1]
-            near &= side * outward[None, :] > 0.0
-        robot_idx, wall_idx = np.nonzero(near)
+        near = dist <= max_range_m + self._all_half
+        # An end face is seen only from in front of it: cull the pairs where it faces away.
+        one_sided = self._all_outward != 0.0
+        a = segs[:, 0]
+        ab = segs[:, 1] - a
+        rel_x = origin[:, 0, None] - a[None, :, 0]
+        rel_y = origin[:, 1, None] - a[None, :, 1]
+        side = rel_x * ab[None, :, 1] - rel_y * ab[None, :, 0]
+        near &= ~one_sided[None, :] | (side * self._all_outward[None, :] > 0.0)
+        robot_idx, seg_idx = np.nonzero(near)
         if len(robot_idx) == 0:
-            return
+            return _Pairs.empty()
+        half = self._all_half[seg_idx]
         o = origin[robot_idx]
-        a = segs[wall_idx, 0] - o
-        b = segs[wall_idx, 1] - o
+        a = segs[seg_idx, 0] - o
+        b = segs[seg_idx, 1] - o
         ab = b - a
         normal = np.column_stack([ab[:, 1], -ab[:, 0]])
         normal /= np.linalg.norm(normal, axis=1)[:, None]
         offset = np.einsum('ij,ij->i', a, normal)
         # Orient each normal from the robot towards the wall's centre line.
-        flip = offset < 0.0
-        normal[flip] *= -1.0
-        offset = np.abs(offset)
-        face = np.maximum(offset - half_thickness_m, 1e-6)
+        normal[offset < 0.0] *= -1.0
+        face = np.maximum(np.abs(offset) - half, 1e-6)
         # The angular interval is the one of the face nearest to the robot.
-        a_face = a - half_thickness_m * normal
-        b_face = b - half_thickness_m * normal
+        a_face = a - half[:, None] * normal
+        b_face = b - half[:, None] * normal
         first, counts = self._arc_bins(
             yaw[robot_idx],
             np.arctan2(a_face[:, 1], a_face[:, 0]),
             np.arctan2(b_face[:, 1], b_face[:, 0]),
         )
-        owner, k = _expand_intervals(first, counts)
+        keep = counts > 0
+        return _Pairs(
+            robot=robot_idx[keep],
+            normal=normal[keep],
+            face_m=face[keep],
+            first=first[keep] % self.num_bins,
+            counts=counts[keep],
+            distance_m=np.maximum(dist[robot_idx, seg_idx] - half, 0.0)[keep],
+        )
+
+    def _may_be_visible(self, pairs: _Pairs, best: np.ndarray) -> np.ndarray:
+        """Conservative occlusion test: False where every bin of the face's interval is
+        already closer than the face can be (checked on sectors of bins)."""
+        nb = self.num_bins
+        width = self._sector_bins
+        sectors = -(-nb // width)
+        padded = np.full((len(best) // nb, sectors * width), np.inf)
+        padded[:, :nb] = best.reshape(-1, nb)
+        sector_max = padded.reshape(len(padded), sectors, width).max(axis=2)
+        s0 = pairs.first // width
+        s1 = (pairs.first + pairs.counts - 1) // width
+        owner, s = _expand_intervals(s0, s1 - s0 + 1)
+        values = sector_max[pairs.robot[owner], s % sectors]
+        starts = np.cumsum(s1 - s0 + 1) - (s1 - s0 + 1)
+        farthest = np.maximum.reduceat(values, starts)
+        return farthest >= pairs.distance_m
+
+    def _fill(
+        self, pairs: _Pairs, ray_dir: tuple[np.ndarray, np.ndarray], best: np.ndarray
+    ) -> None:
+        """Lower ``best`` (flat N * num_bins ranges) with the hits on the pairs' faces."""
+        if pairs.size == 0:
+            return
+        owner, k = _expand_intervals(pairs.first, pairs.counts)
         k %= self.num_bins
-        flat = robot_idx[owner] * self.num_bins + k
-        along = ray_dir[0][flat] * normal[owner, 0] + ray_dir[1][flat] * normal[owner, 1]
+        flat = pairs.robot[owner] * self.num_bins + k
+        normal = pairs.normal[owner]
+        along = ray_dir[0][flat] * normal[:, 0] + ray_dir[1][flat] * normal[:, 1]
         with np.errstate(divide='ignore'):
-            ranges = np.where(along > 1e-9, face[owner] / along, np.inf)
+            ranges = np.where(along > 1e-9, pairs.face_m[owner] / along, np.inf)
         np.minimum.at(best, flat, ranges)
 
     def _scan_discs(

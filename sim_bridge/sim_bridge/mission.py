@@ -233,13 +233,14 @@ def _spin_until(executor: Any, predicate: Callable[[], bool]) -> None:
 
 
 def _make_recorder(recording: RecordingSpec) -> Any:
+    """A bag recorder on sim time; built last, so it discovers every topic at once."""
     try:
-        from swarm_runtime.bag import BagRecorderNode
+        from swarm_runtime.bag import BagRecorder
     except ImportError as err:
-        msg = 'bag recording needs swarm_runtime.bag, which is not available'
+        msg = f'bag recording needs swarm_runtime.bag: {err}'
         raise MissionError(msg) from err
     topics = list(recording.topics) if recording.topics is not None else None
-    return BagRecorderNode(str(recording.path), topics=topics)
+    return BagRecorder(recording.path, topics=topics, use_sim_time=True)
 
 
 def run_mission(

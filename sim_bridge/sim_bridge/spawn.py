@@ -153,7 +153,7 @@ def _oabug_factory() -> Callable[..., object]:
     try:
         from oabug_robot.node import OABugNode
     except ImportError as err:
-        msg = 'the OA-Bug node (package oabug_robot) is not installed'
+        msg = f'the OA-Bug node (package oabug_robot) cannot be imported: {err}'
         raise SimBridgeError(msg) from err
     return OABugNode
 
@@ -211,7 +211,7 @@ def write_figures(result: MissionResult, out_dir: Path, stem: str) -> tuple[Path
     )
     paths = plot_site_paths(
         out_dir / f'{stem}_paths.png',
-        walls=np.asarray(site.walls),
+        walls=np.asarray(site.sealed_walls),
         room_rects=[room.rects for room in site.rooms],
         robot_names=result.robot_names,
         trajectories=result.trajectories[:, :, :2],

@@ -77,6 +77,15 @@ class World:
         self._velocities = np.zeros((len(poses), 2))
         self._wall_clearance_m = self.body.robot_radius_m + 0.5 * self.body.wall_thickness_m
         self.collision_count = np.zeros(len(poses), dtype=int)
+        self._clearance_cache: np.ndarray | None = None
+
+    def _wall_clearance(self) -> np.ndarray:
+        """(N,) distance [m] from each robot centre to the nearest wall centre line."""
+        if self._clearance_cache is None:
+            self._clearance_cache = point_segment_distance(self._poses[:, :2], self.walls).min(
+                axis=1
+            )
+        return self._clearance_cache
 
     @property
     def num_robots(self) -> int:
@@ -128,22 +137,29 @@ class World:
         allowed = moves.copy()
         if len(self.walls) and moves.any():
             new_clear = point_segment_distance(cand_xy, self.walls).min(axis=1)
-            old_clear = point_segment_distance(old_xy, self.walls).min(axis=1)
+            old_clear = self._wall_clearance()
             blocked = (new_clear < self._wall_clearance_m) & (new_clear < old_clear)
             allowed &= ~blocked
         final_xy = old_xy.copy()
         contact = 2.0 * self.body.robot_radius_m
-        for i in np.flatnonzero(allowed):
+        # Only robots that may touch another after this step need the sequential check.
+        gap = np.hypot(*(cand_xy[:, None, :] - old_xy[None, :, :]).transpose(2, 0, 1))
+        step_len = np.hypot(dx, dy)
+        np.fill_diagonal(gap, np.inf)
+        close = (gap < contact + step_len.max() + 1e-9).any(axis=1)
+        quiet = allowed & ~close
+        final_xy[quiet] = cand_xy[quiet]
+        for i in np.flatnonzero(allowed & close):
             others = np.delete(final_xy, i, axis=0)
-            if len(others):
-                new_d = np.hypot(*(others - cand_xy[i]).T).min()
-                old_d = np.hypot(*(others - old_xy[i]).T).min()
-                if new_d < contact and new_d < old_d:
-                    allowed[i] = False
-                    continue
+            new_d = np.hypot(*(others - cand_xy[i]).T).min()
+            old_d = np.hypot(*(others - old_xy[i]).T).min()
+            if new_d < contact and new_d < old_d:
+                allowed[i] = False
+                continue
             final_xy[i] = cand_xy[i]
         self.collision_count += (moves & ~allowed).astype(int)
         self._poses[:, :2] = final_xy
         self._poses[:, 2] = wrap_angle(new_yaw)
+        self._clearance_cache = None
         achieved_v = np.where(allowed, v, 0.0)
         self._velocities = np.column_stack([achieved_v, w])

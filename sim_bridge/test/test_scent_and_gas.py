@@ -22,7 +22,7 @@ def test_clean_air_reads_below_the_paper_background():
 
 def test_sensor_rises_slowly_and_falls_more_slowly():
     sensor = Mp503Model(1, QUIET, np.random.default_rng(0))
-    exposure = np.array([500.0])
+    exposure = np.array([1000.0])
     rise = [int(sensor.update(exposure, 0.1)[0]) for _ in range(100)]
     fall = [int(sensor.update(np.zeros(1), 0.1)[0]) for _ in range(600)]
     assert rise[0] < THRESHOLD  # not instantaneous
@@ -71,7 +71,7 @@ def pumping_robot_readings(speed_mps: float, duration_s: float, field: ScentFiel
         t = step * dt
         x = speed_mps * t
         pump_on = math.fmod(t, 5.0) < 0.5
-        depositor.step(np.array([pump_on]), np.array([[x - 0.1, 0.0]]), t, dt)
+        depositor.step(np.array([pump_on]), np.array([[x - 0.12, 0.0]]), t, dt)
         if step % 2 == 0:
             c = field.concentration(np.array([[x + 0.08, 0.0]]), t)
             readings.append(int(sensor.update(c, 0.1)[0]))

@@ -11,7 +11,7 @@ followed by a saturating transfer to counts on the paper's scale and Gaussian no
     raw = clip(round(baseline + (RAW_MAX - baseline) x / (x + half_response_ppm) + noise))
 
 With the defaults, clean air reads about 60 (the paper: background below 100) and the
-paper's threshold 200 corresponds to about 34 ppm of sensed ethanol.
+paper's threshold 200 corresponds to about 68 ppm of sensed ethanol.
 """
 
 from __future__ import annotations
@@ -46,7 +46,7 @@ class GasSensorConfig:
     rise_time_constant_s: float = 3.0
     fall_time_constant_s: float = 10.0
     baseline_raw: float = 60.0
-    half_response_ppm: float = 200.0
+    half_response_ppm: float = 400.0
     noise_std_raw: float = 4.0
     sensor_offset_m: float = 0.08
 

@@ -43,10 +43,10 @@ class ScentConfig:
         walls_block: when True, vapour does not cross walls.
     """
 
-    deposit_rate_ppm_m2_per_s: float = 250.0
+    deposit_rate_ppm_m2_per_s: float = 100.0
     deposit_period_s: float = 0.25
-    initial_spread_m: float = 0.05
-    final_spread_m: float = 0.35
+    initial_spread_m: float = 0.08
+    final_spread_m: float = 0.15
     spread_time_constant_s: float = 10.0
     decay_time_constant_s: float = 1800.0
     cutoff_sigmas: float = 3.0
