@@ -32,8 +32,8 @@ import numpy as np
 
 from oabug_robot.corners import CornerDetector
 from oabug_robot.heading import angle_difference, preferred_direction, wrap_angle
-from oabug_robot.motion import Twist2D, follow_wall, go_straight, turn_in_place
-from oabug_robot.pump import PumpSchedule
+from oabug_robot.motion import Twist2D, follow_wall, go_straight, turn_in_place, wrap_corner
+from oabug_robot.pump import PumpScheduler
 from oabug_robot.scan_features import ScanFeatures
 from oabug_robot.settings import OABugConfig, SoundMemory, SoundTurnRule, TurnDirection, Variant
 from oabug_robot.sound import PeerBearings, opposite_direction
@@ -57,6 +57,7 @@ class Mode(Enum):
     TURN = 0  # rotating in place to target_yaw_rad, then STRAIGHT
     STRAIGHT = 1  # driving along target_yaw_rad
     FOLLOW = 2  # following the wall on wall_side
+    WRAP = 3  # arcing 90 deg round the end of the wall on wall_side, then FOLLOW
 
 
 class Event(Enum):
@@ -113,6 +114,7 @@ class FsmMemory:
     wall_side: int = 0  # +1 wall on the left, -1 on the right, 0 none
     preferred_direction_rad: float = 0.0
     target_yaw_rad: float = 0.0
+    wrap_start_yaw_rad: float = 0.0
     leave_at_next_corner: bool = False
     visit_count: int = 0
     flip_count: int = 0
@@ -130,7 +132,9 @@ class OABugFsm:
     def __init__(self, config: OABugConfig) -> None:
         self._config = config
         self._rng = np.random.default_rng(config.seed)
-        self._pump = PumpSchedule(config.pump_on_s, config.pump_period_s)
+        self._pump = PumpScheduler(
+            config.pump_on_s, config.pump_period_s, config.pump_min_speed_mps
+        )
         self._corners = CornerDetector()
         phi = preferred_direction(
             config.robot_index, config.robot_count, config.departure, config.heading_bias_rad
@@ -173,7 +177,9 @@ class OABugFsm:
             twist = self._step_random(snapshot, min(max(dt, 0.0), _MAX_STEP_S))
         else:
             twist = self._step_bug(snapshot)
-        pump = self._config.variant.uses_scent and self._pump.is_on(snapshot.time_s - mem.started_s)
+        pump = self._config.variant.uses_scent and self._pump.update(
+            snapshot.time_s, twist.linear_mps
+        )
         return Command(float(twist.linear_mps), float(twist.angular_radps), bool(pump))
 
     # Bug variants ---------------------------------------------------------------------------
@@ -189,19 +195,26 @@ class OABugFsm:
             if abs(error) > cfg.motion.heading_tolerance_rad:
                 return turn_in_place(error, cfg.motion)
             mem.mode = Mode.STRAIGHT
+        front_blocked = scan.front_wall_m <= cfg.perception.wall_hit_distance_m
         if mem.mode is Mode.STRAIGHT:
-            if scan.front_wall_m > cfg.perception.wall_hit_distance_m:
+            if not front_blocked:
                 error = angle_difference(mem.target_yaw_rad, snap.yaw_rad)
                 return go_straight(error, cfg.motion)
             self._on_hit_wall(snap)
-        elif self._corners.update(
-            snap.time_s, snap.yaw_rad, mem.wall_side, scan.side(mem.wall_side)
-        ):
+        elif mem.mode is Mode.WRAP:
+            turned = mem.wall_side * angle_difference(snap.yaw_rad, mem.wrap_start_yaw_rad)
+            wrap_blocked = scan.front_wall_m <= cfg.perception.wrap_stop_distance_m
+            if wrap_blocked or turned >= math.pi / 2 - cfg.motion.heading_tolerance_rad:
+                mem.mode = Mode.FOLLOW
+            else:
+                return wrap_corner(mem.wall_side, cfg.motion)
+        elif self._corners.update(scan.side(mem.wall_side)):
             self._on_outer_corner(snap)
             if mem.mode is Mode.TURN:
                 error = angle_difference(mem.target_yaw_rad, snap.yaw_rad)
                 return turn_in_place(error, cfg.motion)
-        front_blocked = scan.front_wall_m <= cfg.perception.wall_hit_distance_m
+            if mem.mode is Mode.WRAP:
+                return wrap_corner(mem.wall_side, cfg.motion)
         return follow_wall(mem.wall_side, scan.side(mem.wall_side), front_blocked, cfg.motion)
 
     def _on_hit_robot(self, snap: SensorSnapshot) -> None:
@@ -257,11 +270,13 @@ class OABugFsm:
                 mem.last_scent_s = -math.inf
                 mem.visit_count += 1
                 mem.state = FsmState.JUST_STARTED
+                self._wrap(snap)
                 mem.leave_at_next_corner = True
                 self._record(Event.REVISIT)
             else:
                 if cfg.visit_count_resets_on_fresh_corner:
                     mem.visit_count = 0
+                self._wrap(snap)
                 self._record(Event.OUTER_CORNER)
             return
         # Just Started, still on the wall after a revisit: leave now.
@@ -279,6 +294,13 @@ class OABugFsm:
                 if cfg.sound_memory is SoundMemory.STORED:
                     mem.preferred_direction_rad = theta
         self._leave_wall(heading, Event.LEAVE_WALL)
+
+    def _wrap(self, snap: SensorSnapshot) -> None:
+        """Keep following: arc round the end of the wall."""
+        mem = self._memory
+        mem.mode = Mode.WRAP
+        mem.wrap_start_yaw_rad = snap.yaw_rad
+        self._corners.reset()
 
     def _leave_wall(self, heading_rad: float, event: Event) -> None:
         mem = self._memory

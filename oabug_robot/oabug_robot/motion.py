@@ -12,7 +12,7 @@ from oabug_robot.heading import angle_difference
 from oabug_robot.scan_features import SideWall
 from oabug_robot.settings import MotionConfig
 
-__all__ = ['STOP', 'Twist2D', 'follow_wall', 'go_straight', 'turn_in_place']
+__all__ = ['STOP', 'Twist2D', 'follow_wall', 'go_straight', 'turn_in_place', 'wrap_corner']
 
 
 @dataclass(frozen=True)
@@ -80,3 +80,9 @@ def follow_wall(side: int, wall: SideWall, front_blocked: bool, cfg: MotionConfi
     )
     fraction = max(_MIN_FOLLOW_FRACTION, math.cos(min(abs(angle_error), math.pi / 2)))
     return Twist2D(cfg.forward_speed_mps * fraction, _clamp(rate, cfg.turn_rate_radps))
+
+
+def wrap_corner(side: int, cfg: MotionConfig) -> Twist2D:
+    """Arc towards ``side`` at the wall distance: round the end of the wall just passed."""
+    rate = min(cfg.turn_rate_radps, cfg.forward_speed_mps / cfg.wall_distance_m)
+    return Twist2D(rate * cfg.wall_distance_m, side * rate)

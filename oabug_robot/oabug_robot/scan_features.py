@@ -50,15 +50,19 @@ class LaserScanData:
 
 @dataclass(frozen=True)
 class SideWall:
-    """The nearest wall return on one side of the robot.
+    """The wall on one side of the robot.
 
     Attributes:
-        distance_m: range of that return [m]; inf when there is none within capture range.
+        distance_m: range of the nearest wall return [m]; inf when there is none within
+            capture range.
         bearing_rad: its direction in the robot frame [rad]; NaN when there is none.
+        abeam: a wall return lies beside the robot's body (the abeam strip), i.e. the robot
+            has not yet passed the end of the wall on this side.
     """
 
     distance_m: float = math.inf
     bearing_rad: float = math.nan
+    abeam: bool = False
 
     @property
     def found(self) -> bool:
@@ -74,8 +78,9 @@ class ScanFeatures:
         front_wall_m: forward distance [m] to the nearest wall return inside the corridor the
             robot sweeps; inf when the corridor is clear up to the feature range.
         front_robot_m: range [m] of the nearest peer return inside the front cone; inf if none.
-        left: nearest wall return on the left half-plane (slightly past the centre line).
-        right: nearest wall return on the right half-plane.
+        left: nearest wall return on the left, abeam or behind (not ahead: a wall ahead
+            across a door gap must not pull the follower past the door).
+        right: the same on the right.
         near_returns: number of rays that hit something within the feature range.
         peer_returns: number of those attributed to peers.
     """
@@ -128,13 +133,18 @@ class ScanFeatureExtractor:
         return self._table
 
     def extract(
-        self, scan: LaserScanData, peer_azimuths_rad: np.ndarray = _NO_ANGLES
+        self,
+        scan: LaserScanData,
+        peer_azimuths_rad: np.ndarray = _NO_ANGLES,
+        peer_distances_m: np.ndarray | None = None,
     ) -> ScanFeatures:
         """Return the features of ``scan``.
 
         Args:
             scan: the scan; its ranges may contain NaN and +-inf.
             peer_azimuths_rad: (B,) bearings of the peers heard, robot frame [rad].
+            peer_distances_m: (B,) their coarse distances [m], NaN where unknown; None when
+                no distance is known at all.
 
         Raises:
             ScanError: the scan has no rays or its angles are not finite.
@@ -162,7 +172,13 @@ class ScanFeatureExtractor:
         y = r * rays.sin[index]
 
         azimuths = np.asarray(peer_azimuths_rad, dtype=float)
-        is_peer = self._peer_mask(r, rays.angles_rad[index], azimuths) if azimuths.size else None
+        is_peer = None
+        if azimuths.size:
+            if peer_distances_m is None:
+                distances = np.full(azimuths.size, math.nan)
+            else:
+                distances = np.asarray(peer_distances_m, dtype=float)
+            is_peer = self._peer_mask(r, rays.angles_rad[index], azimuths, distances)
         front = (x > 0.0) & (np.abs(y) <= cfg.front_half_width_m)
         captured = r <= cfg.follow_capture_m
         front_robot = math.inf
@@ -177,8 +193,10 @@ class ScanFeatureExtractor:
                 front &= is_wall
                 captured &= is_wall
         front_wall = float(x[front].min()) if front.any() else math.inf
-        left = self._nearest(r, index, rays, captured & (y >= -cfg.side_overlap_m))
-        right = self._nearest(r, index, rays, captured & (y <= cfg.side_overlap_m))
+        captured &= x <= cfg.side_lookahead_m
+        strip = captured & (x >= -cfg.abeam_behind_m) & (np.abs(y) <= cfg.abeam_reach_m)
+        left = self._nearest(r, index, rays, captured & (y >= -cfg.side_overlap_m), strip & (y > 0))
+        right = self._nearest(r, index, rays, captured & (y <= cfg.side_overlap_m), strip & (y < 0))
         return ScanFeatures(
             front_wall_m=front_wall,
             front_robot_m=front_robot,
@@ -188,24 +206,32 @@ class ScanFeatureExtractor:
             peer_returns=peer_returns,
         )
 
-    def _peer_mask(self, r: np.ndarray, angles: np.ndarray, azimuths: np.ndarray) -> np.ndarray:
+    def _peer_mask(
+        self, r: np.ndarray, angles: np.ndarray, azimuths: np.ndarray, distances: np.ndarray
+    ) -> np.ndarray:
         """Return a (K,) mask of the returns that belong to the peers at ``azimuths``.
 
         Each return is compared with the bearing closest to it in angle only (peers rarely
-        overlap in azimuth), which keeps the cost independent of the number of peers.
+        overlap in azimuth), which keeps the cost independent of the number of peers. A
+        bearing whose coarse distance is far beyond the nearest return in its window is a
+        peer heard through a wall: the wall stays a wall.
 
         Args:
             r: (K,) ranges of the returns [m].
             angles: (K,) their directions in the robot frame, in [-pi, pi) [rad].
             azimuths: (B,) peer bearings [rad]; NaN entries are skipped.
+            distances: (B,) peer distances [m]; NaN where unknown.
         """
         cfg = self._config
         is_peer = np.zeros(r.size, dtype=bool)
-        azimuths = azimuths[np.isfinite(azimuths)]
+        known = np.isfinite(azimuths)
         near = np.flatnonzero(r <= cfg.peer_mask_range_m)
-        if azimuths.size == 0 or near.size == 0:
+        if not known.any() or near.size == 0:
             return is_peer
-        bearings = np.sort(np.arctan2(np.sin(azimuths), np.cos(azimuths)))
+        wrapped = np.arctan2(np.sin(azimuths[known]), np.cos(azimuths[known]))
+        order = np.argsort(wrapped)
+        bearings = wrapped[order]
+        bearing_distances = distances[known][order]
         r_near = r[near]
         a_near = angles[near]
         after = np.searchsorted(bearings, a_near) % bearings.size
@@ -222,12 +248,23 @@ class ScanFeatureExtractor:
             return is_peer
         nearest = np.full(bearings.size, math.inf)
         np.minimum.at(nearest, which[window], r_near[window])
-        is_peer[near] = window & (r_near <= nearest[which] + 2.0 * cfg.robot_radius_m)
+        with np.errstate(invalid='ignore'):
+            heard_through_wall = bearing_distances > cfg.peer_distance_factor * (
+                nearest + cfg.robot_radius_m
+            )
+        body = r_near <= nearest[which] + 2.0 * cfg.robot_radius_m
+        is_peer[near] = window & body & ~heard_through_wall[which]
         return is_peer
 
     @staticmethod
-    def _nearest(r: np.ndarray, index: np.ndarray, rays: _RayTable, mask: np.ndarray) -> SideWall:
+    def _nearest(
+        r: np.ndarray, index: np.ndarray, rays: _RayTable, mask: np.ndarray, strip: np.ndarray
+    ) -> SideWall:
         if not mask.any():
             return SideWall()
         best = int(np.argmin(np.where(mask, r, math.inf)))
-        return SideWall(distance_m=float(r[best]), bearing_rad=float(rays.angles_rad[index[best]]))
+        return SideWall(
+            distance_m=float(r[best]),
+            bearing_rad=float(rays.angles_rad[index[best]]),
+            abeam=bool(strip.any()),
+        )

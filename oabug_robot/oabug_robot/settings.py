@@ -117,6 +117,9 @@ class PerceptionConfig:
         robot_radius_m: radius of the own body (and of the peers' bodies) [m].
         front_half_width_m: half width of the corridor ahead checked for walls [m].
         wall_hit_distance_m: a wall return this close ahead (from the lidar origin) is a hit [m].
+        wrap_stop_distance_m: while arcing round a wall end into a door, only a wall this
+            close ahead stops the arc (the far jamb of a 0.5 m door is nearer than
+            wall_hit_distance_m) [m].
         robot_hit_distance_m: a peer return this close inside the front cone is a hit [m].
         robot_cone_half_angle_rad: half angle of the cone in which peers count as hit [rad]
             (the authors' robot: 30 deg).
@@ -124,24 +127,41 @@ class PerceptionConfig:
             lidar returns [rad]; added to the angle the peer's body spans.
         peer_mask_range_m: returns farther than this are never attributed to a peer [m]; a
             peer beyond it cannot touch any feature the controller uses.
+        peer_bearing_max_distance_m: a bearing whose reported distance exceeds this is not
+            used to mask lidar returns (the RSSI distance is coarse, so this is generous) [m].
+        peer_distance_factor: a bearing whose coarse distance exceeds this many times the
+            distance of the peer-like returns in its direction is a peer behind a wall, and
+            those returns stay wall.
         feature_range_m: returns farther than this (or than the capture and hit distances,
             whichever is largest) are ignored [m].
         follow_capture_m: a side return farther than this does not count as the followed wall [m].
         side_overlap_m: how far past the centre line a return may lie and still count for a
-            side (lets a wall ahead pull the follower round an inner corner) [m].
+            side [m].
+        side_lookahead_m: side returns farther ahead than this do not count for the followed
+            wall, so the jamb across a door gap cannot pull the robot past the door (it wraps
+            round the near jamb into the room instead); walls ahead are the front check's [m].
+        abeam_behind_m: the abeam strip reaches this far behind the lidar (the body's trailing
+            edge): the robot has passed a wall's end once no return lies in the strip [m].
+        abeam_reach_m: lateral extent of the abeam strip [m].
         lidar_yaw_offset_rad: yaw of the lidar's zero ray in the robot frame [rad].
     """
 
-    robot_radius_m: float = 0.12
-    front_half_width_m: float = 0.14
+    robot_radius_m: float = 0.1
+    front_half_width_m: float = 0.12
     wall_hit_distance_m: float = 0.28
+    wrap_stop_distance_m: float = 0.18
     robot_hit_distance_m: float = 0.40
     robot_cone_half_angle_rad: float = math.radians(30.0)
     peer_bearing_tolerance_rad: float = math.radians(10.0)
     peer_mask_range_m: float = 1.0
+    peer_bearing_max_distance_m: float = 2.0
+    peer_distance_factor: float = 2.0
     feature_range_m: float = 1.0
     follow_capture_m: float = 0.8
     side_overlap_m: float = 0.05
+    side_lookahead_m: float = 0.05
+    abeam_behind_m: float = 0.1
+    abeam_reach_m: float = 0.45
     lidar_yaw_offset_rad: float = 0.0
 
     def __post_init__(self) -> None:
@@ -154,6 +174,10 @@ class PerceptionConfig:
         _require(
             self.wall_hit_distance_m > self.robot_radius_m,
             'wall_hit_distance_m must exceed robot_radius_m',
+        )
+        _require(
+            self.wrap_stop_distance_m > self.robot_radius_m,
+            'wrap_stop_distance_m must exceed robot_radius_m',
         )
         _require(
             self.robot_cone_half_angle_rad < math.pi / 2,
@@ -231,6 +255,8 @@ class OABugConfig:
             corners (paper, Table I); False leaves it at phi_i (the authors' simulator).
         pump_on_s: pump burst length (paper: 0.5 s).
         pump_period_s: time between burst starts (paper: every 5 s).
+        pump_min_speed_mps: a burst starts only at this forward speed or faster, so the robot
+            does not sit in its own puff (see oabug_robot.pump); 0 pumps on the clock [m/s].
         bearing_timeout_s: bearings older than this are not used [s].
         seed: seed of the Random variant's generator.
         perception: lidar and bearing interpretation.
@@ -253,6 +279,7 @@ class OABugConfig:
     sound_updates_at_corner: bool = True
     pump_on_s: float = 0.5
     pump_period_s: float = 5.0
+    pump_min_speed_mps: float = 0.2
     bearing_timeout_s: float = 1.0
     seed: int = 0
     perception: PerceptionConfig = field(default_factory=PerceptionConfig)
@@ -280,5 +307,9 @@ class OABugConfig:
         _require(
             math.isfinite(self.pump_on_s) and 0.0 <= self.pump_on_s <= self.pump_period_s,
             f'pump_on_s must be in [0, pump_period_s], got {self.pump_on_s}',
+        )
+        _require(
+            math.isfinite(self.pump_min_speed_mps) and self.pump_min_speed_mps >= 0.0,
+            'pump_min_speed_mps must be >= 0',
         )
         _require(self.seed >= 0, 'seed must be >= 0')

@@ -40,6 +40,18 @@ class PeerBearings:
         """Return (B,) bearings [rad] in the robot frame at yaw ``yaw_rad`` (rotation only)."""
         return self.azimuths_rad + (self.yaw_at_stamp_rad - yaw_rad)
 
+    def near_peers_now(
+        self, yaw_rad: float, max_distance_m: float
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Bearings [rad] at yaw ``yaw_rad`` and distances [m] of the peers that may be near.
+
+        A peer whose (coarse) distance is known and larger than ``max_distance_m`` is left
+        out; one whose distance is unknown (NaN) is kept.
+        """
+        with np.errstate(invalid='ignore'):
+            near = ~(self.distances_m > max_distance_m)
+        return self.azimuths_now(yaw_rad)[near], self.distances_m[near]
+
 
 def opposite_direction(
     azimuths_rad: np.ndarray, distances_m: np.ndarray, weighting: SoundWeighting

@@ -34,8 +34,8 @@ def robot_ahead() -> ScanFeatures:
     return ScanFeatures(front_robot_m=0.3)
 
 
-def side_wall(side: int, bearing_deg: float = 90.0) -> ScanFeatures:
-    wall = SideWall(0.25, side * math.radians(bearing_deg))
+def side_wall(side: int, bearing_deg: float = 90.0, abeam: bool = True) -> ScanFeatures:
+    wall = SideWall(0.25, side * math.radians(bearing_deg), abeam=abeam)
     return ScanFeatures(left=wall) if side > 0 else ScanFeatures(right=wall)
 
 
@@ -77,9 +77,13 @@ class Script:
         for _ in range(steps):
             self.step(side_wall(side))
 
+    def finish_wrap(self, side: int) -> None:
+        """The robot has arced 90 deg round the wall end and has the wall abeam again."""
+        self.step(side_wall(side), yaw_rad=self.yaw_rad + side * math.pi / 2)
+
     def pass_outer_corner(self, side: int):
-        """The nearest wall return swings past abeam towards the rear: the wall has ended."""
-        return self.step(side_wall(side, bearing_deg=90.0 + 50.0))
+        """The wall is behind the body now: nothing abeam any more, the wall has ended."""
+        return self.step(side_wall(side, bearing_deg=90.0 + 50.0, abeam=False))
 
 
 def make(variant: Variant, **overrides) -> OABugFsm:
@@ -218,7 +222,7 @@ def test_gas_variants_keep_following_round_an_unscented_outer_corner(variant: Va
     script.pass_outer_corner(1)
     assert fsm.memory.event is Event.OUTER_CORNER
     assert fsm.memory.state is FsmState.FOLLOWING_WALL
-    assert fsm.memory.mode is Mode.FOLLOW
+    assert fsm.memory.mode is Mode.WRAP, 'it arcs round the wall end (into the room)'
 
 
 @pytest.mark.parametrize('variant', [Variant.GAS, Variant.GAS_SOUND])
@@ -236,10 +240,13 @@ def test_scented_outer_corner_switches_to_just_started_and_leaves_at_the_next_on
     assert fsm.memory.event is Event.REVISIT
     assert fsm.memory.visit_count == 1
     assert fsm.memory.state is FsmState.JUST_STARTED
-    assert fsm.memory.mode is Mode.FOLLOW, 'it keeps following up to the next outer corner'
+    assert fsm.memory.mode is Mode.WRAP, 'it keeps following up to the next outer corner'
     assert command.linear_mps > 0.0
+    assert command.angular_radps > 0.0, 'arcing left, round the end of the wall on the left'
+    script.step(side_wall(1), yaw_rad=math.pi / 2)
     script.follow_straight(1)
     assert fsm.memory.mode is Mode.FOLLOW
+    assert fsm.memory.state is FsmState.JUST_STARTED
     script.pass_outer_corner(1)
     assert fsm.memory.event is Event.LEAVE_WALL
     assert fsm.memory.mode is Mode.TURN
@@ -276,6 +283,7 @@ def revisit_and_leave(script: Script) -> None:
     script.gas_raw = 400
     script.pass_outer_corner(1)
     script.gas_raw = 0
+    script.finish_wrap(1)
     script.follow_straight(1, steps=25)
     script.pass_outer_corner(1)
     script.step(free(), yaw_rad=script.fsm.memory.target_yaw_rad)
@@ -296,6 +304,7 @@ def test_third_revisit_flips_the_preferred_direction_by_180_degrees(variant: Var
     script.pass_outer_corner(1)
     assert fsm.memory.visit_count == 3
     script.gas_raw = 0
+    script.finish_wrap(1)
     script.follow_straight(1, steps=25)
     script.pass_outer_corner(1)
     assert fsm.memory.event is Event.FLIP
@@ -425,10 +434,11 @@ def test_gas_sound_leaves_a_revisited_wall_towards_the_sound_direction(
     script.gas_raw = 300
     script.pass_outer_corner(1)
     script.gas_raw = 0
+    script.finish_wrap(1)
     script.follow_straight(1, steps=25)
-    script.hear([90.0], [2.0])  # peer on the left: theta_opp to the right of the heading
+    script.hear([0.0], [2.0])  # peer straight ahead: theta_opp behind
+    expected = script.yaw_rad + math.pi
     script.pass_outer_corner(1)
-    expected = phi - math.pi / 2
     assert angle_difference(fsm.memory.target_yaw_rad, expected) == pytest.approx(0.0, abs=1e-9)
     changed = abs(angle_difference(fsm.memory.preferred_direction_rad, phi)) > 1e-6
     assert changed is stored

@@ -12,7 +12,7 @@ from oabug_robot.heading import (
     wrap_angle,
     yaw_from_quaternion,
 )
-from oabug_robot.pump import PumpSchedule
+from oabug_robot.pump import PumpScheduler
 from oabug_robot.settings import Departure, SoundWeighting
 from oabug_robot.sound import PeerBearings, opposite_direction
 
@@ -95,16 +95,35 @@ def test_bearings_rotate_back_when_the_robot_turns() -> None:
     assert bearings.azimuths_now(0.7) == pytest.approx([0.0])
 
 
-def test_pump_schedule_bursts_at_the_start_of_every_period() -> None:
-    pump = PumpSchedule(on_s=0.5, period_s=5.0)
-    assert [pump.is_on(t) for t in (0.0, 0.49, 0.5, 4.99, 5.0, 5.3, 10.6)] == [
+def test_pump_bursts_half_a_second_every_five_seconds_while_driving() -> None:
+    pump = PumpScheduler(on_s=0.5, period_s=5.0, min_speed_mps=0.2)
+    times = [k * 0.1 for k in range(120)]
+    on = [pump.update(t, 0.3) for t in times]
+    starts = [
+        t for t, now, before in zip(times, on, [False, *on[:-1]], strict=True) if now and not before
+    ]
+    assert starts == pytest.approx([0.0, 5.0, 10.0])
+    assert sum(on) == 15
+
+
+def test_pump_waits_for_the_robot_to_drive_before_a_burst() -> None:
+    pump = PumpScheduler(on_s=0.5, period_s=5.0, min_speed_mps=0.2)
+    assert not pump.update(0.0, 0.0), 'turning on the spot: no puff under the own sensor'
+    assert not pump.update(1.0, 0.1)
+    assert pump.update(2.0, 0.3)
+    assert pump.update(2.4, 0.0), 'a started burst runs its length'
+    assert not pump.update(2.5, 0.3)
+    assert not pump.update(6.9, 0.3)
+    assert pump.update(7.0, 0.3)
+
+
+def test_pump_with_zero_minimum_speed_follows_the_plain_clock() -> None:
+    pump = PumpScheduler(on_s=0.5, period_s=5.0, min_speed_mps=0.0)
+    assert [pump.update(t, 0.0) for t in (0.0, 0.4, 0.6, 5.0, 5.6)] == [
         True,
         True,
         False,
-        False,
-        True,
         True,
         False,
     ]
-    assert not pump.is_on(-1.0)
-    assert not pump.is_on(math.nan)
+    assert not pump.update(math.nan, 0.3)
