@@ -69,15 +69,16 @@ def spin_until(
     """
     executor = _builtin_executor(executor)
     context = executor.context
+    if predicate():
+        return True
+    if not context.ok() or executor._is_shutdown:
+        return False
     limit_ns = None
     if max_wall_time_s is not None:
         limit_ns = context._elapsed_ns + round(max_wall_time_s * 1e9)
-    while not predicate():
-        if not context.ok() or executor._is_shutdown:
-            return False
-        if not executor._run_one(limit_ns):
-            return predicate()
-    return True
+
+    executor._run_callbacks(limit_ns, stop=predicate)
+    return predicate()
 
 
 def spin_ready(executor: Executor) -> int:
@@ -88,10 +89,9 @@ def spin_ready(executor: Executor) -> int:
     """
     executor = _builtin_executor(executor)
     context = executor.context
-    count = 0
-    while context.ok() and not executor._is_shutdown and executor._run_one(context._elapsed_ns):
-        count += 1
-    return count
+    if not context.ok() or executor._is_shutdown:
+        return 0
+    return executor._run_callbacks(context._elapsed_ns)
 
 
 def spin_until_time(

@@ -311,13 +311,23 @@ class ROSClock(Clock):
 
     def _set_ros_ns(self, nanoseconds: int) -> None:
         """Set the ROS time; hand the timers that fell due to their executors."""
+        if self._jump_handles or nanoseconds < self._ros_ns or not self._ros_active:
+            self._set_ros_ns_with_jumps(nanoseconds)
+            return
+        self._ros_ns = nanoseconds
+        heap = self._timer_heap
+        while heap and heap[0][0] <= nanoseconds:
+            _, _, gen, timer = heapq.heappop(heap)
+            if gen == timer._gen:
+                timer._notify_ready()
+
+    def _set_ros_ns_with_jumps(self, nanoseconds: int) -> None:
+        """The general case: jump callbacks, backward jumps, inactive ROS time."""
         if not self._ros_active:
             self._ros_ns = nanoseconds
             return
         delta_ns = nanoseconds - self._ros_ns
-        handles = self._jump_handles
-        if handles:
-            self._call_jump_callbacks(ClockChange.ROS_TIME_NO_CHANGE, delta_ns, pre=True)
+        self._call_jump_callbacks(ClockChange.ROS_TIME_NO_CHANGE, delta_ns, pre=True)
         self._ros_ns = nanoseconds
         if delta_ns < 0:
             for timer in list(self._timers):
@@ -327,5 +337,4 @@ class ROSClock(Clock):
             _, _, gen, timer = heapq.heappop(heap)
             if gen == timer._gen:
                 timer._notify_ready()
-        if handles:
-            self._call_jump_callbacks(ClockChange.ROS_TIME_NO_CHANGE, delta_ns, pre=False)
+        self._call_jump_callbacks(ClockChange.ROS_TIME_NO_CHANGE, delta_ns, pre=False)

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import heapq
 from collections import deque
+from collections.abc import Callable
 from operator import itemgetter
 from typing import TYPE_CHECKING, Any
 
@@ -143,8 +144,8 @@ class Executor:
 
     def spin(self) -> None:
         """Run callbacks until the context or the executor is shut down."""
-        while self._context._ok and not self._is_shutdown:
-            self.spin_once()
+        if not self._is_shutdown and self._context._ok:
+            self._run_callbacks(None)
 
     def spin_once(self, timeout_sec: float | None = None) -> None:
         """Run one callback, advancing virtual time by at most ``timeout_sec`` to find one.
@@ -160,61 +161,79 @@ class Executor:
         if not context._ok:
             raise ExternalShutdownException()
         if timeout_sec is None or timeout_sec < 0:
-            self._run_one(None)
+            self._run_callbacks(None, max_callbacks=1)
         else:
-            self._run_one(context._elapsed_ns + int(timeout_sec * 1e9))
+            self._run_callbacks(context._elapsed_ns + int(timeout_sec * 1e9), max_callbacks=1)
 
     def spin_until_future_complete(self, future: Future, timeout_sec: float | None = None) -> None:
         """Spin until ``future`` is done, the timeout (virtual time) expires or shutdown."""
         context = self._context
-        if timeout_sec is None or timeout_sec < 0:
-            while context._ok and not self._is_shutdown and not future.done():
-                self.spin_once()
+        if self._is_shutdown or not context._ok or future.done():
             return
-        end_ns = context._elapsed_ns + int(timeout_sec * 1e9)
-        while context._ok and not self._is_shutdown and not future.done():
-            remaining_ns = end_ns - context._elapsed_ns
-            if remaining_ns <= 0:
-                return
-            self.spin_once(timeout_sec=remaining_ns / 1e9)
+        limit_ns = None
+        if timeout_sec is not None and timeout_sec >= 0:
+            limit_ns = context._elapsed_ns + int(timeout_sec * 1e9)
+        self._run_callbacks(limit_ns, stop=future.done)
 
     def spin_once_until_future_complete(
         self, future: Future, timeout_sec: float | None = None
     ) -> None:
-        """Run one callback (like :meth:`spin_once`); the future is not otherwise special."""
+        """Run one callback (like :meth:`spin_once`) unless ``future`` is done already."""
         if not future.done():
             self.spin_once(timeout_sec)
 
     # The core loop.
 
-    def _has_ready_work(self) -> bool:
-        """True if a callback could run now without advancing the virtual wall clock."""
-        for seq, subscription in self._inbox:
-            queue = subscription._queue
-            if queue and queue[0][0] == seq and subscription._owner is self:
-                return True
-        return any(gen == timer._gen and timer._owner is self for _, _, gen, timer in self._ready)
+    def _run_callbacks(
+        self,
+        limit_ns: int | None,
+        *,
+        stop: Callable[[], bool] | None = None,
+        max_callbacks: int | None = None,
+    ) -> int:
+        """Run callbacks in order until ``stop()`` (checked after each), ``max_callbacks``,
+        shutdown, or nothing is left to run before the virtual wall clock reaches ``limit_ns``.
 
-    def _run_one(self, limit_ns: int | None) -> bool:
-        """Run one callback; False if none ran before the virtual wall clock reached limit."""
+        Returns:
+            How many callbacks ran.
+
+        Raises:
+            ExecutorStalledError: ``limit_ns`` is None and nothing can ever run.
+        """
         inbox = self._inbox
         ready = self._ready
+        context = self._context
+        heappop = heapq.heappop
+        count = 0
         while True:
+            ran = False
             while inbox:
                 seq, subscription = inbox.popleft()
                 queue = subscription._queue
                 if queue and queue[0][0] == seq and subscription._owner is self:
-                    subscription._deliver(queue.popleft())
-                    return True
-            while ready:
-                _, _, gen, timer = heapq.heappop(ready)
-                if gen == timer._gen and timer._owner is self:
-                    timer._advance()
-                    if timer.callback is not None:
-                        timer.callback()
-                    return True
-            if not self._advance_wall_clock(limit_ns):
-                return False
+                    entry = queue.popleft()
+                    data = entry[1]
+                    if subscription._plain and type(data) is not bytes:
+                        subscription._callback(data)
+                    else:
+                        subscription._deliver(entry)
+                    ran = True
+                    break
+            if not ran:
+                while ready:
+                    _, _, gen, timer = heappop(ready)
+                    if gen == timer._gen and timer._owner is self:
+                        timer._call()
+                        ran = True
+                        break
+            if ran:
+                count += 1
+                if count == max_callbacks or not context._ok or self._is_shutdown:
+                    return count
+                if stop is not None and stop():
+                    return count
+            elif not self._advance_wall_clock(limit_ns):
+                return count
 
     def _advance_wall_clock(self, limit_ns: int | None) -> bool:
         """Jump to the next wall-timer deadline (not past ``limit_ns``); False if none."""

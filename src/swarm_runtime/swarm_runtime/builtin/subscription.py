@@ -72,6 +72,7 @@ class Subscription:
         self.qos_profile = qos_profile
         self.raw = raw
         self.event_handlers: list[Any] = []
+        self._with_info = False
         self._event_callbacks = event_callbacks
         self.callback = callback
         self._node = subscription_impl.node
@@ -117,11 +118,16 @@ class Subscription:
             self._callback = value
             self._callback_type = callback_type
             self._with_info = callback_type is Subscription.CallbackType.WithMessageInfo
+            self._update_plain()
             return
         raise RuntimeError(
             'Subscription.__init__(): callback should be either be callable with one argument'
             '(to get only the message) or two (to get message and message info)'
         )
+
+    def _update_plain(self) -> None:
+        """Whether a delivered message object goes straight to ``callback(msg)``."""
+        self._plain = not self._with_info and not getattr(self, 'raw', False)
 
     def _set_effective_qos(self, qos: QoSProfile) -> None:
         self._effective_qos = qos

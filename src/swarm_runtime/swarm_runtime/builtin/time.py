@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from functools import cache
 from typing import Any
 
 from ._messages import interface_class
@@ -10,6 +11,12 @@ from .constants import S_TO_NS
 from .duration import Duration
 
 __all__ = ['Time']
+
+
+@cache
+def _time_msg_class() -> type:
+    return interface_class('builtin_interfaces', 'Time')
+
 
 _LIMIT = 2**63
 
@@ -135,11 +142,11 @@ class Time:
     def to_msg(self) -> Any:
         """Return the time as a ``builtin_interfaces.msg.Time``."""
         sec, nanosec = divmod(self._nanoseconds, S_TO_NS)
-        return interface_class('builtin_interfaces', 'Time')(sec=sec, nanosec=nanosec)
+        return _time_msg_class()(sec=sec, nanosec=nanosec)
 
     @classmethod
     def from_msg(cls, msg: Any, clock_type: ClockType = ClockType.ROS_TIME) -> Time:
         """Build a Time from a ``builtin_interfaces.msg.Time`` (ROS time by default)."""
-        if not isinstance(msg, interface_class('builtin_interfaces', 'Time')):
+        if not isinstance(msg, _time_msg_class()):
             raise TypeError('Must pass a builtin_interfaces.msg.Time object')
         return cls(seconds=msg.sec, nanoseconds=msg.nanosec, clock_type=clock_type)

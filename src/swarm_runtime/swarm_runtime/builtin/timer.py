@@ -160,9 +160,14 @@ class Timer:
         if owner is not None:
             heapq.heappush(owner._ready, (self._next_call_ns, self._seq, self._gen, self))
 
-    def _advance(self) -> None:
-        """Record a call at the clock's current time and move to the next deadline (rcl)."""
-        now = self._clock._now_ns()
+    def _call(self) -> None:
+        """Run the timer: move to the next deadline as rcl_timer_call does, then the callback.
+
+        The next deadline moves on by one period; if that is still in the past, it skips to
+        the first deadline of the same grid after now (missed periods are not replayed).
+        """
+        clock = self._clock
+        now = clock._now_ns()
         period = self._period_ns
         self._last_call_ns = now
         next_call = self._next_call_ns + period
@@ -173,7 +178,11 @@ class Timer:
                 behind = now - next_call
                 next_call += (1 + (behind - 1) // period) * period
         self._next_call_ns = next_call
-        self._reschedule()
+        self._gen += 1
+        if not self._canceled:
+            clock._schedule_timer(self)
+        if self.callback is not None:
+            self.callback()
 
     def _before_clock_change(self, now_ns: int) -> None:
         """ROS time is about to be switched on or off: remember the time left (rcl).
