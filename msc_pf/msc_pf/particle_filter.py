@@ -280,6 +280,24 @@ class ParticleFilterBank:
         self._n_updates[slot] = 0
 
     # ----------------------------------------------------------------- update
+    def _validate(
+        self,
+        observer_xy: Sequence[float] | np.ndarray,
+        target_ids: Sequence[int],
+        rssi_dbm: Sequence[float] | np.ndarray,
+    ) -> tuple[np.ndarray, np.ndarray]:
+        obs = np.asarray(observer_xy, dtype=np.float64)
+        values = np.asarray(rssi_dbm, dtype=np.float64)
+        if obs.shape != (2,) or not np.all(np.isfinite(obs)):
+            raise ObservationError(f'observer position must be 2 finite numbers, got {obs!r}')
+        if values.shape != (len(target_ids),):
+            raise ObservationError(f'{len(target_ids)} target IDs but RSSI of shape {values.shape}')
+        if not np.all(np.isfinite(values)):
+            raise ObservationError(f'RSSI values must be finite, got {values!r}')
+        if len(set(target_ids)) != len(target_ids):
+            raise ObservationError(f'target IDs repeat within one observation: {target_ids}')
+        return obs, values
+
     def update(
         self,
         observer_xy: Sequence[float] | np.ndarray,
@@ -302,27 +320,75 @@ class ParticleFilterBank:
         Raises:
             ObservationError: non-finite observer position or RSSI, shape mismatch, repeats.
         """
-        obs = np.asarray(observer_xy, dtype=np.float64)
-        values = np.asarray(rssi_dbm, dtype=np.float64)
-        if obs.shape != (2,) or not np.all(np.isfinite(obs)):
-            raise ObservationError(f'observer position must be 2 finite numbers, got {obs!r}')
-        if values.shape != (len(target_ids),):
-            raise ObservationError(f'{len(target_ids)} target IDs but RSSI of shape {values.shape}')
-        if not np.all(np.isfinite(values)):
-            raise ObservationError(f'RSSI values must be finite, got {values!r}')
-        if len(set(target_ids)) != len(target_ids):
-            raise ObservationError(f'target IDs repeat within one observation: {target_ids}')
-        for tid in target_ids:
-            self.track(int(tid), obs)
-        slots = np.array([self._slot_of[int(t)] for t in target_ids], dtype=np.int64)
-        if not self._cfg.update_after_convergence:
-            keep = ~self._converged[slots]
-            slots, values = slots[keep], values[keep]
-        if slots.size == 0:
-            return []
-        return self._update_slots(slots, obs, values)
+        return self.update_joint([(observer_xy, target_ids, rssi_dbm)])
 
-    def _update_slots(self, slots: np.ndarray, obs: np.ndarray, values: np.ndarray) -> list[int]:
+    def update_joint(
+        self,
+        observations: Sequence[
+            tuple[Sequence[float] | np.ndarray, Sequence[int], Sequence[float] | np.ndarray]
+        ],
+    ) -> list[int]:
+        """Fold in samples from several observation points at once (one control step).
+
+        Each filter multiplies the likelihoods of all its samples (eq. 3 per sample), then
+        normalises, estimates and resamples once. This is the same posterior as one update
+        per sample, with one resampling instead of many.
+
+        Args:
+            observations: (observer (2,) [m], target IDs, RSSI [dBm]) per observation point;
+                targets without a filter get one centred on their first observer.
+
+        Returns:
+            IDs whose filter degenerated and was re-initialised around its first observer.
+
+        Raises:
+            ObservationError: as :meth:`update`, for any observation (nothing is updated).
+        """
+        checked = [(self._validate(o, ids, v), ids) for o, ids, v in observations]
+        rounds: list[list[tuple[int, np.ndarray, float]]] = []
+        depth: dict[int, int] = {}
+        for (obs, values), ids in checked:
+            for tid, value in zip(ids, values, strict=True):
+                tid = int(tid)
+                self.track(tid, obs)
+                slot = self._slot_of[tid]
+                if not self._cfg.update_after_convergence and self._converged[slot]:
+                    continue
+                level = depth.get(slot, 0)
+                depth[slot] = level + 1
+                if level == len(rounds):
+                    rounds.append([])
+                rounds[level].append((slot, obs, float(value)))
+        if not rounds:
+            return []
+        first = sorted(rounds[0], key=lambda item: item[0])
+        slots = np.array([item[0] for item in first], dtype=np.int64)
+        row_of = {int(slot): row for row, slot in enumerate(slots)}
+        observers = np.array([item[1] for item in first])
+        values = np.array([item[2] for item in first])
+        extra = []
+        for level in rounds[1:]:
+            rows = np.array([row_of[item[0]] for item in level], dtype=np.int64)
+            extra.append((rows, np.array([item[1] for item in level]), [i[2] for i in level]))
+        return self._update_slots(slots, observers, values, extra)
+
+    def _log_likelihood(self, d2: np.ndarray, values: np.ndarray, out: np.ndarray) -> np.ndarray:
+        """Eqs. (3)-(4) in log form, -((P - P0) + 5 K log10 d^2)^2 / sigma^2, into ``out``."""
+        np.maximum(d2, np.float32(1.0), out=out)  # d < 1 m counts as 1 m
+        np.log10(out, out=out)
+        out *= np.float32(self._log_scale)
+        out += (np.asarray(values) - self._radio.rssi_at_1m_dbm).astype(np.float32)[:, None]
+        np.multiply(out, out, out=out)
+        out *= np.float32(-1.0 / self._denominator)
+        return out
+
+    def _update_slots(
+        self,
+        slots: np.ndarray,
+        observers: np.ndarray,
+        values: np.ndarray,
+        extra: list[tuple[np.ndarray, np.ndarray, list[float]]],
+    ) -> list[int]:
         k = slots.size
         contiguous = bool(np.array_equal(slots, np.arange(k)))
         if contiguous:
@@ -333,19 +399,21 @@ class ParticleFilterBank:
         a, dx = self._buf_a[:k], self._buf_b[:k]
         dy, d2 = self._buf_c32[:k], self._buf_d32[:k]
 
-        # Offsets from the observer; the estimate is accumulated relative to it (float32-safe).
-        np.subtract(x, np.float32(obs[0]), out=dx)
-        np.subtract(y, np.float32(obs[1]), out=dy)
+        # Offsets from each filter's first observer; the estimate is accumulated relative to
+        # it so float32 keeps millimetres.
+        np.subtract(x, observers[:, :1].astype(np.float32), out=dx)
+        np.subtract(y, observers[:, 1:].astype(np.float32), out=dy)
         np.multiply(dx, dx, out=d2)
         np.multiply(dy, dy, out=a)
         d2 += a
-        # Eq. (4) and (3) as a log-likelihood: -((P - P0) + 5 K log10 d^2)^2 / sigma^2.
-        np.maximum(d2, np.float32(1.0), out=a)  # d < 1 m counts as 1 m
-        np.log10(a, out=a)
-        a *= np.float32(self._log_scale)
-        a += (values - self._radio.rssi_at_1m_dbm).astype(np.float32)[:, None]
-        np.multiply(a, a, out=a)
-        a *= np.float32(-1.0 / self._denominator)
+        self._log_likelihood(d2, values, out=a)
+        for rows, where, more in extra:
+            ex_ = x[rows] - where[:, :1].astype(np.float32)
+            ey_ = y[rows] - where[:, 1:].astype(np.float32)
+            ex_ *= ex_
+            ey_ *= ey_
+            ex_ += ey_
+            a[rows] += self._log_likelihood(ex_, np.asarray(more), out=ey_)
         peak = a.max(axis=1)
         degenerate = ~(peak >= _LOG_TINY)  # also catches NaN
         # Eq. (2): normalised weights exp(l - max) / sum; degenerate rows are handled below.
@@ -359,7 +427,7 @@ class ParticleFilterBank:
         mx = np.einsum('kn,kn->k', a, dx).astype(np.float64)
         my = np.einsum('kn,kn->k', a, dy).astype(np.float64)
         spread2 = np.einsum('kn,kn->k', a, d2).astype(np.float64) - (mx * mx + my * my)
-        ex, ey = obs[0] + mx, obs[1] + my
+        ex, ey = observers[:, 0] + mx, observers[:, 1] + my
         best = a.argmax(axis=1)
         rows = np.arange(k)
         best_xy = np.stack([x[rows, best], y[rows, best]], axis=1).astype(np.float64)
@@ -378,12 +446,14 @@ class ParticleFilterBank:
         self._spread[slots] = np.sqrt(np.maximum(spread2, 0.0))
         self._best[slots] = best_xy
         self._updated[slots] = True
-        self._n_updates[slots] += 1
+        self._n_updates[slots] += 1 + np.bincount(
+            np.concatenate([r for r, _, _ in extra] or [np.empty(0, np.int64)]), minlength=k
+        )
 
         reinitialised: list[int] = []
         for row in np.flatnonzero(degenerate):
             slot = int(slots[row])
-            self._reinitialise(slot, obs)
+            self._reinitialise(slot, observers[row])
             reinitialised.append(self._ids[slot])
         return reinitialised
 

@@ -314,11 +314,17 @@ class RobotController:
         for peer in fresh:
             batch = {t: v for t, v in peer.readings if math.isfinite(v) and t not in self._captured}
             batches.append((np.asarray(peer.position_m, dtype=np.float64), batch))
+        observations = []
         for where, batch in batches:
-            if not batch or not np.all(np.isfinite(where)):
-                continue
-            ids = sorted(batch)
-            for target in self._bank.update(where, ids, [batch[t] for t in ids]):
+            if batch and np.all(np.isfinite(where)):
+                ids = sorted(batch)
+                observations.append((where, ids, [batch[t] for t in ids]))
+        if self.config.particle_filter.fusion == 'joint':
+            groups = [observations]
+        else:
+            groups = [[observation] for observation in observations]
+        for group in groups:
+            for target in self._bank.update_joint(group):
                 events.append(f'filter of target {target} degenerated: re-initialised')
         self._bank.end_step()
         return events

@@ -28,6 +28,7 @@ __all__ = [
 AVOIDANCE_FORMS = ('linear', 'inverse_square')
 LEADER_RULES = ('gradient', 'pbest')
 INITIAL_PRIORS = ('detection_square', 'field')
+FUSION_MODES = ('joint', 'sequential')
 RESAMPLING_SCHEMES = ('systematic', 'multinomial')
 
 
@@ -106,6 +107,10 @@ class ParticleFilterConfig:
             from at a random offset (a speed choice: drawing 2 x 20 x 5041 normals per update
             costs more than the rest of the update); 0 draws fresh normals every update.
         update_after_convergence: keep folding observations in after convergence (spec: yes).
+        fusion: 'joint' folds all samples of one control step (own and neighbours') into one
+            update per target (likelihood product, one resampling); 'sequential' makes one
+            update per observation point. Same posterior; 'joint' resamples less often and
+            is several times faster with many neighbours.
     """
 
     n_particles: int = 5041
@@ -121,6 +126,7 @@ class ParticleFilterConfig:
     roughening_floor_m: float = 0.5
     noise_pool_size: int = 1 << 20
     update_after_convergence: bool = True
+    fusion: str = 'joint'
 
     def __post_init__(self) -> None:
         _require_finite(self)
@@ -133,6 +139,7 @@ class ParticleFilterConfig:
             self.init_half_width_m is None or self.init_half_width_m > 0.0,
             'init_half_width_m must be positive',
         )
+        _require(self.fusion in FUSION_MODES, f'fusion not in {FUSION_MODES}')
         _require(self.resampling in RESAMPLING_SCHEMES, f'resampling not in {RESAMPLING_SCHEMES}')
         _require(self.roughening_kappa >= 0.0, 'roughening_kappa must be non-negative')
         _require(self.roughening_floor_m >= 0.0, 'roughening_floor_m must be non-negative')

@@ -1,0 +1,254 @@
+"""MSC + particle filter benchmark: capture completion time of the three schemes.
+
+Runs the ROS-free batch simulator (:mod:`sim_bridge.msc_pf_batch`, the same controller
+objects the ROS node runs) over seeded runs of the paper's scenario (2000 m x 2000 m field,
+targets uniform, robots starting in a 30 m disc at the centre, Table I parameters) and prints:
+
+* main: CCT mean +- std for proposed, msc_pf and msc at 10, 15 and 20 targets with the
+  default robot count, the ratios of the means, unfinished runs (CCT > T_max, never dropped:
+  they count as T_max in the mean, so the mean is then a lower bound), wall time per run;
+* robots: CCT against the robot count (sensitivity);
+* pf: time of one particle-filter update of 20 targets x 5041 particles from one
+  observation (median over repeats), and of one fused update of 3 observers.
+
+A seed fixes target and robot placement, noise and every controller, and runs with the same
+seed see the same targets under every scheme. Example::
+
+    python benchmarks/bench_msc_pf.py --runs 10 --workers 2 --out msc_pf_table.md
+"""
+
+from __future__ import annotations
+
+import os
+
+for _var in ('OMP_NUM_THREADS', 'OPENBLAS_NUM_THREADS', 'MKL_NUM_THREADS'):
+    os.environ.setdefault(_var, '1')
+
+import argparse  # noqa: E402
+import math  # noqa: E402
+import time  # noqa: E402
+from concurrent.futures import ProcessPoolExecutor  # noqa: E402
+from dataclasses import dataclass  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+import numpy as np  # noqa: E402
+from msc_pf.particle_filter import ParticleFilterBank  # noqa: E402
+from msc_pf.schemes import Scheme  # noqa: E402
+from msc_pf.settings import ParticleFilterConfig, RadioConfig  # noqa: E402
+from sim_bridge.msc_pf_batch import BatchScenario, run_batch  # noqa: E402
+
+SCHEMES = ('proposed', 'msc_pf', 'msc')
+EXPERIMENTS = ('main', 'robots', 'pf')
+
+
+@dataclass(frozen=True)
+class RunOutcome:
+    """One run's result."""
+
+    scheme: str
+    n_targets: int
+    n_robots: int
+    seed: int
+    cct_s: float
+    finished: bool
+    wall_time_s: float
+
+
+def _run_one(job: tuple[str, int, int, int, float]) -> RunOutcome:
+    scheme, n_targets, n_robots, seed, max_time_s = job
+    result = run_batch(
+        BatchScenario(
+            scheme=Scheme(scheme),
+            n_robots=n_robots,
+            n_targets=n_targets,
+            seed=seed,
+            max_time_s=max_time_s,
+        )
+    )
+    finished = not math.isnan(result.cct_s)
+    cct = result.cct_s if finished else max_time_s
+    return RunOutcome(scheme, n_targets, n_robots, seed, cct, finished, result.wall_time_s)
+
+
+def _run_all(jobs: list[tuple[str, int, int, int, float]], workers: int) -> list[RunOutcome]:
+    if workers <= 1:
+        return [_run_one(job) for job in jobs]
+    with ProcessPoolExecutor(max_workers=workers) as pool:
+        return list(pool.map(_run_one, jobs))
+
+
+def _stats(outcomes: list[RunOutcome]) -> tuple[float, float, int, float]:
+    cct = np.array([o.cct_s for o in outcomes])
+    unfinished = sum(not o.finished for o in outcomes)
+    wall = float(np.mean([o.wall_time_s for o in outcomes]))
+    return float(cct.mean()), float(cct.std()), unfinished, wall
+
+
+def pf_update_time_ms(n_targets: int = 20, repeats: int = 200, observers: int = 1) -> float:
+    """Median wall time [ms] of one update of ``n_targets`` filters (Table I's N_p)."""
+    radio = RadioConfig()
+    rng = np.random.default_rng(0)
+    bank = ParticleFilterBank(ParticleFilterConfig(), radio, 2000.0, rng, capacity=n_targets)
+    targets = rng.uniform(700.0, 1300.0, (n_targets, 2))
+    ids = list(range(n_targets))
+    where = [np.array([1000.0 + 20.0 * i, 1000.0]) for i in range(observers)]
+    for tid in ids:
+        bank.track(tid, where[0])
+
+    def observation(point: np.ndarray):
+        d = np.hypot(*(targets - point).T)
+        return point, ids, radio.rssi_at_1m_dbm - 30.0 * np.log10(d) + rng.normal(0, 1, len(d))
+
+    times = []
+    for i in range(repeats + 5):
+        batch = [observation(p) for p in where]
+        start = time.perf_counter()
+        bank.update_joint(batch)
+        if i >= 5:
+            times.append(time.perf_counter() - start)
+    return 1e3 * float(np.median(times))
+
+
+def run(
+    *,
+    experiments: tuple[str, ...] = EXPERIMENTS,
+    targets: tuple[int, ...] = (10, 15, 20),
+    robots: int = 15,
+    robot_counts: tuple[int, ...] = (9, 15, 30),
+    sweep_targets: int = 10,
+    runs: int = 10,
+    sweep_runs: int = 5,
+    schemes: tuple[str, ...] = SCHEMES,
+    max_time_s: float = 30000.0,
+    first_seed: int = 0,
+    workers: int = 1,
+) -> tuple[str, list[RunOutcome]]:
+    """Run the experiments; return the report (markdown) and every run's outcome."""
+    lines: list[str] = []
+    outcomes: list[RunOutcome] = []
+    if 'main' in experiments:
+        jobs = [
+            (scheme, n, robots, first_seed + s, max_time_s)
+            for n in targets
+            for scheme in schemes
+            for s in range(runs)
+        ]
+        main = _run_all(jobs, workers)
+        outcomes += main
+        lines += [
+            f'## CCT [s], {robots} robots, {runs} seeded runs per cell (mean +- std)',
+            '',
+            '| targets | ' + ' | '.join(schemes) + ' | proposed/msc | msc_pf/msc | '
+            'proposed/msc_pf | unfinished | wall s/run |',
+            '|---' * (len(schemes) + 6) + '|',
+        ]
+        for n in targets:
+            cells, means, unfinished, walls = [], {}, [], []
+            for scheme in schemes:
+                mean, std, late, wall = _stats(
+                    [o for o in main if o.n_targets == n and o.scheme == scheme]
+                )
+                means[scheme] = mean
+                cells.append(f'{mean:.0f} +- {std:.0f}')
+                unfinished.append(f'{scheme}:{late}')
+                walls.append(f'{scheme}:{wall:.0f}')
+
+            def ratio(a: str, b: str, means: dict[str, float] = means) -> str:
+                if a in means and b in means and means[b] > 0:
+                    return f'{means[a] / means[b]:.2f}'
+                return '-'
+
+            lines.append(
+                f'| {n} | '
+                + ' | '.join(cells)
+                + f' | {ratio("proposed", "msc")} | {ratio("msc_pf", "msc")}'
+                + f' | {ratio("proposed", "msc_pf")} | {" ".join(unfinished)}'
+                + f' | {" ".join(walls)} |'
+            )
+        lines.append('')
+    if 'robots' in experiments:
+        jobs = [
+            (scheme, sweep_targets, count, first_seed + s, max_time_s)
+            for count in robot_counts
+            for scheme in schemes
+            for s in range(sweep_runs)
+        ]
+        sweep = _run_all(jobs, workers)
+        outcomes += sweep
+        lines += [
+            f'## CCT [s] against robot count, {sweep_targets} targets, {sweep_runs} runs per cell',
+            '',
+            '| robots | ' + ' | '.join(schemes) + ' | unfinished |',
+            '|---' * (len(schemes) + 2) + '|',
+        ]
+        for count in robot_counts:
+            cells, unfinished = [], []
+            for scheme in schemes:
+                mean, std, late, _ = _stats(
+                    [o for o in sweep if o.n_robots == count and o.scheme == scheme]
+                )
+                cells.append(f'{mean:.0f} +- {std:.0f}')
+                unfinished.append(f'{scheme}:{late}')
+            lines.append(f'| {count} | ' + ' | '.join(cells) + f' | {" ".join(unfinished)} |')
+        lines.append('')
+    if 'pf' in experiments:
+        one = pf_update_time_ms(20, observers=1)
+        three = pf_update_time_ms(20, observers=3)
+        lines += [
+            '## Particle-filter update time (20 targets x 5041 particles, median)',
+            '',
+            '| update | ms |',
+            '|---|---|',
+            f'| one observation of 20 targets | {one:.2f} |',
+            f'| fused step: 3 observers x 20 targets | {three:.2f} |',
+            '',
+        ]
+    return '\n'.join(lines), outcomes
+
+
+def main() -> None:
+    """Command-line entry point."""
+    parser = argparse.ArgumentParser(description=__doc__.split('\n')[0])
+    parser.add_argument('--experiments', nargs='+', choices=EXPERIMENTS, default=EXPERIMENTS)
+    parser.add_argument('--targets', nargs='+', type=int, default=[10, 15, 20])
+    parser.add_argument('--robots', type=int, default=15)
+    parser.add_argument('--robot-counts', nargs='+', type=int, default=[9, 15, 30])
+    parser.add_argument('--sweep-targets', type=int, default=10)
+    parser.add_argument('--runs', type=int, default=10)
+    parser.add_argument('--sweep-runs', type=int, default=5)
+    parser.add_argument('--schemes', nargs='+', choices=SCHEMES, default=list(SCHEMES))
+    parser.add_argument('--max-time', type=float, default=30000.0, help='T_max per run [s]')
+    parser.add_argument('--first-seed', type=int, default=0)
+    parser.add_argument('--workers', type=int, default=1, help='processes (one core each)')
+    parser.add_argument('--out', type=Path, help='also write the report to this file')
+    args = parser.parse_args()
+    start = time.perf_counter()
+    report, outcomes = run(
+        experiments=tuple(args.experiments),
+        targets=tuple(args.targets),
+        robots=args.robots,
+        robot_counts=tuple(args.robot_counts),
+        sweep_targets=args.sweep_targets,
+        runs=args.runs,
+        sweep_runs=args.sweep_runs,
+        schemes=tuple(args.schemes),
+        max_time_s=args.max_time,
+        first_seed=args.first_seed,
+        workers=args.workers,
+    )
+    report += f'\nTotal wall time: {time.perf_counter() - start:.0f} s\n'
+    print(report)
+    if args.out is not None:
+        rows = '\n'.join(
+            f'{o.scheme},{o.n_targets},{o.n_robots},{o.seed},{o.cct_s:.0f},{o.finished:d},'
+            f'{o.wall_time_s:.1f}'
+            for o in outcomes
+        )
+        args.out.write_text(report)
+        args.out.with_suffix('.csv').write_text(
+            'scheme,targets,robots,seed,cct_s,finished,wall_s\n' + rows + '\n'
+        )
+
+
+if __name__ == '__main__':
+    main()
