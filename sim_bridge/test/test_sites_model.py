@@ -109,3 +109,12 @@ def test_door_reports_width_and_midpoint() -> None:
     assert door.midpoint == pytest.approx((2.5, 2.2))
     with pytest.raises(SiteError, match='four finite'):
         Door((0.0, math.nan, 1.0, 1.0))
+
+
+def test_room_bounding_rects_follow_the_room_order() -> None:
+    rooms = (Room(4, [(0.0, 0.0, 1.0, 1.0), (1.0, 0.0, 2.0, 0.5)]), Room(2, [(3.0, 1.0, 3.5, 2.0)]))
+    site = make_box_site(rooms=rooms, doors=())
+    np.testing.assert_allclose(
+        site.room_bounding_rects, [[0.0, 0.0, 2.0, 1.0], [3.0, 1.0, 3.5, 2.0]]
+    )
+    assert make_box_site(rooms=()).room_bounding_rects.shape == (0, 4)

@@ -402,27 +402,56 @@ class _SiteBuilder:
         inner = np.zeros_like(self.wall)
         inner[1:-1, 1:-1] = True
         interior = (_is_label(codes) | _is_digit(codes)) & inner
-        found: list[tuple[int, int, np.ndarray]] = []  # (first flat index, code, vertex mask)
-        for code in np.unique(codes[interior]).tolist():
-            components, count = ndimage.label(codes == code)
-            for k in range(1, count + 1):
-                mask = components == k
-                found.append((int(np.flatnonzero(mask)[0]), code, mask))
-        found.sort(key=lambda item: item[0])
-        vertex_rooms = np.full(codes.shape, NO_ROOM, dtype=np.int64)
-        first_cell: dict[int, tuple[int, int]] = {}
-        for index, (first, _, mask) in enumerate(found):
-            vertex_rooms[mask] = index + 1
-            first_cell[index + 1] = divmod(first, self.n_cols)
+        # Rooms are 4-connected groups of one letter; ids follow reading order.
+        components, count = ndimage.label(interior)
+        index = np.arange(1, count + 1)
+        low = np.asarray(ndimage.minimum(codes, components, index), dtype=np.int64)
+        high = np.asarray(ndimage.maximum(codes, components, index), dtype=np.int64)
+        if np.any(low != high):
+            self._report_touching_rooms(components == int(np.argmax(low != high)) + 1)
+        vertex_rooms = np.where(components > 0, components, NO_ROOM).astype(np.int64)
+        _, first = np.unique(components.ravel(), return_index=True)
+        first_cell = {k: divmod(int(first[k]), self.n_cols) for k in range(1, count + 1)}
         self._square_rooms_from_vertices(vertex_rooms)
         rooms = []
-        for index, (_, code, _) in enumerate(found):
-            room_id = index + 1
-            rects = lattice.square_to_rects(self.square_rooms == room_id, self.cell_m)
+        for room_id, where in enumerate(ndimage.find_objects(np.maximum(self.square_rooms, 0)), 1):
+            code = int(low[room_id - 1])
+            rects = self._room_rects(room_id, where)
             is_digit = _DIGIT_FIRST <= code <= _DIGIT_LAST
             rooms.append(Room(room_id, rects, label=chr(code), has_victim=is_digit))
         self._check_rooms_have_openings(rooms, first_cell)
         return rooms, self._marked_doors()
+
+    def _room_rects(self, room_id: int, where: tuple[slice, slice] | None) -> np.ndarray:
+        """Rectangles of a room's squares; one rectangle when they fill their bounding box."""
+        if where is None:
+            return lattice.square_to_rects(self.square_rooms == room_id, self.cell_m)
+        rows, cols = where
+        if np.all(self.square_rooms[where] == room_id):
+            n_square_rows = self.n_rows - 1
+            return np.array(
+                [
+                    [
+                        cols.start * self.cell_m,
+                        (n_square_rows - rows.stop) * self.cell_m,
+                        cols.stop * self.cell_m,
+                        (n_square_rows - rows.start) * self.cell_m,
+                    ]
+                ]
+            )
+        return lattice.square_to_rects(self.square_rooms == room_id, self.cell_m)
+
+    def _report_touching_rooms(self, group: np.ndarray) -> None:
+        """Raise at the first place where one connected letter group changes letter."""
+        codes = self.codes
+        right = group[:, :-1] & group[:, 1:] & (codes[:, :-1] != codes[:, 1:])
+        down = group[:-1, :] & group[1:, :] & (codes[:-1, :] != codes[1:, :])
+        places = [(int(r), int(c), int(codes[r, c + 1])) for r, c in np.argwhere(right)]
+        places += [(int(r), int(c), int(codes[r + 1, c])) for r, c in np.argwhere(down)]
+        row, col, other = min(places)
+        labels = sorted({chr(int(codes[row, col])), chr(other)})
+        msg = f'rooms {" and ".join(map(repr, labels))} touch without a wall between them'
+        raise self.error(row, col, msg)
 
     def _square_rooms_from_vertices(self, vertex_rooms: np.ndarray) -> None:
         """A square belongs to the room one of its corners is inside of: a room's area spans
@@ -448,11 +477,13 @@ class _SiteBuilder:
     def _check_rooms_have_openings(
         self, rooms: list[Room], first_cell: dict[int, tuple[int, int]]
     ) -> None:
-        areas, _ = lattice.square_labels(self.wall)
+        """A room whose connected free space holds nothing but itself has no door."""
+        areas, count = lattice.square_labels(self.wall)
+        pairs = np.unique(np.stack([areas.ravel(), self.square_rooms.ravel()]), axis=1)
+        closed_area = np.bincount(pairs[0], minlength=count + 1) == 1
+        open_rooms = set(np.unique(self.square_rooms[~closed_area[areas]]).tolist())
         for room in rooms:
-            mine = self.square_rooms == room.room_id
-            reachable = np.isin(areas, np.unique(areas[mine]))
-            if not np.any(reachable & ~mine):
+            if room.room_id not in open_rooms:
                 row, col = first_cell[room.room_id]
                 raise self.error(row, col, f'room {room.label!r} has no door')
 

@@ -287,6 +287,13 @@ class Site:
         return tuple(room.room_id for room in self.rooms)
 
     @property
+    def room_bounding_rects(self) -> np.ndarray:
+        """(K, 4) x0, y0, x1, y1 [m] of each room's bounding rectangle, in room-index order
+        (the room itself for the one-rectangle rooms of generated and labelled sites)."""
+        rects = np.array([room.bounding_rect for room in self.rooms], dtype=np.float64)
+        return rects.reshape(-1, 4)
+
+    @property
     def sealed_walls(self) -> np.ndarray:
         """(M', 4) walls with the entrance closed by one more segment: what robots collide with
         in a simulation of the paper's closed sites."""
