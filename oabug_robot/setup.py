@@ -34,6 +34,6 @@ setup(
     ),
     license='Apache-2.0',
     entry_points={
-        'console_scripts': [],
+        'console_scripts': ['oabug = oabug_robot.node:main'],
     },
 )
