@@ -66,7 +66,9 @@ class Publisher:
         self._roundtrip = cdr_roundtrip_enabled()
         self._serialize, self._deserialize = cdr_codec()
         self._connected: tuple[Subscription, ...] = ()
-        self._targets: tuple[tuple[Subscription, bool], ...] = ()
+        # Per connected subscription: (subscription, its queue, its depth, wants CDR bytes,
+        # wants MessageInfo), so that publish() reads everything from one tuple.
+        self._targets: tuple[tuple[Subscription, deque[Any], int, bool, bool], ...] = ()
         self._needs_bytes = self._roundtrip
         self._is_clock = self._topic_name == CLOCK_TOPIC
         self._sequence = 0
@@ -93,7 +95,10 @@ class Publisher:
     def _set_connected(self, subscriptions: list[Subscription]) -> None:
         """Called by the graph when the set of connected subscriptions changes."""
         self._connected = tuple(subscriptions)
-        self._targets = tuple((sub, self._roundtrip or sub.raw) for sub in subscriptions)
+        self._targets = tuple(
+            (sub, sub._queue, sub._depth, self._roundtrip or sub.raw, sub._with_info)
+            for sub in subscriptions
+        )
         self._needs_bytes = self._roundtrip or any(sub.raw for sub in subscriptions)
 
     def publish(self, msg: Any) -> None:
@@ -124,14 +129,17 @@ class Publisher:
         else:
             payload = None
         self._sequence += 1
-        stamp_ns = SYSTEM_EPOCH_NS + self._context._elapsed_ns
         next_seq = self._graph.next_seq
-        for sub, wants_bytes in self._targets:
+        for sub, queue, depth, wants_bytes, wants_info in self._targets:
             seq = next_seq()
-            queue = sub._queue
-            if len(queue) >= sub._depth:
+            if len(queue) >= depth:
                 queue.popleft()
-            queue.append((seq, payload if (raw or wants_bytes) else msg, stamp_ns, self._sequence))
+            data = payload if (raw or wants_bytes) else msg
+            if wants_info:
+                stamp_ns = SYSTEM_EPOCH_NS + self._context._elapsed_ns
+                queue.append((seq, data, stamp_ns, self._sequence))
+            else:
+                queue.append((seq, data))
             owner = sub._owner
             if owner is not None:
                 owner._inbox.append((seq, sub))

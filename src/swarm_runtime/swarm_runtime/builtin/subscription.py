@@ -1,9 +1,10 @@
 """``rclpy.subscription``: a subscription's queue and callback.
 
 Each subscription keeps the messages delivered to it but not yet taken by its executor, at
-most ``depth`` of them (KEEP_LAST drops the oldest). Entries are ``(seq, data, stamp_ns,
-publication_sequence_number)``; ``seq`` is the context-wide publish order, which executors
-use to run callbacks in publish order across all subscriptions.
+most ``depth`` of them (KEEP_LAST drops the oldest). Entries are ``(seq, data)``, plus
+``(stamp_ns, publication_sequence_number)`` for callbacks that take a MessageInfo; ``seq`` is
+the context-wide publish order, which executors use to run callbacks in publish order across
+all subscriptions.
 """
 
 from __future__ import annotations
@@ -80,7 +81,7 @@ class Subscription:
         self._typename = subscription_impl.typename
         self._context = self._node.context
         self._effective_qos = qos_profile
-        self._queue: deque[tuple[int, Any, int, int]] = deque()
+        self._queue: deque[tuple[Any, ...]] = deque()
         self._depth = queue_depth(qos_profile)
         self._owner: Executor | None = None
         self._alive = True
@@ -138,21 +139,27 @@ class Subscription:
         queue = self._queue
         if len(queue) >= self._depth:
             queue.popleft()
-        queue.append((seq, data, SYSTEM_EPOCH_NS + self._context._elapsed_ns, 0))
+        if self._with_info:
+            queue.append((seq, data, SYSTEM_EPOCH_NS + self._context._elapsed_ns, 0))
+        else:
+            queue.append((seq, data))
         if self._owner is not None:
             self._owner._inbox.append((seq, self))
 
-    def _deliver(self, entry: tuple[int, Any, int, int]) -> None:
+    def _deliver(self, entry: tuple[Any, ...]) -> None:
         """Run the callback with one queued message (decoding CDR bytes unless raw)."""
         data = entry[1]
         if not self.raw and type(data) is bytes:
             data = self._decode(data, self._typename)
         self._received += 1
         if self._with_info:
+            now_ns = SYSTEM_EPOCH_NS + self._context._elapsed_ns
+            # Entries queued before the callback changed to take a MessageInfo lack its data.
+            stamp_ns, publication = entry[2:4] if len(entry) == 4 else (now_ns, 0)
             info: MessageInfo = {
-                'source_timestamp': entry[2],
-                'received_timestamp': SYSTEM_EPOCH_NS + self._context._elapsed_ns,
-                'publication_sequence_number': entry[3],
+                'source_timestamp': stamp_ns,
+                'received_timestamp': now_ns,
+                'publication_sequence_number': publication,
                 'reception_sequence_number': self._received,
             }
             self._callback(data, info)
