@@ -246,10 +246,18 @@ def test_unknown_characters_are_reported_with_line_and_column(tmp_path: Path) ->
         import_text(tmp_path, replace_char(LABELLED, 4, 7, '\t'))
 
 
-def test_non_ascii_characters_are_reported_with_line_and_column(tmp_path: Path) -> None:
-    path = tmp_path / 'plan.lay'
-    path.write_bytes(replace_char(LABELLED, 3, 5, 'é').encode('utf-8'))
-    with pytest.raises(LayoutError, match=r':3:5: unknown non-ASCII character'):
+def test_labels_past_z_as_the_authors_generator_writes_them_are_rooms(tmp_path: Path) -> None:
+    text = LABELLED.replace('AAAA', '^^^^').replace('BB', 'ÀÀ')
+    result = import_text(tmp_path, text)
+    assert sorted(room.label for room in result.site.rooms) == ['3', 'C', '^', 'À']
+
+
+def test_non_printable_characters_and_broken_encodings_are_reported(tmp_path: Path) -> None:
+    with pytest.raises(LayoutError, match=r":3:5: unknown character '\\xa0'"):
+        import_text(tmp_path, replace_char(LABELLED, 3, 5, '\u00a0'))
+    path = tmp_path / 'latin1.lay'
+    path.write_bytes(replace_char(LABELLED, 3, 5, 'é').encode('latin-1'))
+    with pytest.raises(LayoutError, match=r':3:5: the file is not UTF-8 text'):
         import_layout(path)
 
 

@@ -2,7 +2,7 @@
 
 A :class:`Site` holds a building's walls, rooms, doors, entrance and departure points in
 metres. Sites come from :func:`generate_site` (the paper's Small/Medium/Big configurations
-or any size), from the authors' ASCII layouts (:func:`import_layout`) or from YAML site files
+or any size), from the authors' text layouts (:func:`import_layout`) or from YAML site files
 (:func:`load_site`); every one is checked by :func:`validate_site`. Drawing lives in
 :mod:`sim_bridge.sites.plotting` (matplotlib) and ROS messages in
 :mod:`sim_bridge.sites.site_msgs`, so importing this package pulls in neither.

@@ -149,7 +149,7 @@ def build_parser() -> argparse.ArgumentParser:
     generate.add_argument('--png', help='also render the site to this PNG')
     generate.set_defaults(run=_generate)
 
-    imports = commands.add_parser('import-lay', help='import an ASCII .lay layout')
+    imports = commands.add_parser('import-lay', help='import a .lay text layout')
     imports.add_argument('layout', help='the .lay file')
     imports.add_argument('-o', '--output', required=True, help='site file to write (.yaml)')
     imports.add_argument('--mode', default='auto', choices=[m.value for m in LayoutMode])

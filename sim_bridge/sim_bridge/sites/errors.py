@@ -49,7 +49,7 @@ class GeneratorError(SiteError):
 
 
 class LayoutError(SiteError):
-    """An ASCII ``.lay`` layout is malformed or describes an invalid site.
+    """A ``.lay`` text layout is malformed or describes an invalid site.
 
     The message reads like a compiler diagnostic, ``plan.lay:12:7: <what is wrong>``, with
     1-based line and column.

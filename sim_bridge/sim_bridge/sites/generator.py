@@ -1,7 +1,7 @@
 """Seeded generator of OA-Bug search sites, after the structure of the authors' generator.
 
-The authors' generator (REFERENCE_OABUG_SIM.md §3, described there in prose; this module is
-an independent implementation of that description) carves a building out of solid wall:
+The authors' generator (in their simulator, SwarmSearchSimulation; this module is an
+independent implementation of how it behaves) carves a building out of solid wall:
 
 1. a 4-cell-wide cross of corridors through the middle, spanning the whole site;
 2. extra full-length corridors, 2-3 cells wide, placed at random in the remaining bands as
@@ -332,10 +332,10 @@ class _Carver:
         return True
 
     def codes(self) -> np.ndarray:
-        """(H, W) uint8 characters of the labelled layout."""
-        codes = np.full(self.state.shape, WALL, dtype=np.uint8)
+        """(H, W) character codes of the labelled layout."""
+        codes = np.full(self.state.shape, WALL, dtype=np.int32)
         codes[self.state == _OPEN] = FREE
-        labels = np.array([_LABELS[k % len(_LABELS)] for k in range(self.placed)], dtype=np.uint8)
+        labels = np.array([_LABELS[k % len(_LABELS)] for k in range(self.placed)], dtype=np.int32)
         victims = self.rng.choice(self.placed, size=self.config.victims, replace=False)
         labels[np.sort(victims)] = [ord('0') + k % 10 for k in range(len(victims))]
         interior = self.state == _INTERIOR

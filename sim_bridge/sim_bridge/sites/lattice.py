@@ -3,10 +3,10 @@
 A layout is an (H, W) array of characters, one per grid *vertex*: vertex (r, c) sits at
 x = c * cell_m, y = (H - 1 - r) * cell_m (row 0 is the top line of the file, the world's y
 axis points up). Walls run between 4-adjacent wall vertices, so a straight run of ``%`` is a
-wall line and a single missing vertex in it is a door gap two cells wide
-(REFERENCE_OABUG_SIM.md §3). The free space is made of the (H-1, W-1) unit *squares* between
-vertices; square (i, j) has corners (i, j) .. (i+1, j+1). Two neighbouring squares are
-connected unless the edge between them is a wall.
+wall line and a single missing vertex in it is a door gap two cells wide (as the layout
+module of the authors' simulator, SwarmSearchSimulation, builds them). The free space is
+made of the (H-1, W-1) unit *squares* between vertices; square (i, j) has corners (i, j) ..
+(i+1, j+1). Two neighbouring squares are connected unless the edge between them is a wall.
 
 A square whose four corners are walls is *solid*: the authors' uncarved blocks are meshes
 of such squares that no robot can enter. Walls between two solid squares can never be seen

@@ -1,12 +1,13 @@
-"""ASCII ``.lay`` layouts: the OA-Bug authors' floor-plan format, read into a :class:`Site`.
+"""Text ``.lay`` layouts: the OA-Bug authors' floor-plan format, read into a :class:`Site`.
 
 One character per grid vertex, 1 cell = 4/15 m (see :mod:`.lattice` for the geometry):
 
 ===========  ================================================================================
 ``%``        wall vertex; straight runs of them are wall lines
 `` ``        free space (corridors, and room interiors in unlabelled plans)
-``A``-``z``  interior of a room in a *labelled* layout, one letter per room (the authors'
-             generator continues past ``Z`` with ``[ \\ ] ^ _ ```` and lower case)
+``A`` and up interior of a room in a *labelled* layout, one letter per room: any printable
+             character from ``A`` on (the authors' generator labels room i with chr(65 + i),
+             so past ``Z`` come ``[ \\ ] ^ _ ```` , lower case and beyond)
 ``0``-``9``  interior of a room holding a victim (labelled layouts)
 ``/``        door to a corridor (labelled); on the outer border: the site's single entrance
 ``#``        door between two rooms (labelled)
@@ -20,7 +21,7 @@ of ``/`` marking the entrance.
 one letter is a room. *Unlabelled* layouts (the authors' building plans) only draw walls;
 rooms are then found as the areas closed off by door gaps: a free vertex between two wall
 vertices of a straight line, with free space on both sides of the line that widens on at
-least one side (REFERENCE_OABUG_SIM.md §3: "a door is a missing vertex in a wall line").
+least one side (in the authors' simulator a door is a missing vertex in a wall line).
 A one-cell-wide room whose door leads into another one-cell-wide room is found merged with
 it, and a one-cell-wide corridor behind a gap counts as a room.
 
@@ -70,7 +71,6 @@ CORRIDOR_DOOR: Final = ord('/')
 ROOM_DOOR: Final = ord('#')
 DEPARTURE: Final = ord('D')
 _LABEL_FIRST: Final = ord('A')
-_LABEL_LAST: Final = ord('z')
 _DIGIT_FIRST: Final = ord('0')
 _DIGIT_LAST: Final = ord('9')
 EDGE_INSET_CELLS: Final = 2.5
@@ -98,7 +98,7 @@ class Layout:
     """A parsed layout.
 
     Attributes:
-        codes: (H, W) uint8 character codes, row 0 = first line of the file (read-only).
+        codes: (H, W) int32 Unicode code points, row 0 = first line of the file (read-only).
         source: where it came from, used in error messages (a file name).
     """
 
@@ -106,7 +106,7 @@ class Layout:
     source: str = '<layout>'
 
     def __post_init__(self) -> None:
-        codes = np.array(self.codes, dtype=np.uint8, copy=True)
+        codes = np.array(self.codes, dtype=np.int32, copy=True)
         if codes.ndim != 2 or codes.shape[0] < 3 or codes.shape[1] < 3:
             raise LayoutError(
                 self.source,
@@ -124,7 +124,7 @@ class Layout:
 
     def to_text(self) -> str:
         """The layout as file text, one line per row, ending with a newline."""
-        return ''.join(bytes(row).decode('ascii') + '\n' for row in self.codes)
+        return ''.join(''.join(map(chr, row.tolist())) + '\n' for row in self.codes)
 
 
 @dataclass(frozen=True)
@@ -145,7 +145,7 @@ class LayoutImport:
 
 
 def _is_label(codes: np.ndarray) -> np.ndarray:
-    return (codes >= _LABEL_FIRST) & (codes <= _LABEL_LAST)
+    return codes >= _LABEL_FIRST
 
 
 def _is_digit(codes: np.ndarray) -> np.ndarray:
@@ -175,12 +175,14 @@ def parse_layout(text: str, source: str = '<layout>') -> Layout:
         for column, char in enumerate(line, start=1):
             code = ord(char)
             known = code in (WALL, FREE, CORRIDOR_DOOR, ROOM_DOOR) or (
-                _LABEL_FIRST <= code <= _LABEL_LAST or _DIGIT_FIRST <= code <= _DIGIT_LAST
+                _DIGIT_FIRST <= code <= _DIGIT_LAST
+                or (code >= _LABEL_FIRST and char.isprintable() and not char.isspace())
             )
             if not known:
                 msg = f'unknown character {char!r}; a layout uses {_KNOWN_CHARACTERS}'
                 raise LayoutError(source, number, column, msg)
-    codes = np.frombuffer(''.join(lines).encode('ascii'), dtype=np.uint8).reshape(len(lines), width)
+    flat = np.frombuffer(''.join(lines).encode('utf-32-le'), dtype='<u4')
+    codes = flat.astype(np.int32).reshape(len(lines), width)
     return Layout(codes, source)
 
 
@@ -188,18 +190,18 @@ def read_layout(path: str | Path) -> Layout:
     """Read and parse a ``.lay`` file."""
     path = Path(path)
     try:
-        text = path.read_text(encoding='ascii')
+        text = path.read_text(encoding='utf-8')
     except UnicodeDecodeError as err:
         before = path.read_bytes()[: err.start]
         line = before.count(b'\n') + 1
         column = err.start - (before.rfind(b'\n') + 1) + 1
-        raise LayoutError(str(path), line, column, 'unknown non-ASCII character') from None
+        raise LayoutError(str(path), line, column, 'the file is not UTF-8 text') from None
     return parse_layout(text, str(path))
 
 
 def write_layout(layout: Layout, path: str | Path) -> None:
     """Write a layout as a ``.lay`` file."""
-    Path(path).write_text(layout.to_text(), encoding='ascii')
+    Path(path).write_text(layout.to_text(), encoding='utf-8')
 
 
 def detect_mode(layout: Layout) -> LayoutMode:

@@ -2,7 +2,7 @@
 
 ROS-free and immutable. Coordinates are metres in the site's world frame: origin at the
 lower-left corner of the site's bounds, x to the right, y up (``docs/conventions.md``). Sites
-come from the generator (:mod:`.generator`), from an ASCII layout (:mod:`.layout`) or from a
+come from the generator (:mod:`.generator`), from a text layout (:mod:`.layout`) or from a
 YAML site file (:mod:`.site_file`); :func:`.validation.validate_site` checks the invariants.
 
 Walls are zero-thickness segments (a simulator gives them whatever thickness its bodies

@@ -6,7 +6,7 @@ Sites drawn on a grid (generated and ``.lay`` sites) are rasterized at their gri
 where the raster is exact because every room edge lies on a grid line. Free-form sites use
 ``DEFAULT_RESOLUTION_M``.
 
-Coverage (REFERENCE_OABUG_SIM.md §4): the authors count a room as visited once the robot's
+Coverage: the authors' simulator counts a room as visited once the robot's
 body reaches a little past the room's wall line. :meth:`RoomLookup.rooms_reached` answers
 that question for a round body by probing the centre and four points ``reach_m`` away along
 the axes (doors are gaps in axis-aligned walls, so a body entering a door is caught by the
