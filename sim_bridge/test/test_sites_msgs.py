@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 from sim_bridge.sites import DeparturePoint, Door, Room, Site, SiteError, generate_site
-from sim_bridge.sites.site_msgs import site_from_msg, site_to_msg
+from sim_bridge.sites.site_msgs import site_from_ros, site_to_ros
 from swarm_runtime.messages import cdr_roundtrip
 
 
@@ -27,12 +27,12 @@ def assert_same_site(a: Site, b: Site) -> None:
 
 def test_a_generated_site_survives_a_cdr_round_trip_unchanged() -> None:
     site = generate_site('small', 6)
-    received = cdr_roundtrip(site_to_msg(site, time_s=12.25, frame_id='world'))
+    received = cdr_roundtrip(site_to_ros(site, time_s=12.25, frame_id='world'))
     assert received.header.stamp.sec == 12
     assert received.header.stamp.nanosec == 250_000_000
     assert received.header.frame_id == 'world'
     assert len(received.rooms) == 30
-    assert_same_site(site_from_msg(received), site)
+    assert_same_site(site_from_ros(received), site)
 
 
 def test_a_free_form_site_without_seed_grid_or_entrance_round_trips() -> None:
@@ -49,25 +49,25 @@ def test_a_free_form_site_without_seed_grid_or_entrance_round_trips() -> None:
         doors=(Door((1.0, 0.0, 1.5, 0.0), ()),),
         departure_points={'center': DeparturePoint('center', 1.5, 1.0)},
     )
-    msg = site_to_msg(site)
+    msg = site_to_ros(site)
     assert msg.seed == -1
     assert msg.grid_m == 0.0
     assert len(msg.entrance) == 0
     assert math.isnan(msg.departure_points[0].heading)
-    again = site_from_msg(cdr_roundtrip(msg))
+    again = site_from_ros(cdr_roundtrip(msg))
     assert_same_site(again, site)
     np.testing.assert_array_equal(again.room(5).polygon, site.room(5).polygon)
 
 
 def test_room_order_in_the_message_is_the_room_index() -> None:
     site = generate_site('small', 2)
-    msg = site_to_msg(site)
+    msg = site_to_ros(site)
     assert [room.id for room in msg.rooms] == list(site.room_ids)
     assert site.room_index(msg.rooms[4].id) == 4
 
 
 def test_a_message_with_a_broken_walls_array_is_rejected() -> None:
-    msg = site_to_msg(generate_site('small', 0))
+    msg = site_to_ros(generate_site('small', 0))
     msg.walls = [0.0, 1.0, 2.0]
     with pytest.raises(SiteError, match='not a multiple of 4'):
-        site_from_msg(msg)
+        site_from_ros(msg)

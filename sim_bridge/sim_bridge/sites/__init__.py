@@ -28,6 +28,7 @@ from sim_bridge.sites.generator import (
 from sim_bridge.sites.layout import Layout, LayoutImport, LayoutMode, import_layout, layout_to_site
 from sim_bridge.sites.model import CELL_M, NO_ROOM, DeparturePoint, Door, Room, Site
 from sim_bridge.sites.room_lookup import RoomLookup
+from sim_bridge.sites.site_file import load_site, save_site
 from sim_bridge.sites.validation import validate_site
 
 __all__ = [
@@ -56,5 +57,7 @@ __all__ = [
     'generate_site',
     'import_layout',
     'layout_to_site',
+    'load_site',
+    'save_site',
     'validate_site',
 ]

@@ -100,7 +100,11 @@ class Door:
             msg = f'a door segment needs four finite coordinates, got {self.segment!r}'
             raise SiteError(msg)
         object.__setattr__(self, 'segment', segment)
-        object.__setattr__(self, 'room_ids', tuple(int(i) for i in self.room_ids))
+        room_ids = tuple(int(i) for i in self.room_ids)
+        if len(room_ids) > 2:
+            msg = f'a door joins at most two rooms, got {room_ids}'
+            raise SiteError(msg)
+        object.__setattr__(self, 'room_ids', room_ids)
 
     @property
     def width_m(self) -> float:

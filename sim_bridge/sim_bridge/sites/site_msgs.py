@@ -18,7 +18,7 @@ from swarm_runtime.ros import message_module
 from sim_bridge.sites.errors import SiteError
 from sim_bridge.sites.model import DeparturePoint, Door, Room, Site
 
-__all__ = ['NO_SEED', 'site_from_msg', 'site_to_msg']
+__all__ = ['NO_SEED', 'site_from_ros', 'site_to_ros']
 
 NO_SEED = -1
 """``seed`` of a site message whose site was not generated."""
@@ -48,7 +48,7 @@ def _door_to_msg(door: Door) -> Any:
     )
 
 
-def site_to_msg(site: Site, *, time_s: float = 0.0, frame_id: str = 'world') -> Any:
+def site_to_ros(site: Site, *, time_s: float = 0.0, frame_id: str = 'world') -> Any:
     """The ``swarm_interfaces/Site`` message of ``site``, stamped ``time_s`` [s] in ``frame_id``."""
     swarm_interfaces = message_module('swarm_interfaces')
     std_msgs = message_module('std_msgs')
@@ -90,7 +90,7 @@ def _door_from_msg(msg: Any) -> Door:
     return Door((msg.x0, msg.y0, msg.x1, msg.y1), tuple(int(i) for i in msg.room_ids))
 
 
-def site_from_msg(msg: Any) -> Site:
+def site_from_ros(msg: Any) -> Site:
     """The site a ``swarm_interfaces/Site`` message describes (structurally checked; run
     :func:`~sim_bridge.sites.validation.validate_site` for the geometric invariants).
 
