@@ -21,8 +21,9 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy.linalg import LinAlgError, cho_solve, cholesky, solve_triangular
-from scipy.linalg.lapack import dpotri
+from scipy.linalg.lapack import dpotri, dtrtri
 from scipy.optimize import minimize
+from scipy.spatial.distance import cdist
 
 from bayes_swarm.errors import GpFitError, ObservationError
 from bayes_swarm.settings import GpConfig
@@ -52,9 +53,7 @@ def se_kernel(a: np.ndarray, b: np.ndarray, hyper: Hyperparameters) -> np.ndarra
 
 
 def _squared_distances(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    diff_x = a[:, 0:1] - b[:, 0][None, :]
-    diff_y = a[:, 1:2] - b[:, 1][None, :]
-    return diff_x * diff_x + diff_y * diff_y
+    return cdist(a, b, 'sqeuclidean')
 
 
 def downsample_indices(n: int, n_max: int, *, floor_rule: bool = False) -> np.ndarray:
@@ -93,6 +92,7 @@ class GaussianProcess:
         self._chol = np.zeros((0, 0))
         self._weights = np.zeros(0)
         self._jitter = 0.0
+        self._chol_inv: np.ndarray | None = None
 
     @property
     def hyperparameters(self) -> Hyperparameters:
@@ -163,6 +163,7 @@ class GaussianProcess:
             self._n_at_last_fit = x.shape[0]
             self._chol, self._jitter = self._factor(x, self._hyper)
         self._weights = cho_solve((self._chol, True), y, check_finite=False)
+        self._chol_inv = None
 
     def _factor(self, x: np.ndarray, hyper: Hyperparameters) -> tuple[np.ndarray, float]:
         """Lower Cholesky factor of K + (noise + jitter) I with escalating jitter."""
@@ -226,7 +227,9 @@ class GaussianProcess:
         q = np.asarray(query_m, dtype=float).reshape(-1, 2)
         k_q = se_kernel(self._x, q, self._hyper)
         mean = k_q.T @ self._weights
-        v = solve_triangular(self._chol, k_q, lower=True, check_finite=False)
+        if self._chol_inv is None:
+            self._chol_inv = _inverse_factor(self._chol)
+        v = self._chol_inv @ k_q
         var = self._hyper.signal_variance - np.einsum('ij,ij->j', v, v)
         return mean, np.sqrt(np.maximum(var, 0.0))
 
@@ -243,6 +246,18 @@ class GaussianProcess:
         grad = (k @ diff) / self._hyper.length_scale_m**2
         return float(k.sum()), grad
 
+    def mean_derivatives(self, points_m: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Posterior mean (s,), its gradient (s, 2) and Hessian (s, 2, 2) at (s, 2) points."""
+        p = np.asarray(points_m, dtype=float).reshape(-1, 2)
+        ell2 = self._hyper.length_scale_m**2
+        kw = se_kernel(p, self._x, self._hyper) * self._weights  # (s, n)
+        diff = self._x[None, :, :] - p[:, None, :]  # (s, n, 2)
+        mean = kw.sum(axis=1)
+        grad = np.einsum('sn,snj->sj', kw, diff) / ell2
+        hess = np.einsum('sn,sni,snj->sij', kw, diff, diff) / (ell2 * ell2)
+        hess -= (mean / ell2)[:, None, None] * np.eye(2)
+        return mean, grad, hess
+
     def extended_std(self, extra_m: np.ndarray) -> ExtendedVariance:
         """Posterior std model conditioned on the data plus (k, 2) extra locations.
 
@@ -258,6 +273,7 @@ class ExtendedVariance:
     def __init__(self, gp: GaussianProcess, extra_m: np.ndarray) -> None:
         hyper = gp.hyperparameters
         self._hyper = hyper
+        self._chol_inv: np.ndarray | None = None
         x = gp._x
         chol = gp._chol
         if extra_m.shape[0] == 0:
@@ -297,10 +313,19 @@ class ExtendedVariance:
     def std(self, query_m: np.ndarray) -> np.ndarray:
         """Posterior std (q,) at (q, 2) query points [m]."""
         q = np.asarray(query_m, dtype=float).reshape(-1, 2)
-        k_q = se_kernel(self._x, q, self._hyper)
-        v = solve_triangular(self._chol, k_q, lower=True, check_finite=False)
+        if self._chol_inv is None:
+            self._chol_inv = _inverse_factor(self._chol)
+        v = self._chol_inv @ se_kernel(self._x, q, self._hyper)
         var = self._hyper.signal_variance - np.einsum('ij,ij->j', v, v)
         return np.sqrt(np.maximum(var, 0.0))
+
+
+def _inverse_factor(chol: np.ndarray) -> np.ndarray:
+    """Inverse of a lower Cholesky factor: std queries then cost one matrix product."""
+    inverse, info = dtrtri(chol, lower=1)
+    if info != 0:
+        return solve_triangular(chol, np.eye(chol.shape[0]), lower=True, check_finite=False)
+    return np.tril(inverse)
 
 
 def _negative_log_likelihood(

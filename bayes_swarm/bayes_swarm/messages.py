@@ -65,6 +65,7 @@ class Decision:
         expected_source_m: (2,) argmax of the GP mean, or None for the first decision.
         n_samples: observations the GP was conditioned on (after downsampling).
         compute_time_s: wall-clock time of the decision [s].
+        cpu_time_s: CPU time of this process during the decision [s] (robust to contention).
         detail: a short reason for fallbacks, empty otherwise.
     """
 
@@ -76,3 +77,4 @@ class Decision:
     n_samples: int = 0
     compute_time_s: float = 0.0
     detail: str = ''
+    cpu_time_s: float = 0.0

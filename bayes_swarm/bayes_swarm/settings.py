@@ -25,6 +25,7 @@ import numpy as np
 from bayes_swarm.errors import ConfigError
 
 __all__ = [
+    'INNER_OPTIMIZERS',
     'OUTER_OPTIMIZERS',
     'Arena',
     'BayesSwarmConfig',
@@ -35,6 +36,7 @@ __all__ = [
 ]
 
 OUTER_OPTIMIZERS = ('grid', 'cobyla', 'pso')
+INNER_OPTIMIZERS = ('newton', 'lbfgsb')
 OuterOptimizer = Literal['grid', 'cobyla', 'pso']
 
 
@@ -149,7 +151,8 @@ class BayesSwarmConfig:
     n_max: int = 1000
     alpha_time_scale: float = 1.0
     outer_optimizer: OuterOptimizer = 'grid'
-    n_candidate_headings: int = 36
+    inner_optimizer: Literal['newton', 'lbfgsb'] = 'newton'
+    n_candidate_headings: int = 24
     n_inner_starts: int = 2
     cobyla_max_iterations: int = 60
     pso_particles: int = 40
@@ -189,6 +192,11 @@ class BayesSwarmConfig:
             self.outer_optimizer in OUTER_OPTIMIZERS,
             f'outer_optimizer must be one of {", ".join(OUTER_OPTIMIZERS)}, '
             f'got {self.outer_optimizer!r}',
+        )
+        _require(
+            self.inner_optimizer in INNER_OPTIMIZERS,
+            f'inner_optimizer must be one of {", ".join(INNER_OPTIMIZERS)}, '
+            f'got {self.inner_optimizer!r}',
         )
         _require(self.n_candidate_headings >= 4, 'n_candidate_headings must be >= 4')
         _require(self.n_inner_starts >= 1, 'n_inner_starts must be >= 1')

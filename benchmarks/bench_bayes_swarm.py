@@ -1,0 +1,367 @@
+"""Bayes-Swarm-P benchmark: tau and decision time on the paper's cases, against the baselines.
+
+Runs the ROS-free batch simulator (:mod:`bayes_swarm.batch_sim`, the same planner objects the
+ROS node uses) over seeded runs and prints one table row per experiment: runs, failures
+(never dropped), tau mean +- std over the successful runs, and the median compute time per
+decision of the robot that found the source (median over its decisions, the first trivial
+one included as in the authors' measurement, then median over runs; 'GP' is the same
+without the first decision; 'CPU' is the process CPU time per decision, which a contended
+machine inflates far less than wall-clock time).
+
+Experiments (``--experiments``, default all):
+
+* main: Case 1 with 5 robots and Case 2 with 10 robots (Bayes-Swarm-P);
+* penalty: Bayes-Swarm-P against -O (Table 5);
+* authors: the authors' code options (inert penalty, origin paths, floor downsampling,
+  alpha on 0.1 T_max, COBYLA) for comparison;
+* baselines: Glowworm, Levy walk and exhaustive search (Table 3);
+* scaling: Case 2 with 5 to 50 robots (Fig. 4);
+* case3: Case 3 with 48 and 100 robots (Table 4);
+* avalanche: the avalanche field, 6 UAVs, without and with noise (Table 8).
+
+Decision timings are wall-clock, one BLAS thread per process. Example::
+
+    python benchmarks/bench_bayes_swarm.py --experiments main --runs 20 --out table.md
+"""
+
+from __future__ import annotations
+
+import os
+
+for _var in ('OMP_NUM_THREADS', 'OPENBLAS_NUM_THREADS', 'MKL_NUM_THREADS'):
+    os.environ.setdefault(_var, '1')
+
+import argparse  # noqa: E402
+import math  # noqa: E402
+import sys  # noqa: E402
+import time  # noqa: E402
+from concurrent.futures import ProcessPoolExecutor  # noqa: E402
+from dataclasses import dataclass, field, replace  # noqa: E402
+from pathlib import Path  # noqa: E402
+from typing import Any  # noqa: E402
+
+import numpy as np  # noqa: E402
+from bayes_swarm.batch_sim import MissionSpec, run_mission  # noqa: E402
+from bayes_swarm.messages import DecisionKind  # noqa: E402
+from bayes_swarm.settings import Arena, BayesSwarmConfig, ExhaustiveConfig  # noqa: E402
+from sim_bridge.signal_fields import get_case  # noqa: E402
+
+EXPERIMENTS = ('main', 'penalty', 'authors', 'baselines', 'scaling', 'case3', 'avalanche')
+AUTHORS_OPTIONS = {
+    'authors_negated_m': True,
+    'authors_origin_paths': True,
+    'authors_floor_downsampling': True,
+    'alpha_time_scale': 0.1,
+    'outer_optimizer': 'cobyla',
+}
+
+
+@dataclass(frozen=True)
+class Job:
+    """One configuration to run over seeds."""
+
+    experiment: str
+    label: str
+    case: str
+    algorithm: str
+    robots: int
+    runs: int
+    planner: dict[str, Any] = field(default_factory=dict)
+    noise_std: float = 0.0
+    max_mission_time_s: float | None = None
+    partition: str = 'strips'
+
+
+@dataclass(frozen=True)
+class RunOutcome:
+    found: bool
+    tau: float
+    median_decision_s: float
+    median_gp_decision_s: float
+    median_cpu_decision_s: float
+    decisions: int
+    wall_s: float
+
+
+def mission_spec(job: Job) -> MissionSpec:
+    """Batch-simulator spec of the job's case with the paper's settings."""
+    case = get_case(job.case)
+    t_max = job.max_mission_time_s or case.max_mission_time_s
+    planner = BayesSwarmConfig(
+        arena=Arena(*case.arena_m),
+        velocity_mps=case.velocity_mps,
+        horizon_s=case.horizon_s,
+        observation_rate_hz=case.observation_rate_hz,
+        detection_radius_m=case.detection_radius_m,
+        max_mission_time_s=t_max,
+        initial_direction_range_deg=case.direction_range_deg,
+        max_signal=case.max_signal,
+        lipschitz=case.lipschitz,
+    )
+    options = dict(job.planner)
+    if job.noise_std > 0.0:
+        options.setdefault('gp', replace(planner.gp, noise_std=job.noise_std))
+    planner = replace(planner, **options)
+    return MissionSpec(
+        field=case.field,
+        source_m=case.source_m,
+        depots_m=case.depots_m,
+        planner=planner,
+        depot_direction_offsets_deg=case.depot_direction_offsets_deg,
+        noise_std=job.noise_std,
+        exhaustive=ExhaustiveConfig(partition=job.partition),
+    )
+
+
+def run_one(job: Job, seed: int) -> RunOutcome:
+    """One seeded run of a job."""
+    start = time.perf_counter()
+    result = run_mission(mission_spec(job), job.algorithm, job.robots, seed)
+    wall = time.perf_counter() - start
+    decisions = result.decisions[result.finder] if result.found else []
+    times = [d.compute_time_s for d in decisions]
+    gp_times = [d.compute_time_s for d in decisions if d.kind is not DecisionKind.FIRST]
+    cpu_times = [d.cpu_time_s for d in decisions]
+    return RunOutcome(
+        found=result.found,
+        tau=result.tau,
+        median_decision_s=float(np.median(times)) if times else math.nan,
+        median_gp_decision_s=float(np.median(gp_times)) if gp_times else math.nan,
+        median_cpu_decision_s=float(np.median(cpu_times)) if cpu_times else math.nan,
+        decisions=sum(len(d) for d in result.decisions),
+        wall_s=wall,
+    )
+
+
+def _run_job(args: tuple[int, Job, int]) -> tuple[int, Job, int, RunOutcome]:
+    index, job, seed = args
+    return index, job, seed, run_one(job, seed)
+
+
+def plan_jobs(experiments: list[str], runs: int, baseline_runs: int, large_runs: int) -> list[Job]:
+    """The jobs of the chosen experiments."""
+    jobs: list[Job] = []
+    if 'main' in experiments:
+        jobs += [
+            Job('main', 'Case 1, 5 robots, Bayes-Swarm-P', 'case1', 'bayes_swarm_p', 5, runs),
+            Job('main', 'Case 2, 10 robots, Bayes-Swarm-P', 'case2', 'bayes_swarm_p', 10, runs),
+        ]
+    if 'penalty' in experiments:
+        jobs += [
+            Job('penalty', 'Case 1, 5 robots, Bayes-Swarm-O', 'case1', 'bayes_swarm_o', 5, runs),
+            Job('penalty', 'Case 2, 10 robots, Bayes-Swarm-O', 'case2', 'bayes_swarm_o', 10, runs),
+        ]
+    if 'authors' in experiments:
+        for case, m in (('case1', 5), ('case2', 10)):
+            jobs.append(
+                Job(
+                    'authors',
+                    f"{case.title()[:-1]} {case[-1]}, {m} robots, authors' options",
+                    case,
+                    'bayes_swarm_p',
+                    m,
+                    runs,
+                    dict(AUTHORS_OPTIONS),
+                )
+            )
+    if 'baselines' in experiments:
+        for case, m in (('case1', 5), ('case2', 10)):
+            name = f'Case {case[-1]}, {m} robots'
+            jobs += [
+                Job('baselines', f'{name}, Glowworm', case, 'glowworm', m, baseline_runs),
+                Job('baselines', f'{name}, Levy walk', case, 'levy', m, baseline_runs),
+                Job(
+                    'baselines',
+                    f'{name}, Levy walk, T_max x30',
+                    case,
+                    'levy',
+                    m,
+                    baseline_runs,
+                    max_mission_time_s=30 * get_case(case).max_mission_time_s,
+                ),
+            ]
+        jobs += [
+            Job(
+                'baselines',
+                'Case 1, 10 robots, exhaustive (quadrants), T_max x30',
+                'case1',
+                'exhaustive',
+                10,
+                1,
+                max_mission_time_s=3000.0,
+                partition='quadrants',
+            ),
+            Job(
+                'baselines',
+                'Case 2, 10 robots, exhaustive (quadrants), T_max x30',
+                'case2',
+                'exhaustive',
+                10,
+                1,
+                max_mission_time_s=30000.0,
+                partition='quadrants',
+            ),
+        ]
+    if 'scaling' in experiments:
+        for m in (5, 10, 20, 30, 40, 50):
+            jobs.append(
+                Job(
+                    'scaling',
+                    f'Case 2, {m} robots, Bayes-Swarm-P',
+                    'case2',
+                    'bayes_swarm_p',
+                    m,
+                    large_runs,
+                )
+            )
+    if 'case3' in experiments:
+        for m in (48, 100):
+            jobs.append(
+                Job(
+                    'case3',
+                    f'Case 3, {m} robots, Bayes-Swarm-P',
+                    'case3',
+                    'bayes_swarm_p',
+                    m,
+                    large_runs,
+                )
+            )
+    if 'avalanche' in experiments:
+        noise = 47.0 / 100.0
+        av = 'Avalanche, 6 UAVs'
+        jobs += [
+            Job(
+                'avalanche', f'{av}, Bayes-Swarm-P', 'avalanche', 'bayes_swarm_p', 6, baseline_runs
+            ),
+            Job('avalanche', f'{av}, Glowworm', 'avalanche', 'glowworm', 6, baseline_runs),
+            Job('avalanche', f'{av}, Levy walk', 'avalanche', 'levy', 6, baseline_runs),
+            Job(
+                'avalanche',
+                f'{av}, exhaustive, T_max x30',
+                'avalanche',
+                'exhaustive',
+                6,
+                1,
+                max_mission_time_s=3000.0,
+            ),
+            Job(
+                'avalanche',
+                f'{av}, noise 0.47, Bayes-Swarm-P',
+                'avalanche',
+                'bayes_swarm_p',
+                6,
+                baseline_runs,
+                noise_std=noise,
+            ),
+            Job(
+                'avalanche',
+                f'{av}, noise 0.47, Glowworm',
+                'avalanche',
+                'glowworm',
+                6,
+                baseline_runs,
+                noise_std=noise,
+            ),
+        ]
+    return jobs
+
+
+def _fmt_ms(values: list[float]) -> str:
+    finite = [v for v in values if math.isfinite(v)]
+    return f'{1e3 * float(np.median(finite)):.1f}' if finite else '-'
+
+
+def summarize(job: Job, outcomes: list[RunOutcome]) -> dict[str, str]:
+    """One table row."""
+    taus = np.array([o.tau for o in outcomes if o.found])
+    fails = sum(not o.found for o in outcomes)
+    tau = f'{taus.mean():.2f} +- {taus.std():.2f}' if taus.size else '-'
+    return {
+        'experiment': job.label,
+        'runs': str(len(outcomes)),
+        'fails': str(fails),
+        'tau': tau,
+        'decision ms': _fmt_ms([o.median_decision_s for o in outcomes]),
+        'GP decision ms': _fmt_ms([o.median_gp_decision_s for o in outcomes]),
+        'CPU decision ms': _fmt_ms([o.median_cpu_decision_s for o in outcomes]),
+        'wall s/run': f'{np.mean([o.wall_s for o in outcomes]):.1f}',
+    }
+
+
+def format_table(rows: list[dict[str, str]]) -> str:
+    """Markdown table of the rows."""
+    if not rows:
+        return ''
+    keys = list(rows[0])
+    lines = ['| ' + ' | '.join(keys) + ' |', '|' + '---|' * len(keys)]
+    lines += ['| ' + ' | '.join(row[k] for k in keys) + ' |' for row in rows]
+    return '\n'.join(lines)
+
+
+def run(
+    experiments: list[str],
+    runs: int = 20,
+    baseline_runs: int = 5,
+    large_runs: int = 3,
+    processes: int = 1,
+    first_seed: int = 0,
+    progress: bool = True,
+) -> list[dict[str, str]]:
+    """Run the experiments and return the table rows (one per job)."""
+    jobs = plan_jobs(experiments, runs, baseline_runs, large_runs)
+    tasks = [(i, job, first_seed + s) for i, job in enumerate(jobs) for s in range(job.runs)]
+    results: list[list[RunOutcome]] = [[] for _ in jobs]
+    if processes > 1:
+        with ProcessPoolExecutor(max_workers=processes) as pool:
+            for index, job, seed, outcome in pool.map(_run_job, tasks):
+                results[index].append(outcome)
+                if progress:
+                    _report(job, seed, outcome)
+    else:
+        for task in tasks:
+            index, job, seed, outcome = _run_job(task)
+            results[index].append(outcome)
+            if progress:
+                _report(job, seed, outcome)
+    return [summarize(job, outcomes) for job, outcomes in zip(jobs, results, strict=True)]
+
+
+def _report(job: Job, seed: int, outcome: RunOutcome) -> None:
+    status = f'tau {outcome.tau:.3f}' if outcome.found else 'not found'
+    print(
+        f'  {job.label} seed {seed}: {status}, median decision '
+        f'{1e3 * outcome.median_decision_s:.1f} ms, wall {outcome.wall_s:.1f} s',
+        file=sys.stderr,
+        flush=True,
+    )
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
+    parser.add_argument('--experiments', nargs='+', choices=EXPERIMENTS, default=list(EXPERIMENTS))
+    parser.add_argument('--runs', type=int, default=20, help='seeds per Bayes-Swarm row')
+    parser.add_argument('--baseline-runs', type=int, default=5, help='seeds per baseline row')
+    parser.add_argument('--large-runs', type=int, default=3, help='seeds per scaling/Case 3 row')
+    parser.add_argument('--processes', type=int, default=1, choices=(1, 2))
+    parser.add_argument('--first-seed', type=int, default=0)
+    parser.add_argument('--out', type=Path, default=None, help='also write the table here')
+    parser.add_argument('--quiet', action='store_true', help='no per-run progress on stderr')
+    args = parser.parse_args(argv)
+    rows = run(
+        args.experiments,
+        runs=args.runs,
+        baseline_runs=args.baseline_runs,
+        large_runs=args.large_runs,
+        processes=args.processes,
+        first_seed=args.first_seed,
+        progress=not args.quiet,
+    )
+    table = format_table(rows)
+    print(table)
+    if args.out is not None:
+        args.out.write_text(table + '\n')
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())
