@@ -107,7 +107,6 @@ class SimBridgeNode(Node):
         n = self.engine.num_robots
         self.robot_names: tuple[str, ...] = tuple(f'r{i}' for i in range(n))
         self.step_listeners: list[Callable[[StepOutput], None]] = []
-        self._yaw_variance = 0.0
 
         self._clock_pub = self.create_publisher(_rosgraph.Clock, '/clock', 10)
         self._poses_pub = self.create_publisher(_swarm.TruePoseArray, '/sim/poses', 10)
@@ -256,39 +255,46 @@ class SimBridgeNode(Node):
         self._clock_pub.publish(conversions.clock_to_ros(t))
         names = self.robot_names
         cfg = self.config
+        # Messages are built only for topics somebody subscribes to (the engine still
+        # computes every reading, so runs do not depend on who listens).
         if out.scans is not None:
             for i, name in enumerate(names):
-                msg = conversions.scan_to_ros(out.scans[i], t, f'{name}/laser', cfg.lidar)
-                self._scan_pubs[i].publish(msg)
+                if self._scan_pubs[i].get_subscription_count():
+                    msg = conversions.scan_to_ros(out.scans[i], t, f'{name}/laser', cfg.lidar)
+                    self._scan_pubs[i].publish(msg)
         if out.gas_raw is not None:
             for i, name in enumerate(names):
-                self._gas_pubs[i].publish(
-                    conversions.gas_to_ros(int(out.gas_raw[i]), t, f'{name}/gas_sensor')
-                )
+                if self._gas_pubs[i].get_subscription_count():
+                    self._gas_pubs[i].publish(
+                        conversions.gas_to_ros(int(out.gas_raw[i]), t, f'{name}/gas_sensor')
+                    )
         if out.bearings is not None:
             for i, name in enumerate(names):
-                self._bearing_pubs[i].publish(
-                    conversions.bearings_to_ros(out.bearings[i], names, t, f'{name}/base_link')
-                )
+                if self._bearing_pubs[i].get_subscription_count():
+                    self._bearing_pubs[i].publish(
+                        conversions.bearings_to_ros(out.bearings[i], names, t, f'{name}/base_link')
+                    )
         if out.imu is not None:
             yaw, rate = out.imu
             density = cfg.imu.noise_density_radps_per_sqrt_hz
             bias = cfg.imu.residual_bias_std_radps
-            self._yaw_variance = density**2 * t + (bias * t) ** 2
+            yaw_variance = density**2 * t + (bias * t) ** 2
             for i, name in enumerate(names):
-                self._imu_pubs[i].publish(
-                    conversions.imu_to_ros(
-                        float(yaw[i]), float(rate[i]), t, f'{name}/imu_link', self._yaw_variance
+                if self._imu_pubs[i].get_subscription_count():
+                    self._imu_pubs[i].publish(
+                        conversions.imu_to_ros(
+                            float(yaw[i]), float(rate[i]), t, f'{name}/imu_link', yaw_variance
+                        )
                     )
-                )
         if out.odometry is not None:
             poses, twists = out.odometry
             for i, name in enumerate(names):
-                self._odom_pubs[i].publish(
-                    conversions.odometry_to_ros(
-                        poses[i], twists[i], t, f'{name}/odom', f'{name}/base_link'
+                if self._odom_pubs[i].get_subscription_count():
+                    self._odom_pubs[i].publish(
+                        conversions.odometry_to_ros(
+                            poses[i], twists[i], t, f'{name}/odom', f'{name}/base_link'
+                        )
                     )
-                )
         if out.ground_truth_due:
             self._poses_pub.publish(conversions.true_poses_to_ros(names, out.poses, t))
         if out.new_room_entries or self.engine.step_index % self._coverage_every == 0:

@@ -66,7 +66,7 @@ class EngineConfig:
         seed: seed of every random draw in the world.
     """
 
-    physics_rate_hz: float = 20.0
+    physics_rate_hz: float = 10.0
     cmd_vel_timeout_s: float = 0.5
     pump_timeout_s: float = 1.0
     pump_offset_m: float = 0.12

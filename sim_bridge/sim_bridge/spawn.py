@@ -62,7 +62,9 @@ class SpawnConfig:
         site_seed: seed of the generated site.
         variant: random, minimum, sound, gas or gas_sound.
         robots: number of robots.
-        departure: 'center' or 'edge'.
+        departure: name of the site's departure point ('center' or 'edge' on generated
+            sites). A point with a heading into the site gets the paper's edge fan (half
+            circle), any other the centre fan (full circle).
         seed: seed of the run (world noise and the fan's random bias).
         actions: max actions per robot; None takes the preset's Table II value (else 1000).
         speed_mps: the robots' cruise speed [m/s].
@@ -90,9 +92,6 @@ class SpawnConfig:
     def __post_init__(self) -> None:
         if self.variant not in VARIANTS:
             msg = f'unknown variant {self.variant!r}; choose one of {", ".join(VARIANTS)}'
-            raise ConfigurationError(msg)
-        if self.departure not in ('center', 'edge'):
-            msg = f"departure must be 'center' or 'edge', got {self.departure!r}"
             raise ConfigurationError(msg)
         if self.robots < 1:
             msg = f'robots must be >= 1, got {self.robots}'
@@ -161,9 +160,13 @@ def _oabug_factory() -> Callable[..., object]:
 def build_mission(config: SpawnConfig) -> tuple[MissionSpec, float]:
     """The mission spec of ``config`` and the heading bias it uses."""
     site = load_site(config.site, seed=config.site_seed)
-    point = site.departure(config.departure)
-    bias = heading_bias_rad(config.departure, point.heading_rad, config.seed)
-    poses = departure_poses(point.xy, config.departure, config.robots, bias)
+    try:
+        point = site.departure(config.departure)
+    except Exception as err:
+        raise ConfigurationError(str(err)) from err
+    fan = 'edge' if point.heading_rad is not None else 'center'
+    bias = heading_bias_rad(fan, point.heading_rad, config.seed)
+    poses = departure_poses(point.xy, fan, config.robots, bias)
     factory = _oabug_factory()
     robots = []
     for i in range(config.robots):
@@ -171,7 +174,7 @@ def build_mission(config: SpawnConfig) -> tuple[MissionSpec, float]:
             'variant': config.variant,
             'robot_index': i,
             'robot_count': config.robots,
-            'departure': config.departure,
+            'departure': fan,
             'heading_bias_deg': math.degrees(bias),
             'forward_speed_mps': float(config.speed_mps),
             'own_tag_id': f'R{i}',
@@ -251,7 +254,7 @@ def run(
     mission = run_mission(spec, progress=progress)
     figures: tuple[Path, ...] = ()
     if config.out_dir is not None:
-        stem = f'oabug_{config.variant}_{config.departure}_{config.site}_s{config.site_seed}'
+        stem = f'oabug_{config.variant}_{config.departure}_{mission.site.name}_seed{config.seed}'
         figures = write_figures(mission, Path(config.out_dir), stem)
     return SpawnResult(config=config, mission=mission, heading_bias_rad=bias, figures=figures)
 
@@ -274,7 +277,9 @@ def _parser() -> argparse.ArgumentParser:
     parser.add_argument('--variant', choices=VARIANTS, default='gas_sound', help='algorithm')
     parser.add_argument('--robots', type=int, default=10, help='number of robots')
     parser.add_argument(
-        '--departure', choices=('center', 'edge'), default='center', help='where robots start'
+        '--departure',
+        default='center',
+        help="the site's departure point: 'center' or 'edge' on generated sites",
     )
     parser.add_argument('--seed', type=int, default=0, help='seed of the run')
     parser.add_argument(

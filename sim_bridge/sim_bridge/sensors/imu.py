@@ -33,7 +33,7 @@ class ImuConfig:
         bias_random_walk_radps_per_sqrt_s: bias drift rate [rad/s/sqrt(s)].
     """
 
-    rate_hz: float = 20.0
+    rate_hz: float = 10.0
     noise_density_radps_per_sqrt_hz: float = math.radians(0.005)
     residual_bias_std_radps: float = 0.0
     bias_random_walk_radps_per_sqrt_s: float = 0.0

@@ -1,0 +1,148 @@
+"""The mission runner and the OA-Bug spawner, end to end on a small fixed site."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from sim_bridge.errors import ConfigurationError
+from sim_bridge.geometry import point_segment_distance
+from sim_bridge.mission import MissionSpec, RobotNodeSpec, StopReason, run_mission
+from sim_bridge.site_loading import load_site
+from swarm_runtime.ros import Node, message_module, qos_profile_sensor_data
+
+FIVE_ROOMS = Path(__file__).parent / 'data' / 'five_rooms.lay'
+geometry_msgs = message_module('geometry_msgs')
+sensor_msgs = message_module('sensor_msgs')
+
+
+class WallBouncer(Node):
+    """Drives straight and turns left in place while anything is close ahead."""
+
+    def __init__(self, **kwargs):
+        super().__init__('bouncer', **kwargs)
+        self._pub = self.create_publisher(geometry_msgs.Twist, 'cmd_vel', 10)
+        self.create_subscription(
+            sensor_msgs.LaserScan, 'scan', self._on_scan, qos_profile_sensor_data
+        )
+        self.scans = 0
+
+    def _on_scan(self, msg):
+        self.scans += 1
+        ranges = np.asarray(msg.ranges)
+        angles = msg.angle_min + msg.angle_increment * np.arange(len(ranges))
+        ahead = np.abs(angles) < np.radians(35.0)
+        blocked = np.nanmin(np.where(ahead, ranges, np.inf)) < 0.45
+        cmd = geometry_msgs.Twist()
+        cmd.linear.x = 0.0 if blocked else 0.3
+        cmd.angular.z = 1.2 if blocked else 0.0
+        self._pub.publish(cmd)
+
+
+class SilentNode(Node):
+    """Publishes one forward command and then nothing: its robot must stop."""
+
+    def __init__(self, **kwargs):
+        super().__init__('silent', **kwargs)
+        self._pub = self.create_publisher(geometry_msgs.Twist, 'cmd_vel', 10)
+        self._timer = self.create_timer(0.1, self._once)
+
+    def _once(self):
+        cmd = geometry_msgs.Twist()
+        cmd.linear.x = 0.3
+        self._pub.publish(cmd)
+        self._timer.cancel()
+
+
+def bouncer_mission(seconds, factory=WallBouncer):
+    site = load_site(str(FIVE_ROOMS))
+    start = np.array([[2.8, 1.73, 0.0], [3.4, 1.73, np.pi]])
+    return MissionSpec(
+        site=site,
+        initial_poses=start,
+        robots=[RobotNodeSpec(factory), RobotNodeSpec(factory)],
+        max_sim_time_s=seconds,
+    )
+
+
+def test_runner_drives_robots_from_their_nodes_without_touching_walls():
+    result = run_mission(bouncer_mission(30.0))
+    assert result.stop_reason == StopReason.BUDGET
+    assert result.sim_time_s == pytest.approx(30.0, abs=0.11)
+    assert np.all(result.distance_travelled_m > 2.0)
+    walls = np.asarray(result.site.sealed_walls).reshape(-1, 2, 2)
+    xy = result.trajectories[:, :, :2].reshape(-1, 2)
+    assert point_segment_distance(xy, walls).min() >= 0.1
+    assert result.trajectories.shape[1:] == (2, 3)
+    _, fraction = result.coverage_curve()
+    assert fraction[-1] == pytest.approx(result.coverage)
+
+
+def test_a_robot_whose_node_falls_silent_stops_within_the_watchdog_timeout():
+    result = run_mission(bouncer_mission(5.0, factory=SilentNode))
+    # One command, then 0.5 s of watchdog grace: about 0.15 m at 0.3 m/s.
+    assert np.all(result.distance_travelled_m < 0.3)
+    assert np.all(result.distance_travelled_m > 0.05)
+
+
+def test_progress_reports_arrive_and_a_predicate_can_stop_the_run():
+    reports = []
+    result = run_mission(
+        bouncer_mission(60.0), progress=reports.append, stop=lambda p: p.sim_time_s >= 10.0
+    )
+    assert result.stop_reason == StopReason.PREDICATE
+    assert result.sim_time_s == pytest.approx(10.0, abs=0.11)
+    assert [round(r.sim_time_s) for r in reports[:2]] == [0, 10]
+
+
+def test_mission_spec_rejects_mismatched_robots_and_poses():
+    site = load_site(str(FIVE_ROOMS))
+    with pytest.raises(ConfigurationError, match='2 robot node specs for 1 start poses'):
+        MissionSpec(site, np.zeros((1, 3)), [RobotNodeSpec(WallBouncer)] * 2, 10.0)
+
+
+@pytest.mark.slow
+def test_oabug_spawner_covers_the_small_site_deterministically(tmp_path):
+    pytest.importorskip('oabug_robot.node')
+    from sim_bridge.spawn import SpawnConfig, run
+
+    def once(out_dir):
+        config = SpawnConfig(
+            site=str(FIVE_ROOMS),
+            departure='edge',
+            robots=3,
+            actions=300,
+            variant='gas_sound',
+            seed=1,
+            out_dir=out_dir,
+        )
+        return run(config)
+
+    first = once(tmp_path)
+    second = once(None)
+    assert first.coverage >= 0.8
+    entries = [(e.room_index, e.robot_index, e.time_s) for e in first.mission.room_entries]
+    assert entries == [(e.room_index, e.robot_index, e.time_s) for e in second.mission.room_entries]
+    assert np.array_equal(first.mission.trajectories, second.mission.trajectories)
+    assert [p.name for p in first.figures] == [
+        'oabug_gas_sound_edge_five_rooms_seed1_paths.png',
+        'oabug_gas_sound_edge_five_rooms_seed1_coverage.png',
+    ]
+    assert all(p.stat().st_size > 1000 for p in first.figures)
+
+
+def test_spawner_help_reads_well(capsys):
+    from sim_bridge.spawn import main
+
+    with pytest.raises(SystemExit) as exit_info:
+        main(['--help'])
+    assert exit_info.value.code == 0
+    text = capsys.readouterr().out
+    for option in ('--site', '--variant', '--robots', '--departure', '--actions', '--record'):
+        assert option in text
+
+
+def test_spawner_reports_bad_input_without_a_traceback(capsys):
+    from sim_bridge.spawn import main
+
+    assert main(['--robots', '0']) == 2
+    assert 'robots must be >= 1' in capsys.readouterr().err
