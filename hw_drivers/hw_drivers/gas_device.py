@@ -43,6 +43,8 @@ from hw_drivers.gas_protocol import (
 from hw_drivers.i2c_transport import SMBusLike, i2c_error
 from hw_drivers.serial_transport import SerialPort
 
+_MAX_OS_POLLS = 50
+
 __all__ = [
     'AdsGasBackend',
     'GasBackend',
@@ -157,13 +159,18 @@ class AdsGasBackend:
         self._write_config(start=True)
         deadline = self._clock() + 10.0 * self.config.conversion_time_s + 0.01
         self._sleep(self.config.conversion_time_s)
-        while True:
+        # Bounded by time and by count, so a clock that does not move cannot hang the loop.
+        for _ in range(_MAX_OS_POLLS):
             word = decode_ads_word(self._read_register(ADS_CONFIG_REGISTER, 'polling OS'))
             if ads_conversion_done(word):
                 break
             if self._clock() > deadline:
-                raise DeviceTimeoutError('ADS1x15 conversion did not complete (OS stayed 0)')
+                break
             self._sleep(self.config.conversion_time_s / 4.0)
+        else:
+            word = 0
+        if not ads_conversion_done(word):
+            raise DeviceTimeoutError('ADS1x15 conversion did not complete (OS stayed 0)')
         data = self._read_register(ADS_CONVERSION_REGISTER, 'reading the conversion')
         return decode_ads_conversion(data, self.config)
 

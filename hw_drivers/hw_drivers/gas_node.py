@@ -145,7 +145,8 @@ class GasNode(Node):
             hat = FakeGroveHat()
             hat.channel_mv[int(self._values['channel'])] = round(FAKE_BACKGROUND_V * 1000)
             return FakeSMBus({self._address: hat})
-        return FakeSMBus({self._address: FakeAds1115(self._device_clock, volts=FAKE_BACKGROUND_V)})
+        chip = FakeAds1115(self._device_clock, volts=FAKE_BACKGROUND_V, conversion_time_s=0.0)
+        return FakeSMBus({self._address: chip})
 
     def _open_port(self) -> SerialPort:
         if self._fake:

@@ -42,7 +42,7 @@ from hw_drivers.node_common import (
     publish_diagnostics,
     seconds_clock,
 )
-from hw_drivers.worker import DeviceWorker, DiagnosticLevel
+from hw_drivers.worker import DeviceWorker
 
 __all__ = ['PARAMETERS', 'Mpu6050Node', 'main']
 
@@ -166,13 +166,12 @@ class Mpu6050Node(Node):
     def _publish_diagnostics(self) -> None:
         now_ns = self.get_clock().now().nanoseconds
         heading = self._heading
-        note = None
+        quiet_reason = ''
         extra = {'calibration_failures': str(heading.calibration_failures)}
-        if not heading.calibrated:
-            text = 'calibrating gyro bias: keep the robot still'
+        if not heading.calibrated and self._poller.worker.connected:
+            quiet_reason = 'calibrating gyro bias: keep the robot still'
             if heading.last_calibration_error:
-                text += f' (last attempt: {heading.last_calibration_error})'
-            note = (DiagnosticLevel.WARN, text)
+                quiet_reason += f' (last attempt: {heading.last_calibration_error})'
         elif heading.integrator is not None:
             extra['gyro_z_bias_dps'] = f'{math.degrees(heading.integrator.bias_radps):.4f}'
             extra['yaw_deg'] = f'{math.degrees(heading.integrator.yaw_rad):.2f}'
@@ -180,7 +179,7 @@ class Mpu6050Node(Node):
         if self._session is not None:
             extra['read_errors'] = str(self._session.read_errors)
             extra['saturations'] = str(self._session.saturations)
-        entry = self._monitor.entry(now_ns, self._poller.worker, extra, note=note)
+        entry = self._monitor.entry(now_ns, self._poller.worker, extra, quiet_reason=quiet_reason)
         publish_diagnostics(self._diag_pub, [entry], now_ns)
 
     def destroy_node(self) -> None:

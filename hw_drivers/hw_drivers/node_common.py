@@ -115,11 +115,18 @@ class DeviceMonitor:
         extra: Mapping[str, str] | None = None,
         *,
         note: tuple[DiagnosticLevel, str] | None = None,
+        quiet_reason: str = '',
     ) -> DiagnosticEntry:
-        """Build the entry: the worst of worker status, staleness and an optional note."""
+        """Build the entry: the worst of worker status, staleness and an optional note.
+
+        ``quiet_reason`` explains an expected silence (e.g. calibration): it is reported as a
+        WARN instead of the stale ERROR.
+        """
         status = worker.status
         level, message = status.level, status.message
-        if self.is_stale(now_ns) and status.level < DiagnosticLevel.ERROR:
+        if quiet_reason and status.level < DiagnosticLevel.ERROR:
+            level, message = DiagnosticLevel.WARN, quiet_reason
+        elif self.is_stale(now_ns) and status.level < DiagnosticLevel.ERROR:
             if self._last_data_ns is None:
                 age = 'no data yet'
             else:

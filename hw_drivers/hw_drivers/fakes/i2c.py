@@ -85,15 +85,22 @@ class FakeAds1115:
     """ADS1115 register semantics: big-endian registers, single-shot with an OS busy bit.
 
     ``volts`` is the voltage on every input; a conversion takes ``conversion_time_s``
-    (default from the written data rate) on the injected clock; ``never_completes`` keeps
-    OS at 0 forever.
+    (default: one period of the written data rate; 0 for instant) on the injected clock;
+    ``never_completes`` keeps OS at 0 forever.
     """
 
     RESET_CONFIG = 0x8583
 
-    def __init__(self, clock: Callable[[], float], *, volts: float = 0.5) -> None:
+    def __init__(
+        self,
+        clock: Callable[[], float],
+        *,
+        volts: float = 0.5,
+        conversion_time_s: float | None = None,
+    ) -> None:
         self._clock = clock
         self.volts = volts
+        self.conversion_time_s = conversion_time_s
         self.config = self.RESET_CONFIG
         self.conversion = 0
         self._done_at_s = -math.inf
@@ -124,7 +131,10 @@ class FakeAds1115:
         self.config = word & 0x7FFF
         if word & 0x8000:
             self.conversions_started += 1
-            self._done_at_s = self._clock() + 1.0 / self._rate_sps()
+            duration_s = self.conversion_time_s
+            if duration_s is None:
+                duration_s = 1.0 / self._rate_sps()
+            self._done_at_s = self._clock() + duration_s
             counts = round(self.volts / self._full_scale_v() * 32768)
             self.conversion = max(-32768, min(32767, counts))
 
