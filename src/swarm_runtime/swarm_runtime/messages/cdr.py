@@ -1,27 +1,35 @@
-"""CDR serialization of generated messages through rosbags' typestore.
+"""CDR serialization of generated messages.
 
-A message is converted to rosbags' own message object (a generated, specialised function per
-type) and serialized by the typestore; decoding goes the other way. When rosbags rejects a
-value (something with the wrong type that got into a message while field checks were off),
-the message is walked field by field to name the culprit in a :class:`SerializationError`.
+Little-endian CDR (what rmw sends on every common host) is encoded and decoded by functions
+generated per type (:mod:`.cdr_codegen`), which produce the same bytes as rosbags'
+typestore. Big-endian data is decoded through rosbags: the message is converted from rosbags'
+own message object. When a value cannot be encoded (something with the wrong type got into a
+message while field checks were off), the message is walked field by field to name the culprit
+in a :class:`SerializationError`.
 """
 
 from __future__ import annotations
 
 import struct
+import sys
 from typing import Any
 
 import numpy as np
 from rosbags.serde import SerdeError
 
+from .cdr_codegen import CdrDecodeError
 from .errors import DeserializationError, SerializationError, UnknownMessageTypeError
 from .fields import FieldSpec
 from .registry import MessageRegistry
 
 __all__ = ['cdr_roundtrip', 'deserialize_cdr', 'message_typename', 'serialize_cdr']
 
-# Exceptions rosbags' generated (de)serializers and our converters raise on bad values.
+# Exceptions the generated encoders and rosbags raise on values they cannot encode.
 _VALUE_ERRORS = (struct.error, TypeError, ValueError, AttributeError, OverflowError, IndexError)
+# Exceptions the generated decoders raise on bytes that are not a valid encoding.
+_DECODE_ERRORS = (struct.error, CdrDecodeError, ValueError, UnicodeDecodeError, IndexError)
+_LITTLE_ENDIAN_HEADER = b'\x00\x01'
+_NATIVE_LITTLE_ENDIAN = sys.byteorder == 'little'
 
 _STRUCT_FORMATS = {
     'bool': '?',
@@ -72,9 +80,13 @@ def serialize_cdr(message: Any, registry: MessageRegistry) -> bytes:
             type, the field path and the offending value.
     """
     typename = message_typename(message)
-    to_rosbags, _ = registry.converters(typename)
     try:
-        return bytes(registry.typestore.serialize_cdr(to_rosbags(message), typename))
+        if _NATIVE_LITTLE_ENDIAN:
+            return registry.cdr_functions(typename).serialize(message)
+        to_rosbags, _ = registry.converters(typename)
+        return bytes(
+            registry.typestore.serialize_cdr(to_rosbags(message), typename, little_endian=True)
+        )
     except (*_VALUE_ERRORS, SerdeError) as err:
         raise _describe_failure(message, typename, registry, err) from err
 
@@ -88,6 +100,14 @@ def deserialize_cdr(
         DeserializationError: the bytes are not a valid CDR encoding of ``typename``.
     """
     full = registry.get_class(typename).__msgtype__
+    if type(data) is not bytes:
+        data = bytes(data)
+    if data[:2] == _LITTLE_ENDIAN_HEADER and len(data) >= 4 and _NATIVE_LITTLE_ENDIAN:
+        try:
+            return registry.cdr_functions(full).deserialize(data)
+        except _DECODE_ERRORS as err:
+            msg = f'cannot decode {len(data)} bytes as {full}: {err}'
+            raise DeserializationError(msg) from err
     _, from_rosbags = registry.converters(full)
     try:
         raw = registry.typestore.deserialize_cdr(data, full)
@@ -104,13 +124,14 @@ def cdr_roundtrip(message: Any, registry: MessageRegistry) -> Any:
     back rounded, arrays come back as fresh ``array.array`` / ``numpy.ndarray`` objects.
     """
     typename = message_typename(message)
-    to_rosbags, from_rosbags = registry.converters(typename)
-    typestore = registry.typestore
+    if not _NATIVE_LITTLE_ENDIAN:
+        return deserialize_cdr(serialize_cdr(message, registry), typename, registry)
+    functions = registry.cdr_functions(typename)
     try:
-        raw = typestore.serialize_cdr(to_rosbags(message), typename)
-    except (*_VALUE_ERRORS, SerdeError) as err:
+        data = functions.serialize(message)
+    except _VALUE_ERRORS as err:
         raise _describe_failure(message, typename, registry, err) from err
-    return from_rosbags(typestore.deserialize_cdr(raw, typename))
+    return functions.deserialize(data)
 
 
 # --------------------------------------------------------------------------- diagnosis

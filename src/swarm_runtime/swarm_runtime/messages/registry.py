@@ -11,6 +11,7 @@ from typing import Any
 
 from rosbags.typesys.store import Typestore
 
+from .cdr_codegen import CdrFunctions, build_cdr_functions
 from .codegen import GeneratedMessage, build_converters, build_message_class
 from .errors import InterfacesNotFoundError, UnknownMessageTypeError, UnknownPackageError
 from .fields import MessageSpec, message_spec, split_typename
@@ -99,6 +100,7 @@ class MessageRegistry:
         self._classes: dict[str, type[GeneratedMessage]] = {}
         self._specs: dict[str, MessageSpec] = {}
         self._converters: dict[str, tuple[Converter, Converter]] = {}
+        self._cdr: dict[str, CdrFunctions] = {}
 
     @property
     def typestore(self) -> Typestore:
@@ -190,6 +192,27 @@ class MessageRegistry:
                 )
                 self._converters[typename] = pair
             return pair
+
+    def cdr_functions(self, typename: str) -> CdrFunctions:
+        """Return the generated CDR encoder and decoder of a full type name."""
+        functions = self._cdr.get(typename)
+        if functions is not None:
+            return functions
+        with self._lock:
+            functions = self._cdr.get(typename)
+            if functions is None:
+                functions = build_cdr_functions(
+                    self.spec(typename),
+                    self.spec,
+                    self.get_class,
+                    self.cdr_functions,
+                    self._package_check_fields,
+                )
+                self._cdr[typename] = functions
+            return functions
+
+    def _package_check_fields(self, typename: str) -> bool:
+        return self.get_module(split_typename(typename)[0]).check_fields
 
 
 def normalize_typename(typename: str) -> str:
