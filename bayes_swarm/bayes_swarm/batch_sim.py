@@ -311,7 +311,7 @@ def _make_agents(
             _LevyAgent(LevyWalk(spec.levy, spec.arena, seed=seeds[i + 1])) for i in range(n_robots)
         ]
     if algorithm == 'exhaustive':
-        spacing = spec.exhaustive.lane_spacing_m or 2.0 * spec.planner.detection_radius_m
+        spacing = spec.exhaustive.spacing_m(spec.planner.detection_radius_m)
         paths = sweep_paths(spec.arena, world.starts, spacing, spec.exhaustive.partition)
         return [_SweepAgent(p) for p in paths]
     agents: list[_Agent] = []

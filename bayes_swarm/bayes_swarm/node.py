@@ -195,7 +195,7 @@ class BayesSwarmNode(Node):
                 strip = partition_arena(
                     s.planner.arena, s.planner.n_robots, s.exhaustive.partition
                 )[s.planner.robot_index]
-                spacing = s.exhaustive.lane_spacing_m or 2.0 * s.planner.detection_radius_m
+                spacing = s.exhaustive.spacing_m(s.planner.detection_radius_m)
                 self._sweep = list(strip_sweep(strip, spacing, position))
             waypoint = self._sweep.pop(0) if self._sweep else position
             decision = Decision(waypoint, self._decisions, DecisionKind.ACQUISITION)

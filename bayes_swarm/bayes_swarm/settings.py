@@ -272,9 +272,10 @@ class LevyConfig:
 class ExhaustiveConfig:
     """Partitioned boustrophedon sweep (ALGORITHM_SPECS.md §4).
 
-    ``lane_spacing_m`` None means 2 * detection radius. ``partition`` is 'strips' (m equal
-    vertical strips) or 'quadrants' (the paper's allocation: robots spread over the four
-    quarters, each quarter cut into equal strips).
+    ``lane_spacing_m`` None means :meth:`spacing_m` of the detection radius: 2 eps, less a
+    hair (0.1 %) so that a source exactly midway between two lanes is still detected.
+    ``partition`` is 'strips' (m equal vertical strips) or 'quadrants' (the paper's
+    allocation: robots spread over the four quarters, each quarter cut into equal strips).
     """
 
     lane_spacing_m: float | None = None
@@ -287,3 +288,7 @@ class ExhaustiveConfig:
             self.partition in ('strips', 'quadrants'),
             f"partition must be 'strips' or 'quadrants', got {self.partition!r}",
         )
+
+    def spacing_m(self, detection_radius_m: float) -> float:
+        """Lane spacing [m] for a detection radius eps [m]."""
+        return self.lane_spacing_m or 2.0 * detection_radius_m * (1.0 - 1e-3)

@@ -162,3 +162,20 @@ def test_reaching_an_expected_source_that_is_not_the_source_marks_it_weaker_and_
 def test_invalid_parameters_are_rejected_with_the_field_named(factory, match):
     with pytest.raises(ConfigError, match=match):
         factory()
+
+
+def test_newton_ascent_finds_the_gp_mean_maximum_found_by_a_dense_grid():
+    from bayes_swarm.gp import GaussianProcess, Hyperparameters
+    from bayes_swarm.planner import ascend_mean
+
+    rng = np.random.default_rng(8)
+    pts = rng.uniform(0, 2.4, size=(60, 2))
+    gp = GaussianProcess(GpConfig())
+    gp.fit(pts, case1_field(pts), hyperparameters=Hyperparameters(0.5, 0.8))
+    arena = Arena(0, 2.4, 0, 2.4)
+    found = ascend_mean(gp, np.array([[0.2, 0.2], [2.3, 0.3], [1.5, 1.5]]), arena)
+    gx, gy = np.meshgrid(np.linspace(0, 2.4, 481), np.linspace(0, 2.4, 481))
+    grid = np.column_stack([gx.ravel(), gy.ravel()])
+    best = grid[np.argmax(gp.predict_mean(grid))]
+    assert np.hypot(*(found - best)) < 0.01
+    assert gp.predict_mean(found[None])[0] >= gp.predict_mean(best[None])[0] - 1e-9
