@@ -10,6 +10,8 @@ from collections import deque
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from scipy import ndimage
 from sim_bridge.sites import (
     CELL_M,
@@ -197,3 +199,26 @@ def test_rooms_are_rectangles_spanning_their_wall_lines() -> None:
         assert np.allclose([x0, y0, x1, y1], np.round([x0, y0, x1, y1]))
         assert x1 - x0 >= 2 - 1e-9
         assert y1 - y0 >= 2 - 1e-9
+
+
+@settings(max_examples=15, deadline=None)
+@given(
+    width=st.integers(10, 90),
+    height=st.integers(10, 60),
+    room_density=st.floats(0.0, 1.0),
+    seed=st.integers(0, 2**32 - 1),
+)
+def test_any_size_gives_a_valid_site_with_exactly_the_rooms_asked_for_or_a_clear_error(
+    width: int, height: int, room_density: float, seed: int
+) -> None:
+    rooms = round(room_density * width * height / 50)
+    config = GeneratorConfig(width, height, rooms=rooms, victims=min(rooms, 3), max_attempts=3)
+    try:
+        site = generate_site(config, seed)
+    except GeneratorError as err:
+        site, failure = None, str(err)
+    if site is None:
+        assert f'of {rooms} rooms' in failure
+    else:
+        assert len(site.rooms) == rooms
+        validate_site(site)
