@@ -236,11 +236,18 @@ class _Reader:
         codes = ''.join(self.run_codes)
         name = self.structs.setdefault(codes, f'_S{len(self.structs)}')
         if self.run_targets:
-            temps = [self.names('v') for _ in self.run_targets]
-            self.lines.append(f'{", ".join(temps)}, = {name}.unpack_from(data, pos)')
-            for temp, (target, base) in zip(temps, self.run_targets, strict=True):
-                value = f'bytes(({temp},))' if base == 'byte' else temp
-                self.lines.append(f'{target} = {value}')
+            # Unpack straight into the slots; octets go through a temporary to become bytes.
+            names = []
+            conversions = []
+            for target, base in self.run_targets:
+                if base == 'byte':
+                    temp = self.names('v')
+                    names.append(temp)
+                    conversions.append(f'{target} = bytes(({temp},))')
+                else:
+                    names.append(target)
+            self.lines.append(f'{", ".join(names)}, = {name}.unpack_from(data, pos)')
+            self.lines.extend(conversions)
         elif self.run_arrays:
             # Nothing to unpack, but the struct call checks that the bytes are there.
             self.lines.append(f'{name}.unpack_from(data, pos)')
