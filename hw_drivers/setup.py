@@ -23,8 +23,9 @@ setup(
         ('share/ament_index/resource_index/packages', [f'resource/{PACKAGE_NAME}']),
         (f'share/{PACKAGE_NAME}', ['package.xml']),
         *share_files('config'),
+        *share_files('bringup'),
     ],
-    install_requires=['numpy', 'pyserial', 'smbus2', 'swarm_runtime'],
+    install_requires=['numpy', 'pyserial', 'smbus2', 'gpiod', 'swarm_runtime'],
     zip_safe=True,
     maintainer='Swarm search maintainers',
     maintainer_email='maintainers@swarm-search.org',
@@ -34,6 +35,14 @@ setup(
     ),
     license='Apache-2.0',
     entry_points={
-        'console_scripts': [],
+        'console_scripts': [
+            'rplidar_node = hw_drivers.rplidar_node:main',
+            'gas_adc_node = hw_drivers.gas_node:main',
+            'mpu6050_node = hw_drivers.mpu6050_node:main',
+            'aoa_receiver_node = hw_drivers.aoa_receiver_node:main',
+            'pump_node = hw_drivers.pump_node:main',
+            'pump_off = hw_drivers.pump_off:main',
+            'robot_bringup = hw_drivers.bringup.cli:main',
+        ],
     },
 )
