@@ -264,6 +264,8 @@ class _Carver:
         return bands
 
     def carve_rooms(self) -> int:
+        """Carve rooms until the requested number stands or no space has a door candidate;
+        return how many were placed."""
         active = list(range(len(self.spaces)))
         while self.placed < self.config.rooms and active:
             pick = int(self.rng.integers(len(active)))
@@ -299,7 +301,13 @@ class _Carver:
         return np.column_stack([rows + r0, cols + c0, dr, dc])
 
     def _carve(self, r: int, c: int, dr: int, dc: int) -> bool:
-        """Grow a room from door (r, c) in direction (dr, dc); False if none fits."""
+        """Grow a room from door (r, c) in direction (dr, dc); False if none fits.
+
+        Works in a frame local to the door: u is the depth from the door's wall line (u = 0)
+        into the solid, v the lateral offset from the door. The room's interior spans
+        u = 1..depth, its wall rectangle u = 0..depth + 1, and every cell of that rectangle
+        must be solid before carving, so the room keeps one wall line to everything else.
+        """
         h, w = self.state.shape
         pr, pc = abs(dc), abs(dr)  # lateral axis
         depth_limit = (h - 1 - r if dr > 0 else r) if dr else (w - 1 - c if dc > 0 else c)
@@ -308,6 +316,7 @@ class _Carver:
         u = np.arange(depth_limit + 1)[:, None]
         v = np.arange(-lateral_neg, lateral_pos + 1)[None, :]
         solid = self.state[r + u * dr + v * pr, c + u * dc + v * pc] == _SOLID
+        # Solid cells from the door line inwards, per lateral offset.
         depth_run = np.where(solid.all(axis=0), solid.shape[0], solid.argmin(axis=0))
         v0 = lateral_neg
         if v0 < 1 or v0 + 1 >= solid.shape[1]:
