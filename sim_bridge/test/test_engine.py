@@ -60,7 +60,8 @@ def test_a_robot_whose_commands_go_stale_stops():
     engine.set_velocity_command(0, 0.3, 0.0)
     run(engine, 2.0)
     # Moved only for the 0.5 s the command stayed fresh.
-    assert engine.world.poses[0, 0] == pytest.approx(1.0 + 0.3 * 0.5, abs=0.3 * 0.05 + 1e-9)
+    dt = engine.config.physics_period_s
+    assert engine.world.poses[0, 0] == pytest.approx(1.0 + 0.3 * 0.5, abs=0.3 * dt + 1e-9)
     assert engine.world.velocities[0, 0] == 0.0
 
 
@@ -86,7 +87,7 @@ def test_a_robot_entering_the_room_is_recorded_as_its_first_visitor():
     assert len(entries) == 1
     assert entries[0].robot_index == 0
     # The disc reaches the room interior at x = 4.03 - 0.1 after 2.93 m at 0.4 m/s.
-    assert entries[0].time_s == pytest.approx(2.93 / 0.4, abs=0.06)
+    assert entries[0].time_s == pytest.approx(2.93 / 0.4, abs=engine.config.physics_period_s)
     assert engine.coverage.complete
 
 
