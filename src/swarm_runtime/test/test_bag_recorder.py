@@ -10,6 +10,7 @@ from swarm_runtime.bag import BagRecorder, TruncatedBagWarning, read_bag_info, r
 from swarm_runtime.ros import (
     Node,
     Parameter,
+    QoSDurabilityPolicy,
     QoSProfile,
     ReliabilityPolicy,
     message_module,
@@ -135,6 +136,26 @@ def test_offered_qos_is_recorded_when_the_runtime_cannot_report_it(
     assert profile.depth == qos_profile_sensor_data.depth
 
 
+def test_latched_topics_declared_in_offered_qos_keep_their_history(
+    ros: None, tmp_path: Path
+) -> None:
+    latched = QoSProfile(depth=1, durability=QoSDurabilityPolicy.TRANSIENT_LOCAL)
+    executor = rclpy.executors.SingleThreadedExecutor()
+    site = Node('site_publisher')
+    site.create_publisher(std_msgs.String, '/sim/site', latched).publish(
+        std_msgs.String(data='site layout')
+    )
+    recorder = BagRecorder(tmp_path / 'bag', topics=['/sim/site'], offered_qos={'/sim/*': latched})
+    executor.add_node(site)
+    executor.add_node(recorder)
+    _spin(executor, 5)
+    recorder.destroy_node()
+    read = list(read_messages(tmp_path / 'bag'))
+    assert [m.message.data for m in read] == ['site layout']
+    (profile,) = read_bag_info(tmp_path / 'bag').topics['/sim/site'].offered_qos_profiles
+    assert profile.durability.name == 'TRANSIENT_LOCAL'
+
+
 def test_subscription_qos_matches_every_offered_profile() -> None:
     reliable = QoSProfile(depth=10)
     best_effort = QoSProfile(depth=5, reliability=ReliabilityPolicy.BEST_EFFORT)
@@ -146,7 +167,7 @@ def test_subscription_qos_matches_every_offered_profile() -> None:
         BagRecorder._subscription_qos([reliable, best_effort]).reliability
         == ReliabilityPolicy.BEST_EFFORT
     )
-    assert BagRecorder._subscription_qos(None).reliability == ReliabilityPolicy.BEST_EFFORT
+    assert BagRecorder._subscription_qos([]).reliability == ReliabilityPolicy.BEST_EFFORT
 
 
 def test_flushed_messages_survive_a_recorder_that_never_closed(ros: None, tmp_path: Path) -> None:

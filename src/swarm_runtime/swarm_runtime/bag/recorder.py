@@ -7,9 +7,10 @@ stamps each message with the node's clock (sim time under ``use_sim_time``).
 
 For each topic it records the QoS profiles the publishers offer (``get_publishers_info_by_topic``)
 and subscribes with a profile that matches all of them (reliable only if every publisher is,
-transient-local only if every publisher is). A runtime that cannot report publisher QoS gets
-a best-effort, volatile subscription, which matches any publisher, and the profiles given in
-``offered_qos`` (or none) are recorded.
+transient-local only if every publisher is, so latched messages published before the recorder
+started are recorded too). Where the runtime cannot report publisher QoS, the profile declared
+for the topic in ``offered_qos`` is used in its place; a topic without one gets a best-effort,
+volatile subscription, which matches any publisher but misses latched history.
 """
 
 from __future__ import annotations
@@ -155,10 +156,11 @@ class BagRecorder(Node):
             self._skipped.add(topic)
             return
         offered = self._publisher_qos(topic)
-        recorded = offered if offered is not None else self._fallback_qos(topic)
+        if offered is None:
+            offered = self._fallback_qos(topic)
         try:
             self._writer.add_topic(
-                topic, typename, offered_qos_profiles=[qos_to_rosbags(q) for q in recorded]
+                topic, typename, offered_qos_profiles=[qos_to_rosbags(q) for q in offered]
             )
         except BagError as err:
             self.get_logger().error(f'not recording {topic}: {err}')
@@ -182,19 +184,20 @@ class BagRecorder(Node):
         return [endpoint.qos_profile for endpoint in endpoints]
 
     def _fallback_qos(self, topic: str) -> list[QoSProfile]:
+        """The profile declared in ``offered_qos`` for ``topic``, if any."""
         for pattern, profile in self._offered_qos.items():
             if fnmatch.fnmatchcase(topic, pattern):
                 return [profile]
         return []
 
     @staticmethod
-    def _subscription_qos(offered: list[QoSProfile] | None) -> QoSProfile:
-        """A profile that matches every offered one (best effort/volatile when unknown)."""
+    def _subscription_qos(offered: list[QoSProfile]) -> QoSProfile:
+        """A profile that matches every offered one (best effort/volatile when none is known)."""
         reliable = bool(offered) and all(
-            q.reliability == ReliabilityPolicy.RELIABLE for q in offered or ()
+            q.reliability == ReliabilityPolicy.RELIABLE for q in offered
         )
         latched = bool(offered) and all(
-            q.durability == QoSDurabilityPolicy.TRANSIENT_LOCAL for q in offered or ()
+            q.durability == QoSDurabilityPolicy.TRANSIENT_LOCAL for q in offered
         )
         return QoSProfile(
             history=HistoryPolicy.KEEP_LAST,
