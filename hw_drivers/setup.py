@@ -42,7 +42,7 @@ setup(
             'aoa_receiver_node = hw_drivers.aoa_receiver_node:main',
             'pump_node = hw_drivers.pump_node:main',
             'pump_off = hw_drivers.pump_off:main',
-            'robot_bringup = hw_drivers.bringup.cli:main',
+            'robot_bringup = hw_drivers.robot_bringup.cli:main',
         ],
     },
 )

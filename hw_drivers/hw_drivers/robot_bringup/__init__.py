@@ -1,0 +1,1 @@
+"""One robot's bringup without launch files (see :mod:`hw_drivers.robot_bringup.cli`)."""
