@@ -27,7 +27,7 @@ from typing import Any, NamedTuple
 
 import yaml
 from rosbags.highlevel import AnyReader, AnyReaderError
-from rosbags.interfaces import Connection, ConnectionExtRosbag2, Nodetype, Qos
+from rosbags.interfaces import Connection, ConnectionExtRosbag2, Qos
 from rosbags.rosbag2 import ReaderError
 from rosbags.rosbag2.metadata import parse_qos
 from rosbags.serde import SerdeError
@@ -41,6 +41,7 @@ from rosbags.typesys import (
 from rosbags.typesys.store import Typestore
 
 from ..messages.errors import MessageError
+from ..messages.fields import referenced_types
 from .errors import BagError, BagNotFoundError, CorruptBagError
 from .mcap_scan import McapScan, ScannedMessage
 
@@ -235,17 +236,6 @@ class _Decoder:
             return None
 
 
-def _referenced_types(fielddefs: Any) -> set[str]:
-    """Names of the message types a rosbags field list refers to."""
-    names = set()
-    for _, (kind, detail) in fielddefs:
-        if kind == Nodetype.NAME:
-            names.add(detail)
-        elif kind in (Nodetype.ARRAY, Nodetype.SEQUENCE) and detail[0][0] == Nodetype.NAME:
-            names.add(detail[0][1])
-    return names
-
-
 def _typestore_from_schemas(schemas: Iterable[tuple[str, str, str]]) -> Typestore:
     """A typestore of the definitions stored in a bag, completed from the Jazzy types."""
     from swarm_runtime.messages.typestore import jazzy_typestore
@@ -263,12 +253,12 @@ def _typestore_from_schemas(schemas: Iterable[tuple[str, str, str]]) -> Typestor
                 if body.strip():
                     types.update(get_types_from_idl(body))
     jazzy = jazzy_typestore().fielddefs
-    missing = {n for defs in types.values() for n in _referenced_types(defs[1])} - types.keys()
+    missing = {n for defs in types.values() for n in referenced_types(defs[1])} - types.keys()
     while missing:
         name = missing.pop()
         if name in jazzy and name not in types:
             types[name] = jazzy[name]
-            missing |= _referenced_types(jazzy[name][1]) - types.keys()
+            missing |= referenced_types(jazzy[name][1]) - types.keys()
     typestore = get_typestore(Stores.EMPTY)
     typestore.register(types)
     return typestore

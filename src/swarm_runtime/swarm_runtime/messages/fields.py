@@ -38,6 +38,7 @@ __all__ = [
     'FieldSpec',
     'MessageSpec',
     'message_spec',
+    'referenced_types',
     'split_typename',
 ]
 
@@ -286,6 +287,17 @@ class MessageSpec:
             if field.element.is_message:
                 seen.setdefault(field.element.nested, None)
         return tuple(seen)
+
+
+def referenced_types(fielddefs: Any) -> set[str]:
+    """Names of the message types a rosbags field list (``fielddefs[name][1]``) refers to."""
+    names = set()
+    for _, (kind, detail) in fielddefs:
+        if kind == Nodetype.NAME:
+            names.add(str(detail))
+        elif kind in (Nodetype.ARRAY, Nodetype.SEQUENCE) and detail[0][0] == Nodetype.NAME:
+            names.add(str(detail[0][1]))
+    return names
 
 
 def _element(desc: tuple[Any, Any], typename: str, field: str) -> ElementSpec:

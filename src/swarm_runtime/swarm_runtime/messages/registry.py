@@ -6,14 +6,18 @@ import os
 import threading
 import types
 from collections.abc import Callable
-from pathlib import Path
 from typing import Any
 
 from rosbags.typesys.store import Typestore
 
 from .cdr_codegen import CdrFunctions, build_cdr_functions
 from .codegen import GeneratedMessage, build_converters, build_message_class
-from .errors import InterfacesNotFoundError, UnknownMessageTypeError, UnknownPackageError
+from .errors import (
+    InterfaceDefinitionError,
+    InterfacesNotFoundError,
+    UnknownMessageTypeError,
+    UnknownPackageError,
+)
 from .fields import MessageSpec, message_spec, split_typename
 from .interface_paths import INTERFACES_PACKAGE, find_interface_msg_dir
 from .typestore import jazzy_typestore, load_msg_directory
@@ -83,16 +87,15 @@ class MessageRegistry:
     def __init__(
         self, typestore: Typestore | None = None, *, check_fields: bool | None = None
     ) -> None:
-        self._interfaces_error: InterfacesNotFoundError | None = None
+        # Why swarm_interfaces is unavailable, if it is: raised when it is asked for, so the
+        # standard types keep working without it.
+        self._interfaces_error: InterfacesNotFoundError | InterfaceDefinitionError | None = None
         if typestore is None:
             typestore = jazzy_typestore()
             try:
-                msg_dir: Path | None = find_interface_msg_dir()
-            except InterfacesNotFoundError as err:
+                load_msg_directory(typestore, find_interface_msg_dir())
+            except (InterfacesNotFoundError, InterfaceDefinitionError) as err:
                 self._interfaces_error = err
-                msg_dir = None
-            if msg_dir is not None:
-                load_msg_directory(typestore, msg_dir)
         self._typestore = typestore
         self._check_fields = check_fields
         self._lock = threading.RLock()
