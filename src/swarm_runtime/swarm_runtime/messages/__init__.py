@@ -11,6 +11,12 @@ under ``ROS_PYTHON_CHECK_FIELDS=1``, ``__eq__``, ``__repr__``, ``get_fields_and_
     scan = sensor_msgs.LaserScan(angle_increment=0.0174)
     received = cdr_roundtrip(scan)   # what another process would receive (float32 rounding)
 
+Field checks follow Jazzy: ``ROS_PYTHON_CHECK_FIELDS=1`` turns them on; it is read once per
+package, when the package's module is first created (rosidl reads it when the generated module
+is imported), and ``check_fields=`` in a constructor overrides it per message. As in rosidl,
+the constructor wraps a numeric sequence in ``array.array`` before checking it (so a numpy
+array is accepted there), while assigning a numpy array to that field fails the check.
+
 Node code does not import this module: it goes through :mod:`swarm_runtime.ros`, which hands
 out the real generated classes on a ROS machine.
 """
