@@ -5,8 +5,10 @@ independent implementation of how it behaves) carves a building out of solid wal
 
 1. a 4-cell-wide cross of corridors through the middle, spanning the whole site;
 2. extra full-length corridors, 2-3 cells wide, placed at random in the remaining bands as
-   long as they keep ``room_min_length_cells + 1`` cells to the band edges (so Small always
-   has one horizontal corridor and 3-5 vertical ones);
+   long as they leave room on both sides for a room of the minimum length and its two wall
+   lines (``room_min_length_cells + 2`` cells). Small thus always has one horizontal
+   corridor and 3-5 vertical ones; Medium 2-3 and 4-6 (rarely 7), Big 3-4 (rarely 5) and
+   6-10, as the authors' generator gives;
 3. the solid blocks between corridors are the *spaces*; rooms are carved into them one at a
    time: pick a space, pick a door cell on a wall with exactly one open neighbour (a
    corridor, or an existing room: a nested room), and grow a rectangle away from that
@@ -73,8 +75,8 @@ class GeneratorConfig:
         cell_m: grid spacing [m], the paper's 4/15 m.
         central_corridor_cells: width of the central corridor cross [cells].
         extra_corridor_cells: (min, max) width of the extra corridors [cells].
-        room_min_length_cells: extra corridors keep this + 1 cells to the edges of the band
-            they split [cells].
+        room_min_length_cells: minimum room length; extra corridors keep this + 2 solid cells
+            (a room and its two wall lines) to the edges of the band they split [cells].
         max_attempts: whole-site attempts before giving up when the rooms do not fit.
         name: configuration name, used in site names.
     """
@@ -246,7 +248,7 @@ class _Carver:
         low = max(1, size // 20)
         high = max(low, size // 10)
         count = int(self.rng.integers(low, high + 1)) - 1
-        margin = self.config.room_min_length_cells + 1
+        margin = self.config.room_min_length_cells + 2  # a shortest room and its wall lines
         min_width, max_width = self.config.extra_corridor_cells
         for _ in range(count):
             width = int(self.rng.integers(min_width, max_width + 1))
