@@ -160,7 +160,7 @@ def test_unwritten_recording_without_footer_is_recovered(tmp_path: Path) -> None
 
 def test_missing_bag_and_wrong_file_kinds_are_reported(tmp_path: Path) -> None:
     with pytest.raises(BagNotFoundError, match='no such bag'):
-        list(read_messages(tmp_path / 'absent'))
+        read_messages(tmp_path / 'absent')  # raised by the call, before any iteration
     text_file = tmp_path / 'notes.txt'
     text_file.write_text('hello')
     with pytest.raises(BagNotFoundError, match='not a bag directory'):

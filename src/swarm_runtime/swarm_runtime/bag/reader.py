@@ -284,16 +284,21 @@ def read_messages(
         raw: Yield the CDR bytes instead of decoding them.
 
     Raises:
-        BagNotFoundError: the bag, its metadata.yaml or a listed file does not exist.
-        CorruptBagError: the bag is damaged (raised at the damage; the messages before it
-            have been yielded).
+        BagNotFoundError: the bag, its metadata.yaml or a listed file does not exist (raised
+            by the call itself).
+        CorruptBagError: the bag is damaged (raised while iterating, at the damage; the
+            messages before it have been yielded).
     """
-    bag_path = Path(path)
-    files = _locate(bag_path)
-    selected = _topic_filter(topics)
+    files = _locate(Path(path))
+    if files.problem is not None and (not allow_truncated or not files.storage_files):
+        raise BagNotFoundError(files.problem)
+    return _iterate(files, _topic_filter(topics), allow_truncated=allow_truncated, raw=raw)
+
+
+def _iterate(
+    files: _BagFiles, selected: Callable[[str], bool], *, allow_truncated: bool, raw: bool
+) -> Iterator[BagMessage]:
     if files.problem is not None:
-        if not allow_truncated or not files.storage_files:
-            raise BagNotFoundError(files.problem)
         _warn(files.problem)
         yield from _scan_files(files.storage_files, selected, raw=raw)
         return
