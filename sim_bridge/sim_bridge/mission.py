@@ -27,7 +27,14 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from swarm_runtime.ros import Parameter, SingleThreadedExecutor, rclpy, using_real_rclpy
+from swarm_runtime.ros import (
+    Parameter,
+    QoSDurabilityPolicy,
+    QoSProfile,
+    SingleThreadedExecutor,
+    rclpy,
+    using_real_rclpy,
+)
 
 from sim_bridge.bridge_node import SimBridgeNode
 from sim_bridge.engine import EngineConfig, StepOutput
@@ -78,10 +85,14 @@ class RecordingSpec:
     Attributes:
         path: the bag directory to create; it must not exist yet.
         topics: absolute topic names to record; None records every topic.
+        latched_topics: topics published once with transient-local durability (the site,
+            the coverage): the recorder subscribes to them transient-local so it gets the
+            message published before it started.
     """
 
     path: Path
     topics: tuple[str, ...] | None = None
+    latched_topics: tuple[str, ...] = ('/sim/site', '/sim/coverage')
 
 
 @dataclass(frozen=True)
@@ -240,7 +251,13 @@ def _make_recorder(recording: RecordingSpec) -> Any:
         msg = f'bag recording needs swarm_runtime.bag: {err}'
         raise MissionError(msg) from err
     topics = list(recording.topics) if recording.topics is not None else None
-    return BagRecorder(recording.path, topics=topics, use_sim_time=True)
+    latched = QoSProfile(depth=1, durability=QoSDurabilityPolicy.TRANSIENT_LOCAL)
+    return BagRecorder(
+        recording.path,
+        topics=topics,
+        offered_qos=dict.fromkeys(recording.latched_topics, latched),
+        use_sim_time=True,
+    )
 
 
 def run_mission(

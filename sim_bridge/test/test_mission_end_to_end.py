@@ -4,38 +4,15 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from sim_bridge.bouncer import WallBouncer
 from sim_bridge.errors import ConfigurationError
 from sim_bridge.geometry import point_segment_distance
 from sim_bridge.mission import MissionSpec, RobotNodeSpec, StopReason, run_mission
 from sim_bridge.site_loading import load_site
-from swarm_runtime.ros import Node, message_module, qos_profile_sensor_data
+from swarm_runtime.ros import Node, message_module
 
 FIVE_ROOMS = Path(__file__).parent / 'data' / 'five_rooms.lay'
 geometry_msgs = message_module('geometry_msgs')
-sensor_msgs = message_module('sensor_msgs')
-
-
-class WallBouncer(Node):
-    """Drives straight and turns left in place while anything is close ahead."""
-
-    def __init__(self, **kwargs):
-        super().__init__('bouncer', **kwargs)
-        self._pub = self.create_publisher(geometry_msgs.Twist, 'cmd_vel', 10)
-        self.create_subscription(
-            sensor_msgs.LaserScan, 'scan', self._on_scan, qos_profile_sensor_data
-        )
-        self.scans = 0
-
-    def _on_scan(self, msg):
-        self.scans += 1
-        ranges = np.asarray(msg.ranges)
-        angles = msg.angle_min + msg.angle_increment * np.arange(len(ranges))
-        ahead = np.abs(angles) < np.radians(35.0)
-        blocked = np.nanmin(np.where(ahead, ranges, np.inf)) < 0.45
-        cmd = geometry_msgs.Twist()
-        cmd.linear.x = 0.0 if blocked else 0.3
-        cmd.angular.z = 1.2 if blocked else 0.0
-        self._pub.publish(cmd)
 
 
 class SilentNode(Node):

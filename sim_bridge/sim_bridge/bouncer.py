@@ -1,0 +1,80 @@
+"""A trivial wall-bouncing controller: the smallest node that drives a simulated robot.
+
+It goes straight at ``speed_mps`` and turns left in place while the lidar sees anything
+closer than ``clearance_m`` within +-35 degrees ahead. It exists to smoke-test the bridge and
+the mission runner without any search algorithm (``ros2 run`` it against the bridge to watch
+a robot move), not to search.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+from swarm_runtime.ros import (
+    ExternalShutdownException,
+    Node,
+    message_module,
+    qos_profile_sensor_data,
+    rclpy,
+)
+
+__all__ = ['WallBouncer', 'main']
+
+_geometry = message_module('geometry_msgs')
+_sensor = message_module('sensor_msgs')
+_rcl = message_module('rcl_interfaces')
+
+
+class WallBouncer(Node):
+    """Drive straight; turn left in place while something is close ahead."""
+
+    def __init__(self, **kwargs: Any) -> None:
+        super().__init__('bouncer', **kwargs)
+        describe = _rcl.ParameterDescriptor
+        self._speed = float(
+            self.declare_parameter('speed_mps', 0.3, describe(description='Speed [m/s].')).value
+        )
+        self._turn = float(
+            self.declare_parameter(
+                'turn_rate_radps', 1.2, describe(description='Turn rate [rad/s].')
+            ).value
+        )
+        self._clearance = float(
+            self.declare_parameter(
+                'clearance_m', 0.45, describe(description='Turn when closer ahead [m].')
+            ).value
+        )
+        self._pub = self.create_publisher(_geometry.Twist, 'cmd_vel', 10)
+        self.create_subscription(_sensor.LaserScan, 'scan', self._on_scan, qos_profile_sensor_data)
+
+    def _on_scan(self, msg: Any) -> None:
+        ranges = np.asarray(msg.ranges, dtype=float)
+        angles = msg.angle_min + msg.angle_increment * np.arange(len(ranges))
+        ahead = np.abs(np.mod(angles + math.pi, 2 * math.pi) - math.pi) < math.radians(35.0)
+        close = ranges[ahead & np.isfinite(ranges)]
+        blocked = bool(close.size and close.min() < self._clearance)
+        cmd = _geometry.Twist()
+        cmd.linear.x = 0.0 if blocked else self._speed
+        cmd.angular.z = self._turn if blocked else 0.0
+        self._pub.publish(cmd)
+
+
+def main(args: list[str] | None = None) -> None:
+    """Entry point: ``python -m sim_bridge.bouncer --ros-args -r __ns:=/r0``."""
+    rclpy.init(args=args)
+    node = None
+    try:
+        node = WallBouncer()
+        rclpy.spin(node)
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        if node is not None:
+            node.destroy_node()
+        rclpy.try_shutdown()
+
+
+if __name__ == '__main__':
+    main()
