@@ -29,7 +29,6 @@ import yaml
 from rosbags.highlevel import AnyReader, AnyReaderError
 from rosbags.interfaces import Connection, ConnectionExtRosbag2, Qos
 from rosbags.rosbag2 import ReaderError
-from rosbags.rosbag2.metadata import parse_qos
 from rosbags.serde import SerdeError
 from rosbags.typesys import (
     Stores,
@@ -434,8 +433,3 @@ def _summary(connection: Connection, previous: TopicSummary | None) -> TopicSumm
     return TopicSummary(
         connection.topic, connection.msgtype, connection.msgcount, connection.digest, qos
     )
-
-
-def parse_offered_qos(text: str) -> list[Qos]:
-    """Parse an ``offered_qos_profiles`` string as stored in an MCAP channel's metadata."""
-    return parse_qos(text)

@@ -17,7 +17,6 @@ from typing import Any
 import numpy as np
 
 __all__ = [
-    'MISSING',
     'all_instances',
     'array_from_numpy',
     'arrays_equal',
@@ -32,17 +31,6 @@ __all__ = [
     'sequence_repr',
 ]
 
-
-class _Missing:
-    """Marker for a constructor keyword that was not given."""
-
-    __slots__ = ()
-
-    def __repr__(self) -> str:
-        return '<missing>'
-
-
-MISSING: Any = _Missing()
 
 _PLAIN_SEQUENCES = (list, tuple)
 _SEQUENCE_ABCS = (Sequence, Set, UserList)
