@@ -16,7 +16,10 @@ Choices where the paper is silent or inconsistent (see docs/bayes_swarm.md):
 * Avalanche: the beacon lies flat (moment along world x) ``depth_m`` = 2 m below the UAVs'
   sensing plane at (20, 20); the moment is scaled so that the maximum |H| directly above the
   beacon is the paper's 47. The depot is the corner (0, 0), which gives the paper's
-  t_idealized = 56.57 s at 0.5 m/s.
+  t_idealized = 56.57 s at 0.5 m/s. The penalty uses M = 47 and L = 20, the largest gradient
+  of this field (Sec. 2.5: L = max |grad f|). The paper's L = 2 with M = 47 would exclude a
+  ball of radius (M - mu) / L ~ 23 m around every peer's waypoint, i.e. the whole reachable
+  area; it did not matter in the authors' code only because their penalty is inert.
 """
 
 from __future__ import annotations
@@ -230,7 +233,7 @@ def _avalanche() -> SignalCase:
         detection_radius_m=0.15,
         max_mission_time_s=100.0,
         max_signal=47.0,
-        lipschitz=2.0,
+        lipschitz=20.0,  # max |grad f| of this field; see the module docstring
         direction_range_deg=90.0,
         observation_rate_hz=0.5,
         default_robots=6,
