@@ -255,6 +255,15 @@ def plan_jobs(experiments: list[str], runs: int, baseline_runs: int, large_runs:
             ),
             Job(
                 'avalanche',
+                f'{av}, noise 0.47, Bayes-Swarm-O',
+                'avalanche',
+                'bayes_swarm_o',
+                6,
+                baseline_runs,
+                noise_std=noise,
+            ),
+            Job(
+                'avalanche',
                 f'{av}, noise 0.47, Glowworm',
                 'avalanche',
                 'glowworm',
