@@ -113,3 +113,20 @@ def test_walls_outside_the_bounds_are_rejected() -> None:
     with pytest.raises(SiteValidationError, match='leaves the site bounds') as info:
         validate_site(box_site(walls=[*OUTER_WALLS, *ROOM_WALLS, (1.0, 1.0, 5.0, 1.0)]))
     assert info.value.key_path == ('walls', len(OUTER_WALLS) + len(ROOM_WALLS))
+
+
+def test_a_door_narrower_than_the_robot_is_rejected() -> None:
+    doors = (Door((2.5, 1.9, 2.5, 2.05), (1,)),)
+    with pytest.raises(
+        SiteValidationError, match=r'door at .* is 0\.150 m wide, narrower than a robot'
+    ) as info:
+        validate_site(box_site(doors=doors))
+    assert info.value.key_path == ('doors', 0)
+
+
+def test_an_entrance_that_is_not_a_gap_in_the_enclosure_is_rejected() -> None:
+    walls = [(0.0, 0.0, 4.0, 0.0), *OUTER_WALLS[2:], *ROOM_WALLS]
+    with pytest.raises(
+        SiteValidationError, match=r'the entrance at \(2\.000, 0\.000\) m is not a gap'
+    ):
+        validate_site(box_site(walls=walls))

@@ -1,10 +1,13 @@
 """Invariants every site must hold, checked the same way for generated, imported and loaded
 sites.
 
-1. Walls and rooms lie within the bounds; rooms do not overlap.
-2. Every departure point has a robot's clearance from every wall (it is not inside a wall).
+1. Walls and rooms lie within the bounds; rooms do not overlap; doors name existing rooms
+   and are at least as wide as a robot.
+2. Every departure point has a robot's clearance from every wall (it is not inside a wall)
+   and is not walled into a pocket too small to move in.
 3. The enclosure is closed except for the entrance: with the entrance sealed, no departure
-   point can reach the outside of the bounds.
+   point can reach the outside of the bounds; with it open, they can (the entrance is a gap
+   in the enclosure).
 4. Every room is reachable from every departure point through its doors; a room that cannot
    be reached and is named by no door is reported as a room with no door.
 
@@ -23,7 +26,7 @@ import numpy as np
 from scipy import ndimage
 
 from sim_bridge.sites.errors import SiteValidationError
-from sim_bridge.sites.model import NO_ROOM, Site
+from sim_bridge.sites.model import NO_ROOM, Door, Site
 
 __all__ = [
     'DEFAULT_ROBOT_RADIUS_M',
@@ -139,6 +142,7 @@ def validate_site(site: Site, *, robot_radius_m: float = DEFAULT_ROBOT_RADIUS_M)
                     f'less than the robot radius {robot_radius_m} m'
                 )
                 raise SiteValidationError(msg, position_m=point.xy, key_path=key_path)
+    _check_door_widths(site, robot_radius_m)
     lookup = site.room_lookup  # raises on overlapping rooms
     raster = free_space_raster(site, sealed=True)
     ring = np.unique(
@@ -150,6 +154,9 @@ def validate_site(site: Site, *, robot_radius_m: float = DEFAULT_ROBOT_RADIUS_M)
     for name, point in site.departure_points.items():
         x, y = point.xy
         label = raster.label_at(point.xy)
+        if label == 0:
+            msg = f'departure point {name!r} at ({x:.3f}, {y:.3f}) m is inside a wall'
+            raise SiteValidationError(msg, position_m=point.xy, key_path=('departure_points', name))
         if label in ring:
             where = _leak_position(raster, label, site, point.xy)
             msg = (
@@ -179,6 +186,35 @@ def validate_site(site: Site, *, robot_radius_m: float = DEFAULT_ROBOT_RADIUS_M)
                 problem = f'is not reachable from departure point {name!r}'
             msg = f'{named} at ({lx:.3f}, {ly:.3f}) m {problem}'
             raise SiteValidationError(msg, position_m=(lx, ly), key_path=('rooms', index))
+    if site.entrance is not None:
+        _check_entrance_opens(site, site.entrance)
+
+
+def _check_door_widths(site: Site, robot_radius_m: float) -> None:
+    doors = [(('doors', i), door, 'door') for i, door in enumerate(site.doors)]
+    if site.entrance is not None:
+        doors.append((('entrance',), site.entrance, 'the entrance'))
+    for key_path, door, what in doors:
+        if door.width_m < 2 * robot_radius_m:
+            x, y = door.midpoint
+            msg = (
+                f'{what} at ({x:.3f}, {y:.3f}) m is {door.width_m:.3f} m wide, narrower than a '
+                f'robot ({2 * robot_radius_m:.3f} m)'
+            )
+            raise SiteValidationError(msg, position_m=door.midpoint, key_path=key_path)
+
+
+def _check_entrance_opens(site: Site, entrance: Door) -> None:
+    """With the entrance open, the inside must reach the outside: the entrance is a gap in
+    the enclosure, not a segment somewhere else."""
+    raster = free_space_raster(site, sealed=False)
+    labels = raster.labels
+    ring = set(np.concatenate([labels[0], labels[-1], labels[:, 0], labels[:, -1]]).tolist())
+    point = next(iter(site.departure_points.values()))
+    if raster.label_at(point.xy) not in ring:
+        x, y = entrance.midpoint
+        msg = f'the entrance at ({x:.3f}, {y:.3f}) m is not a gap in the enclosure'
+        raise SiteValidationError(msg, position_m=(x, y), key_path=('entrance',))
 
 
 def _check_within_bounds(site: Site) -> None:
