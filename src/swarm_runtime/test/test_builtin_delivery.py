@@ -21,7 +21,7 @@ from swarm_runtime.builtin.qos import (
     qos_profile_system_default,
 )
 from swarm_runtime.messages import get_message_module, serialize_cdr
-from swarm_runtime.simulation import spin_ready
+from swarm_runtime.simulation import sim_time_s, spin_ready
 
 from swarm_runtime import builtin as rclpy
 
@@ -315,3 +315,13 @@ def test_destroyed_subscription_gets_no_queued_messages(executor) -> None:
     executor.add_node(node)
     spin_ready(executor)
     assert received == []
+
+
+def test_a_clock_topic_of_another_type_is_just_a_topic(executor) -> None:
+    node = Node('odd')
+    received = recorder(node, std_msgs.String, '/clock', 10)
+    node.create_publisher(std_msgs.String, '/clock', 10).publish(std_msgs.String(data='tick'))
+    executor.add_node(node)
+    spin_ready(executor)
+    assert [m.data for m in received] == ['tick']
+    assert sim_time_s() is None

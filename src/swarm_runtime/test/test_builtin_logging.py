@@ -87,3 +87,11 @@ def test_child_loggers_extend_the_name_and_levels_are_hierarchical(init, caplog)
     assert not child.is_enabled_for(LoggingSeverity.WARN)
     assert child.is_enabled_for(LoggingSeverity.FATAL)
     parent.set_level(LoggingSeverity.UNSET)
+
+
+def test_log_can_name_another_logger(init, caplog) -> None:
+    rclpy.init(args=['prog'])
+    logger = Node('algo').get_logger()
+    with caplog.at_level(logging.INFO):
+        assert logger.log('elsewhere', LoggingSeverity.INFO, name='algo.planner')
+    assert [r.name for r in caplog.records] == ['ros.algo.planner']

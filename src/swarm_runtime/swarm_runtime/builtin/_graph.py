@@ -36,6 +36,7 @@ __all__ = [
 ]
 
 CLOCK_TOPIC = '/clock'
+CLOCK_TYPE = 'rosgraph_msgs/msg/Clock'
 
 
 def _copy(qos: QoSProfile) -> QoSProfile:

@@ -142,7 +142,7 @@ class RcutilsLogger:
 
         Keyword options (rclpy's): ``throttle_duration_sec`` (with optional
         ``throttle_time_source_type``, a Clock; default the system clock), ``skip_first``,
-        ``once``.
+        ``once``, and ``name`` to log under another logger name.
 
         Raises:
             TypeError: an unknown option, or a message that is not a str.
@@ -156,13 +156,17 @@ class RcutilsLogger:
             msg = f'log message must be a str, got {type(message).__name__}'
             raise TypeError(msg)
         severity = LoggingSeverity(severity)
-        if not self._logger.isEnabledFor(severity):
+        logger = self._logger
+        if options and 'name' in options:
+            options = dict(options)
+            logger = _python_logger(options.pop('name'))
+        if not logger.isEnabledFor(severity):
             return False
         if options:
             caller = sys._getframe(2)
             if not self._passes_filters((caller.f_code, caller.f_lasti), severity, options):
                 return False
-        self._logger.log(severity, message, stacklevel=3)
+        logger.log(severity, message, stacklevel=3)
         return True
 
     def _passes_filters(

@@ -15,7 +15,7 @@ from collections import deque
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
-from ._graph import CLOCK_TOPIC, effective_publisher_qos, queue_depth
+from ._graph import CLOCK_TOPIC, CLOCK_TYPE, effective_publisher_qos, queue_depth
 from ._messages import cdr_codec, cdr_roundtrip_enabled
 from .clock import SYSTEM_EPOCH_NS
 from .duration import Duration
@@ -70,7 +70,7 @@ class Publisher:
         # wants MessageInfo), so that publish() reads everything from one tuple.
         self._targets: tuple[tuple[Subscription, deque[Any], int, bool, bool], ...] = ()
         self._needs_bytes = self._roundtrip
-        self._is_clock = self._topic_name == CLOCK_TOPIC
+        self._is_clock = self._topic_name == CLOCK_TOPIC and self._typename == CLOCK_TYPE
         self._sequence = 0
         self._alive = True
         self._history: deque[Any] | None = None
