@@ -92,6 +92,8 @@ class RPLidarConfig:
         reset_settle_s: pause after RESET before flushing [s].
         spin_up_s: pause between motor start and SCAN [s].
         read_chunk_bytes: most bytes read per poll.
+        min_read_bytes: bytes asked for per poll even when fewer are waiting; the port's read
+            timeout bounds the wait, and larger reads keep the per-call decoding cost low.
         stall_timeout_s: no revolution for this long restarts the scan [s].
         max_reject_ratio: rejected bytes / received bytes over one second that restarts the scan.
         max_backlog_bytes: input backlog beyond which unread data is dropped.
@@ -106,6 +108,7 @@ class RPLidarConfig:
     reset_settle_s: float = 2.0
     spin_up_s: float = 1.0
     read_chunk_bytes: int = 4096
+    min_read_bytes: int = 512
     stall_timeout_s: float = 1.0
     max_reject_ratio: float = 0.01
     max_backlog_bytes: int = 4000
@@ -279,7 +282,7 @@ class RPLidarSession:
             self.assembler.reset()
             self.dropped_backlogs += 1
             waiting = 0
-        data = port.read(min(max(waiting, 1), config.read_chunk_bytes))
+        data = port.read(min(max(waiting, config.min_read_bytes), config.read_chunk_bytes))
         now = self._clock()
         produced = False
         if data:

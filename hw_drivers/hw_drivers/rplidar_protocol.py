@@ -48,6 +48,8 @@ RESPONSE_SYNC = (0xA5, 0x5A)
 DESCRIPTOR_SIZE = 7
 SAMPLE_SIZE = 5
 ANGLE_Q6_FULL_TURN = 360 * 64
+_EMPTY = np.zeros(0, dtype=np.uint8)
+_RESYNC_WINDOW = 64
 
 
 class Command(IntEnum):
@@ -221,13 +223,14 @@ def _valid_offsets(buf: npt.NDArray[np.uint8]) -> npt.NDArray[np.bool_]:
 def decode_samples(frames: npt.NDArray[np.uint8]) -> ScanSamples:
     """Decode an (N, 5) array of already validated sample bytes."""
     b0 = frames[:, 0]
-    angle_q6 = (frames[:, 1] >> 1).astype(np.uint16) | (frames[:, 2].astype(np.uint16) << 7)
-    distance_q2 = frames[:, 3].astype(np.uint16) | (frames[:, 4].astype(np.uint16) << 8)
+    wide = frames.astype(np.uint16)
+    angle_q6 = (wide[:, 1] >> 1) | (wide[:, 2] << 7)
+    distance_q2 = wide[:, 3] | (wide[:, 4] << 8)
     return ScanSamples(
         start=(b0 & 1).astype(bool),
-        quality=(b0 >> 2).astype(np.uint8),
-        angle_deg=angle_q6 / 64.0,
-        distance_mm=distance_q2 / 4.0,
+        quality=b0 >> 2,
+        angle_deg=angle_q6 * (1.0 / 64.0),
+        distance_mm=distance_q2 * 0.25,
     )
 
 
@@ -241,13 +244,13 @@ class SampleStreamDecoder:
     """
 
     def __init__(self) -> None:
-        self._pending = np.zeros(0, dtype=np.uint8)
+        self._pending = _EMPTY
         self.accepted_samples = 0
         self.rejected_bytes = 0
 
     def reset(self) -> None:
         """Forget buffered bytes (after a flush of the port); counters are kept."""
-        self._pending = np.zeros(0, dtype=np.uint8)
+        self._pending = _EMPTY
 
     def feed(self, data: bytes) -> ScanSamples:
         """Decode all complete samples in the pending bytes plus ``data``."""
@@ -255,27 +258,30 @@ class SampleStreamDecoder:
         buf = np.concatenate((self._pending, incoming)) if self._pending.size else incoming
         valid = _valid_offsets(buf)
         n_offsets = valid.shape[0]
-        starts: list[npt.NDArray[np.intp]] = []
+        runs: list[npt.NDArray[np.uint8]] = []
         pos = 0
         while pos < n_offsets:
             chain = valid[pos::SAMPLE_SIZE]
             bad = np.flatnonzero(~chain)
             run = int(bad[0]) if bad.size else chain.shape[0]
             if run:
-                starts.append(pos + SAMPLE_SIZE * np.arange(run, dtype=np.intp))
+                # A run of aligned valid samples is a contiguous block: reshape, no copy.
+                runs.append(buf[pos : pos + SAMPLE_SIZE * run].reshape(run, SAMPLE_SIZE))
                 pos += SAMPLE_SIZE * run
                 continue
-            later = np.flatnonzero(valid[pos + 1 :])
-            skip = int(later[0]) + 1 if later.size else n_offsets - pos
+            # Look for the next plausible offset in a short window (cost independent of the
+            # buffer size); an all-junk window is skipped as a whole.
+            window = valid[pos + 1 : pos + 1 + _RESYNC_WINDOW]
+            later = np.flatnonzero(window)
+            skip = int(later[0]) + 1 if later.size else window.shape[0] + 1
             self.rejected_bytes += skip
             pos += skip
         # Every offset with 5 bytes left was taken or skipped: at most 4 bytes remain.
-        self._pending = buf[pos:].copy() if pos < buf.shape[0] else np.zeros(0, dtype=np.uint8)
-        if not starts:
+        self._pending = buf[pos:].copy() if pos < buf.shape[0] else _EMPTY
+        if not runs:
             return decode_samples(np.zeros((0, SAMPLE_SIZE), dtype=np.uint8))
-        index = np.concatenate(starts)
-        self.accepted_samples += int(index.shape[0])
-        frames = buf[index[:, None] + np.arange(SAMPLE_SIZE)]
+        frames = runs[0] if len(runs) == 1 else np.concatenate(runs)
+        self.accepted_samples += int(frames.shape[0])
         return decode_samples(frames)
 
 
