@@ -334,3 +334,25 @@ def test_parameter_type_inference_matches_rclpy() -> None:
         Parameter.Type.from_parameter_value([1, 'a'])
     with pytest.raises(ValueError, match='do not agree'):
         Parameter('x', Parameter.Type.DOUBLE, 1)
+
+
+def test_params_file_node_keys_may_be_nested_by_namespace(init, tmp_path) -> None:
+    params = write_params(
+        tmp_path,
+        """
+/r1:
+  algo:
+    ros__parameters:
+      rate_hz: 4.0
+/*:
+  algo:
+    ros__parameters:
+      gain: 2.0
+""",
+    )
+    start('--params-file', params)
+    node = Node('algo', namespace='r1')
+    assert node.declare_parameter('rate_hz', 10.0).value == 4.0
+    assert node.declare_parameter('gain', 1.0).value == 2.0
+    deeper = Node('algo', namespace='/a/b')
+    assert deeper.declare_parameter('gain', 1.0).value == 1.0

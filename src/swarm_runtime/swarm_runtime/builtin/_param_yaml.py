@@ -177,8 +177,32 @@ def _flatten(node_key: str, prefix: str, node: yaml.Node, where: str) -> list[Pa
     return entries
 
 
+def _node_entries(path_key: str, body: yaml.Node, where: str) -> list[ParameterFileEntry]:
+    """Entries under one key: ``ros__parameters`` here, or nested namespace/node keys."""
+    sections = _mapping_items(body, where)
+    keys = [key for key, _ in sections]
+    if 'ros__parameters' in keys:
+        others = [key for key in keys if key != 'ros__parameters']
+        if others:
+            msg = f'{where}: only ros__parameters may appear under a node, found {others}'
+            raise ParameterValueError(msg)
+        return _flatten(path_key, '', dict(sections)['ros__parameters'], f'{where}.ros__parameters')
+    entries: list[ParameterFileEntry] = []
+    for key, nested in sections:
+        if not isinstance(nested, yaml.MappingNode):
+            msg = f"{where}.{key}: a node entry needs a 'ros__parameters' map"
+            raise ParameterValueError(msg)
+        entries.extend(
+            _node_entries(f'{path_key.rstrip("/")}/{key.strip("/")}', nested, f'{where}.{key}')
+        )
+    return entries
+
+
 def load_parameter_file(path: str | Path) -> list[ParameterFileEntry]:
     """Read a ROS 2 parameter file (``<node key>: {ros__parameters: {...}}``).
+
+    Node keys may also be nested by namespace (``/r1: {algo: {ros__parameters: ...}}`` is
+    ``/r1/algo``), as rcl allows.
 
     Returns:
         The entries in file order.
@@ -201,12 +225,8 @@ def load_parameter_file(path: str | Path) -> list[ParameterFileEntry]:
         return []
     entries: list[ParameterFileEntry] = []
     for node_key, body in _mapping_items(root, str(path)):
-        where = f'{path}: {node_key}'
-        sections = dict(_mapping_items(body, where))
-        if 'ros__parameters' not in sections:
-            msg = f"{where}: a node entry needs a 'ros__parameters' map"
+        if not isinstance(body, yaml.MappingNode):
+            msg = f"{path}: {node_key}: a node entry needs a 'ros__parameters' map"
             raise ParameterValueError(msg)
-        entries.extend(
-            _flatten(node_key, '', sections['ros__parameters'], f'{where}.ros__parameters')
-        )
+        entries.extend(_node_entries(node_key, body, f'{path}: {node_key}'))
     return entries
