@@ -213,6 +213,7 @@ class OABugNode(Node):
         self._gas_time_s: float | None = None
         self._bearings: PeerBearings | None = None
         self._last_warning_s: dict[str, float] = {}
+        self._heard: set[str] = set()
 
         self._cmd_pub = self.create_publisher(geometry_msgs.Twist, 'cmd_vel', 10)
         self._pump_pub = self.create_publisher(std_msgs.Bool, 'pump', 10)
@@ -239,13 +240,16 @@ class OABugNode(Node):
     def _now_s(self) -> float:
         return self.get_clock().now().nanoseconds * 1e-9
 
-    def _warn(self, key: str, text: str) -> None:
-        """Log a warning at most once per WARN_PERIOD_S for each key."""
+    def _log_once_per_period(self, key: str, text: str, *, warn: bool = True) -> None:
+        """Log ``text`` at most once per WARN_PERIOD_S for each key (warning or info)."""
         now = self._now_s()
         last = self._last_warning_s.get(key)
         if last is None or now - last >= WARN_PERIOD_S or now < last:
             self._last_warning_s[key] = now
-            self.get_logger().warning(text)
+            if warn:
+                self.get_logger().warning(text)
+            else:
+                self.get_logger().info(text)
 
     # Sensor callbacks: store the latest value and when it arrived (node clock).
 
@@ -257,13 +261,15 @@ class OABugNode(Node):
         try:
             self._yaw_rad = yaw_from_imu(msg)
         except ValueError as err:
-            self._warn('imu', f'ignoring IMU message: {err}')
+            self._log_once_per_period('imu', f'ignoring IMU message: {err}')
             return
         self._imu_time_s = self._now_s()
+        self._heard.add('imu')
 
     def _on_gas(self, msg: Any) -> None:
         self._gas_raw = gas_from_ros(msg)
         self._gas_time_s = self._now_s()
+        self._heard.add('gas')
 
     def _on_bearings(self, msg: Any) -> None:
         yaw = self._yaw_rad if math.isfinite(self._yaw_rad) else 0.0
@@ -301,9 +307,10 @@ class OABugNode(Node):
         try:
             self._features = self._extractor.extract(scan_from_ros(msg), *self._near_peers(now_s))
         except ScanError as err:
-            self._warn('scan', f'ignoring laser scan: {err}')
+            self._log_once_per_period('scan', f'ignoring laser scan: {err}')
             return
         self._features_time_s = scan_time
+        self._heard.add('scan')
 
     def _on_control(self) -> None:
         now_s = self._now_s()
@@ -331,10 +338,16 @@ class OABugNode(Node):
         self._cmd_pub.publish(stop_twist())
         self._pump_pub.publish(command_to_pump(False))
         self._publish_state(now_s, pump_on=False, stale=True)
-        self._warn(
-            'stale',
-            f'holding still, no fresh {", ".join(stale)} within {self._stale_timeout_s:.2f} s',
-        )
+        never = [name for name in stale if name not in self._heard]
+        if never:
+            self._log_once_per_period(
+                'waiting', f'waiting for the first {", ".join(never)} message', warn=False
+            )
+        else:
+            self._log_once_per_period(
+                'stale',
+                f'holding still, no fresh {", ".join(stale)} within {self._stale_timeout_s:.2f} s',
+            )
 
     def _publish_state(self, now_s: float, *, pump_on: bool, stale: bool) -> None:
         self._state_pub.publish(
