@@ -118,3 +118,11 @@ def test_room_bounding_rects_follow_the_room_order() -> None:
         site.room_bounding_rects, [[0.0, 0.0, 2.0, 1.0], [3.0, 1.0, 3.5, 2.0]]
     )
     assert make_box_site(rooms=()).room_bounding_rects.shape == (0, 4)
+
+
+def test_a_site_prints_as_a_short_summary() -> None:
+    text = repr(make_box_site())
+    assert text == (
+        "Site('box', 4.00 x 3.00 m, 1 rooms, 1 doors, 8 walls, entrance=yes, "
+        'departure points: center, edge, seed=None)'
+    )

@@ -203,7 +203,7 @@ class Room:
         return (float(centre[0]), float(centre[1]))
 
 
-@dataclass(frozen=True, eq=False)
+@dataclass(frozen=True, eq=False, repr=False)
 class Site:
     """A building to search: enclosure and inner walls, rooms, doors, departure points.
 
@@ -279,6 +279,15 @@ class Site:
             object.__setattr__(self, 'grid_m', grid)
         if self.seed is not None:
             object.__setattr__(self, 'seed', int(self.seed))
+
+    def __repr__(self) -> str:
+        points = ', '.join(self.departure_points)
+        return (
+            f'Site({self.name!r}, {self.width_m:.2f} x {self.height_m:.2f} m, '
+            f'{len(self.rooms)} rooms, {len(self.doors)} doors, {len(self.walls)} walls, '
+            f'entrance={"yes" if self.entrance else "no"}, departure points: {points}, '
+            f'seed={self.seed})'
+        )
 
     @property
     def bounds(self) -> tuple[float, float, float, float]:
