@@ -213,7 +213,7 @@ class GaussianProcess:
                 jac=True,
                 method='L-BFGS-B',
                 bounds=bounds,
-                options={'maxiter': 60},
+                options={'maxiter': 40, 'ftol': 1e-7},
             )
             if np.isfinite(result.fun) and (best is None or result.fun < best[0]):
                 best = (float(result.fun), result.x)

@@ -388,7 +388,7 @@ def _negated_mean(x: np.ndarray, gp: GaussianProcess) -> tuple[float, np.ndarray
 
 
 def ascend_mean(
-    gp: GaussianProcess, seeds_m: np.ndarray, arena: Arena, max_iterations: int = 40
+    gp: GaussianProcess, seeds_m: np.ndarray, arena: Arena, max_iterations: int = 25
 ) -> np.ndarray:
     """Eq. 5 from several starts at once: projected trust-region Newton ascent of the GP mean.
 
@@ -585,10 +585,10 @@ class _OuterProblem:
             candidate = self._refine(best)
         if not self._feasible(best):
             best = cfg.arena.clip(self.position)
-        if (
-            np.all(np.isfinite(candidate))
-            and self._feasible(candidate)
-            and self.values(candidate)[0] >= self.values(best)[0]
-        ):
+        if not (np.all(np.isfinite(candidate)) and self._feasible(candidate)):
+            return best
+        if cfg.outer_optimizer == 'grid':
+            return candidate  # the pattern search only ever accepts improvements
+        if self.values(candidate)[0] >= self.values(best)[0]:
             return candidate
         return best
