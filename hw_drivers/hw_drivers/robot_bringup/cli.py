@@ -166,8 +166,7 @@ def run(options: BringupOptions, *, dry_run: bool = False, grace_s: float = 5.0)
     def on_signal(signum: int, _frame: object) -> None:
         stop['signal'] = signum
 
-    signal.signal(signal.SIGTERM, on_signal)
-    signal.signal(signal.SIGINT, on_signal)
+    previous = {sig: signal.signal(sig, on_signal) for sig in (signal.SIGTERM, signal.SIGINT)}
     status = 0
     try:
         for spec in plan:
@@ -184,6 +183,8 @@ def run(options: BringupOptions, *, dry_run: bool = False, grace_s: float = 5.0)
             time.sleep(0.2)
     finally:
         _stop_all(children, grace_s)
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
     return status
 
 

@@ -1,0 +1,77 @@
+"""robot_bringup: what it starts, in which order, and how it stops."""
+
+import signal
+import sys
+
+import yaml
+from hw_drivers.robot_bringup import cli
+from hw_drivers.robot_bringup.cli import BringupOptions, ChildSpec, build_plan, driver_parameters
+
+
+def test_pump_starts_first_and_oabug_last_after_the_locator():
+    plan = build_plan(BringupOptions(robot='r3', locator_command='locator -s 127.0.0.1:8080'))
+    names = [spec.name for spec in plan]
+    assert names[0] == 'pump_node'
+    assert names[-1] == 'oabug'
+    assert names.index('aoa_receiver_node') < names.index('aoa_locator')
+
+
+def test_every_child_runs_in_the_robot_namespace_with_the_simulator_frames():
+    plan = build_plan(BringupOptions(robot='r3', own_tag_id='C3', launcher='ros2'))
+    commands = {spec.name: ' '.join(spec.command) for spec in plan}
+    assert all('__ns:=/r3' in command for command in commands.values())
+    assert commands['rplidar_node'].startswith('ros2 run hw_drivers rplidar_node')
+    assert 'frame_id:=r3/laser' in commands['rplidar_node']
+    assert 'frame_id:=r3/imu_link' in commands['mpu6050_node']
+    assert 'own_tag_id:=C3' in commands['aoa_receiver_node']
+    assert 'own_tag_id:=C3' in commands['oabug']
+
+
+def test_fake_mode_switches_every_device_driver_to_its_simulated_device():
+    params = driver_parameters('r0', fake=True)
+    assert all(params[name]['fake_device'] for name in ('pump_node', 'rplidar_node'))
+    assert 'fake_device' not in params['aoa_receiver_node']  # it has no device to fake
+
+
+def test_dry_run_prints_the_commands(capsys):
+    assert cli.run(BringupOptions(launcher='python'), dry_run=True) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert len(lines) == 6
+    assert lines[0].split()[1:3] == ['-m', 'hw_drivers.pump_node']
+
+
+def test_a_dying_child_stops_the_others_and_fails_the_bringup(monkeypatch, tmp_path):
+    marker = tmp_path / 'stopped'
+    sleeper = (
+        'import signal, sys, time\n'
+        f'signal.signal(signal.SIGINT, lambda *a: (open({str(marker)!r}, "w").close(), '
+        'sys.exit(0)))\n'
+        'time.sleep(30)\n'
+    )
+    plan = [
+        ChildSpec('long_running', (sys.executable, '-c', sleeper), settle_s=0.5),
+        ChildSpec('crashing', (sys.executable, '-c', 'raise SystemExit(4)')),
+    ]
+    monkeypatch.setattr(cli, 'build_plan', lambda options: plan)
+    handler_before = signal.getsignal(signal.SIGINT)
+    assert cli.run(BringupOptions(), grace_s=5.0) == 1
+    assert marker.exists()
+    assert (
+        signal.getsignal(signal.SIGINT) is handler_before
+    )  # the survivor got SIGINT and shut down cleanly
+
+
+def test_example_parameter_file_names_real_parameters():
+    tables = {
+        'rplidar_node': rplidar_node.PARAMETERS,
+        'gas_adc_node': gas_node.PARAMETERS,
+        'mpu6050_node': mpu6050_node.PARAMETERS,
+        'aoa_receiver_node': aoa_receiver_node.PARAMETERS,
+        'pump_node': pump_node.PARAMETERS,
+    }
+    path = Path(__file__).resolve().parents[1] / 'bringup' / 'r0.params.example.yaml'
+    document = yaml.safe_load(path.read_text())
+    for key, section in document.items():
+        node = key.removeprefix('/**/')
+        names = {name for name, _, _ in tables[node]}
+        assert set(section['ros__parameters']) <= names, node
