@@ -367,7 +367,8 @@ class _SiteBuilder:
                 what = 'a gap' if code == FREE else f'{chr(code)!r}'
                 msg = (
                     f'the enclosure is open: the outer wall has {what} here; the first and last '
-                    "lines and columns must be '%', except one run of '/' marking the entrance"
+                    "lines and columns must be '%', except one run of '/' marking the entrance "
+                    "(fill the outside of a building that is not rectangular with '%')"
                 )
                 raise self.error(row, col, msg)
         if len(runs) > 1:
