@@ -2,10 +2,13 @@
 
 import signal
 import sys
+from pathlib import Path
 
 import yaml
 from hw_drivers.robot_bringup import cli
 from hw_drivers.robot_bringup.cli import BringupOptions, ChildSpec, build_plan, driver_parameters
+
+from hw_drivers import aoa_receiver_node, gas_node, mpu6050_node, pump_node, rplidar_node
 
 
 def test_pump_starts_first_and_oabug_last_after_the_locator():
@@ -55,7 +58,7 @@ def test_a_dying_child_stops_the_others_and_fails_the_bringup(monkeypatch, tmp_p
     monkeypatch.setattr(cli, 'build_plan', lambda options: plan)
     handler_before = signal.getsignal(signal.SIGINT)
     assert cli.run(BringupOptions(), grace_s=5.0) == 1
-    assert marker.exists()
+    assert marker.exists()  # the survivor got SIGINT and shut down cleanly
     assert (
         signal.getsignal(signal.SIGINT) is handler_before
     )  # the survivor got SIGINT and shut down cleanly
