@@ -188,10 +188,6 @@ class Clock:
     def _now_ns(self) -> int:
         return self._offset_ns + self._time_context()._elapsed_ns
 
-    def _is_wall_driven(self) -> bool:
-        """True when this clock moves with the virtual wall clock (not with /clock)."""
-        return True
-
     def now(self) -> Time:
         """Return the current time of this clock."""
         return Time._from_ns(self._now_ns(), self._clock_type)
@@ -274,9 +270,6 @@ class ROSClock(Clock):
         if self._ros_active:
             return self._ros_ns
         return self._offset_ns + self._time_context()._elapsed_ns
-
-    def _is_wall_driven(self) -> bool:
-        return not self._ros_active
 
     def _schedule_timer(self, timer: Timer) -> None:
         if not self._ros_active:

@@ -23,7 +23,6 @@ from .exceptions import (
     InvalidHandle,
     InvalidParameterTypeException,
     InvalidParameterValueException,
-    InvalidTopicNameException,
     NotInitializedException,
     ParameterAlreadyDeclaredException,
     ParameterImmutableException,
@@ -315,14 +314,12 @@ class Node:
         validate_full_topic_name(remapped)
         return remapped
 
-    def _resolve_or_raise(self, topic: str) -> str:
+    def _resolve_entity_topic(self, topic: str) -> str:
+        """Resolve the topic of a new publisher or subscription (TypeError if not a str)."""
         if not isinstance(topic, str):
             msg = f'topic name must be a str, got {type(topic).__name__}'
             raise TypeError(msg)
-        try:
-            return self.resolve_topic_name(topic)
-        except InvalidTopicNameException as err:
-            raise err from None
+        return self.resolve_topic_name(topic)
 
     @staticmethod
     def _validate_qos_or_depth_parameter(qos_or_depth: QoSProfile | int) -> QoSProfile:
@@ -364,7 +361,7 @@ class Node:
         """
         self._check_alive()
         qos = self._validate_qos_or_depth_parameter(qos_profile)
-        topic_name = self._resolve_or_raise(topic)
+        topic_name = self._resolve_entity_topic(topic)
         self._reject_qos_overriding(qos_overriding_options)
         implementation = PublisherImpl(self, topic_name, message_typename(msg_type))
         publisher = publisher_class(
@@ -400,7 +397,7 @@ class Node:
         """
         self._check_alive()
         qos = self._validate_qos_or_depth_parameter(qos_profile)
-        topic_name = self._resolve_or_raise(topic)
+        topic_name = self._resolve_entity_topic(topic)
         self._reject_qos_overriding(qos_overriding_options)
         implementation = SubscriptionImpl(self, topic_name, message_typename(msg_type))
         subscription = Subscription(
