@@ -78,3 +78,16 @@ def test_example_parameter_file_names_real_parameters():
         node = key.removeprefix('/**/')
         names = {name for name, _, _ in tables[node]}
         assert set(section['ros__parameters']) <= names, node
+
+
+def test_the_locator_is_respawned_alone(monkeypatch, tmp_path):
+    runs = tmp_path / 'runs'
+    runs.mkdir()
+    locator = f'import pathlib, uuid; (pathlib.Path({str(runs)!r}) / uuid.uuid4().hex).touch()'
+    plan = [
+        ChildSpec('aoa_locator', (sys.executable, '-c', locator), respawn=True),
+        ChildSpec('crashing_later', (sys.executable, '-c', 'import time; time.sleep(3)')),
+    ]
+    monkeypatch.setattr(cli, 'build_plan', lambda options: plan)
+    assert cli.run(BringupOptions(), grace_s=2.0, respawn_delay_s=0.1) == 1
+    assert len(list(runs.iterdir())) >= 2

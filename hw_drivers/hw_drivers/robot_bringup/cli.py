@@ -6,7 +6,8 @@ and AoA receiver drivers, optionally the locator host binary (after the AoA rece
 listening), and the OA-Bug node, all in the robot's namespace with frame ids that match the
 simulator's (``r0/laser``, ``r0/imu_link``, ...). If any child exits, the others are stopped
 (SIGINT, then SIGTERM, then SIGKILL) and the bringup exits non-zero, so systemd's
-``Restart=on-failure`` restarts the robot as a whole. ``--dry-run`` prints the commands.
+``Restart=on-failure`` restarts the robot as a whole; only the locator host, which exits by
+design whenever its connection ends, is restarted alone. ``--dry-run`` prints the commands.
 
 Children are started with ``ros2 run`` on a ROS machine, or with ``python -m`` where ``ros2``
 is missing (``--launcher`` chooses explicitly).
@@ -15,6 +16,7 @@ is missing (``--launcher`` chooses explicitly).
 from __future__ import annotations
 
 import argparse
+import shlex
 import shutil
 import signal
 import subprocess
@@ -40,11 +42,12 @@ DRIVERS = ('pump_node', 'rplidar_node', 'gas_adc_node', 'mpu6050_node', 'aoa_rec
 
 @dataclass(frozen=True)
 class ChildSpec:
-    """One process of the bringup."""
+    """One process of the bringup; ``respawn`` restarts it alone when it exits."""
 
     name: str
     command: tuple[str, ...]
     settle_s: float = 0.0
+    respawn: bool = False
 
 
 @dataclass(frozen=True)
@@ -124,7 +127,9 @@ def build_plan(options: BringupOptions) -> list[ChildSpec]:
         for name in DRIVERS
     ]
     if options.locator_command:
-        plan.append(ChildSpec('aoa_locator', tuple(options.locator_command.split()), 0.5))
+        # The authors' locator exits whenever its TCP connection ends: respawn it alone.
+        command = tuple(shlex.split(options.locator_command))
+        plan.append(ChildSpec('aoa_locator', command, settle_s=0.5, respawn=True))
     if options.with_oabug:
         oabug_params = {
             'variant': options.variant,
@@ -153,7 +158,13 @@ def _stop_all(children: Sequence[tuple[ChildSpec, subprocess.Popen]], grace_s: f
             process.wait()
 
 
-def run(options: BringupOptions, *, dry_run: bool = False, grace_s: float = 5.0) -> int:
+def run(
+    options: BringupOptions,
+    *,
+    dry_run: bool = False,
+    grace_s: float = 5.0,
+    respawn_delay_s: float = 2.0,
+) -> int:
     """Start the plan and supervise it; return the exit status for the process."""
     plan = build_plan(options)
     if dry_run:
@@ -174,12 +185,17 @@ def run(options: BringupOptions, *, dry_run: bool = False, grace_s: float = 5.0)
             children.append((spec, subprocess.Popen(spec.command)))
             time.sleep(spec.settle_s)
         while not stop['signal']:
-            exited = [(spec, p) for spec, p in children if p.poll() is not None]
-            if exited:
-                spec, process = exited[0]
+            exited = [(i, spec, p) for i, (spec, p) in enumerate(children) if p.poll() is not None]
+            fatal = [(spec, p) for _, spec, p in exited if not spec.respawn]
+            if fatal:
+                spec, process = fatal[0]
                 print(f'{spec.name} exited with status {process.returncode}; stopping', flush=True)
                 status = 1
                 break
+            for index, spec, process in exited:
+                print(f'{spec.name} exited ({process.returncode}); restarting it', flush=True)
+                time.sleep(respawn_delay_s)
+                children[index] = (spec, subprocess.Popen(spec.command))
             time.sleep(0.2)
     finally:
         _stop_all(children, grace_s)
