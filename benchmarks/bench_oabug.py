@@ -1,0 +1,209 @@
+"""OA-Bug benchmark: coverage of the five Table I variants on generated sites, and throughput.
+
+Runs every (site, variant, departure) combination through the full simulation (sim bridge +
+OA-Bug nodes on the built-in runtime), one run per worker process at a time, and prints the
+mean +- std coverage beside the authors' simulator measured on this project's machines
+(REFERENCE_OABUG_SIM.md §5), plus wall seconds per run and robot-metres simulated per wall
+second. Example (the Small sweep of the closing note, 20 sites, both cores)::
+
+    python benchmarks/bench_oabug.py --config small --sites 20 --workers 2 --out small.md
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import multiprocessing
+import time
+from collections import defaultdict
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+VARIANTS = ('random', 'minimum', 'sound', 'gas', 'gas_sound')
+DEPARTURES = ('center', 'edge')
+
+# Authors' simulator, 100 Small / 20 Medium sites, 10 robots: mean +- std coverage [%].
+REFERENCE = {
+    'small': {
+        ('center', 'random'): (15.53, 6.17),
+        ('center', 'minimum'): (28.17, 7.53),
+        ('center', 'sound'): (33.20, 7.70),
+        ('center', 'gas'): (96.07, 7.14),
+        ('center', 'gas_sound'): (96.27, 5.40),
+        ('edge', 'random'): (8.10, 4.99),
+        ('edge', 'minimum'): (20.33, 7.36),
+        ('edge', 'sound'): (25.57, 9.76),
+        ('edge', 'gas'): (84.17, 21.07),
+        ('edge', 'gas_sound'): (95.43, 6.64),
+    },
+    'medium': {
+        ('center', 'random'): (14.00, 4.52),
+        ('center', 'minimum'): (17.25, 4.63),
+        ('center', 'sound'): (19.25, 4.55),
+        ('center', 'gas'): (93.75, 5.62),
+        ('center', 'gas_sound'): (92.25, 4.51),
+        ('edge', 'random'): (10.75, 3.63),
+        ('edge', 'minimum'): (13.50, 5.05),
+        ('edge', 'sound'): (13.83, 6.28),
+        ('edge', 'gas'): (74.75, 27.09),
+        ('edge', 'gas_sound'): (88.25, 6.66),
+    },
+}
+
+
+@dataclass(frozen=True)
+class Job:
+    """One simulated run."""
+
+    config: str
+    site_seed: int
+    variant: str
+    departure: str
+    robots: int
+    actions: int | None
+    speed_mps: float
+
+
+@dataclass(frozen=True)
+class Outcome:
+    """What one run produced."""
+
+    job: Job
+    coverage: float
+    sim_time_s: float
+    wall_time_s: float
+    robot_metres: float
+
+
+def run_job(job: Job) -> Outcome:
+    """Run one job headless (called in a worker process)."""
+    from sim_bridge.spawn import SpawnConfig, run
+
+    config = SpawnConfig(
+        site=job.config,
+        site_seed=job.site_seed,
+        variant=job.variant,
+        robots=job.robots,
+        departure=job.departure,
+        seed=job.site_seed,
+        actions=job.actions,
+        speed_mps=job.speed_mps,
+    )
+    start = time.perf_counter()
+    result = run(config)
+    wall = time.perf_counter() - start
+    return Outcome(
+        job=job,
+        coverage=result.coverage,
+        sim_time_s=result.mission.sim_time_s,
+        wall_time_s=wall,
+        robot_metres=float(result.mission.distance_travelled_m.sum()),
+    )
+
+
+def _mean_std(values: Sequence[float]) -> tuple[float, float]:
+    n = len(values)
+    mean = sum(values) / n
+    return mean, math.sqrt(sum((v - mean) ** 2 for v in values) / n)
+
+
+def format_table(outcomes: Sequence[Outcome], config: str) -> str:
+    """Markdown table of coverage (mean +- population std over sites) and throughput."""
+    groups: dict[tuple[str, str], list[Outcome]] = defaultdict(list)
+    for o in outcomes:
+        groups[(o.job.departure, o.job.variant)].append(o)
+    reference = REFERENCE.get(config, {})
+    lines = [
+        "| departure | variant | runs | coverage % (this suite) | authors' simulator % "
+        '| full coverage runs | wall s/run | robot-m per wall s |',
+        '|---|---|---|---|---|---|---|---|',
+    ]
+    for departure in DEPARTURES:
+        for variant in VARIANTS:
+            runs = groups.get((departure, variant))
+            if not runs:
+                continue
+            mean, std = _mean_std([100.0 * o.coverage for o in runs])
+            ref = reference.get((departure, variant))
+            ref_text = f'{ref[0]:.1f} +- {ref[1]:.1f}' if ref else 'n/a'
+            full = sum(o.coverage >= 1.0 for o in runs)
+            wall = sum(o.wall_time_s for o in runs) / len(runs)
+            metres = sum(o.robot_metres for o in runs) / sum(o.wall_time_s for o in runs)
+            lines.append(
+                f'| {departure} | {variant} | {len(runs)} | {mean:.1f} +- {std:.1f} | {ref_text} '
+                f'| {full} | {wall:.1f} | {metres:.0f} |'
+            )
+    return '\n'.join(lines)
+
+
+def run(
+    *,
+    config: str = 'small',
+    sites: int = 20,
+    first_site_seed: int = 0,
+    variants: Sequence[str] = VARIANTS,
+    departures: Sequence[str] = DEPARTURES,
+    robots: int = 10,
+    actions: int | None = None,
+    speed_mps: float = 0.3,
+    workers: int = 2,
+) -> tuple[list[Outcome], float]:
+    """Run the sweep; return the outcomes and the total wall time [s]."""
+    jobs = [
+        Job(config, seed, variant, departure, robots, actions, speed_mps)
+        for seed in range(first_site_seed, first_site_seed + sites)
+        for departure in departures
+        for variant in variants
+    ]
+    start = time.perf_counter()
+    if workers <= 1:
+        outcomes = [run_job(job) for job in jobs]
+    else:
+        context = multiprocessing.get_context('spawn')
+        with context.Pool(workers, maxtasksperchild=20) as pool:
+            outcomes = list(pool.imap_unordered(run_job, jobs, chunksize=1))
+    return outcomes, time.perf_counter() - start
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Command line entry point."""
+    parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
+    parser.add_argument('--config', choices=('small', 'medium', 'big'), default='small')
+    parser.add_argument('--sites', type=int, default=20, help='number of generated sites')
+    parser.add_argument('--first-site-seed', type=int, default=0)
+    parser.add_argument('--variants', nargs='+', choices=VARIANTS, default=list(VARIANTS))
+    parser.add_argument('--departures', nargs='+', choices=DEPARTURES, default=list(DEPARTURES))
+    parser.add_argument('--robots', type=int, default=10)
+    parser.add_argument('--actions', type=int, default=None, help='default: Table II budget')
+    parser.add_argument('--speed', type=float, default=0.3, help='robot speed [m/s]')
+    parser.add_argument('--workers', type=int, default=2, help='worker processes')
+    parser.add_argument('--out', type=Path, default=None, help='also write the table here')
+    args = parser.parse_args(argv)
+    outcomes, total_s = run(
+        config=args.config,
+        sites=args.sites,
+        first_site_seed=args.first_site_seed,
+        variants=args.variants,
+        departures=args.departures,
+        robots=args.robots,
+        actions=args.actions,
+        speed_mps=args.speed,
+        workers=args.workers,
+    )
+    table = format_table(outcomes, args.config)
+    sim_s = sum(o.sim_time_s for o in outcomes)
+    footer = (
+        f'\n{len(outcomes)} runs ({args.config}, {args.robots} robots, {args.sites} sites) in '
+        f'{total_s:.0f} s wall with {args.workers} workers: {total_s / len(outcomes):.2f} s per '
+        f'run overall, {sim_s / total_s:.1f} sim s per wall s; a 1000-run sweep would take '
+        f'{1000 * total_s / len(outcomes) / 60:.0f} min.'
+    )
+    print(table + footer)
+    if args.out is not None:
+        args.out.write_text(table + '\n' + footer + '\n', encoding='utf-8')
+    return 0
+
+
+if __name__ == '__main__':
+    raise SystemExit(main())
