@@ -51,6 +51,23 @@ UNLABELLED = """\
 %%%%%%%%%%%%%%%%%%
 """
 
+# Doors two vertices (0.8 m) wide; a two-cell-wide corridor leads down to a hall.
+WIDE_DOORS = """\
+%%%%%%%%%%%%%%%%%%%%%%
+%      %      %      %
+%      %      %      %
+%      %      %      %
+%%%  %%%%%  %%%%  %%%%
+%                    %
+% DD                 %
+%                    %
+%%%%%%%%%%%%%%%%%  %%%
+%%%%%%%%%%%%%%%%%  %%%
+%                    %
+%                    %
+%%%%%%%%%%%%%%%%%%%%%%
+"""
+
 
 def write(tmp_path: Path, text: str, name: str = 'plan.lay') -> Path:
     path = tmp_path / name
@@ -121,6 +138,20 @@ def test_unlabelled_doors_connect_rooms_and_corridor(tmp_path: Path) -> None:
     corridor_doors = [door for door in site.doors if len(door.room_ids) == 1]
     assert len(room_doors) == 1  # between the top middle and top right rooms
     assert len(corridor_doors) == 3
+
+
+def test_wider_door_gaps_are_found_when_allowed_and_a_narrow_corridor_is_no_door(
+    tmp_path: Path,
+) -> None:
+    path = write(tmp_path, WIDE_DOORS)
+    assert import_layout(path).rooms_found == 0  # one-vertex doors only: no room closed off
+    result = import_layout(path, max_door_cells=2)
+    assert result.rooms_found == 3
+    assert [door.width_m for door in result.site.doors] == pytest.approx([3 * CELL_M] * 3)
+    hall = (10 * CELL_M, 1.5 * CELL_M)
+    assert result.site.room_ids_at(np.array([hall])).tolist() == [NO_ROOM]
+    with pytest.raises(LayoutError, match='max_door_cells must be at least 1'):
+        import_layout(path, max_door_cells=0)
 
 
 def test_the_example_office_plan_imports_with_its_nested_and_island_rooms() -> None:

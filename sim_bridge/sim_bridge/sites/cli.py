@@ -104,6 +104,7 @@ def _import_lay(args: argparse.Namespace) -> int:
         name=args.name,
         departure_name=args.departure_name,
         departures=dict(args.departure) if args.departure else None,
+        max_door_cells=args.max_door_cells,
     )
     print(
         f'{args.layout}: {result.mode.value} layout, found {result.rooms_found} rooms and '
@@ -164,6 +165,12 @@ def build_parser() -> argparse.ArgumentParser:
         type=_parse_departure,
         metavar='NAME=LINE,COLUMN',
         help='explicit departure point at a (fractional) line and column; repeatable',
+    )
+    imports.add_argument(
+        '--max-door-cells',
+        type=int,
+        default=1,
+        help='widest door gap of an unlabelled plan, in missing characters (default 1)',
     )
     imports.add_argument('--png', help='also render the site to this PNG')
     imports.set_defaults(run=_import_lay)

@@ -21,9 +21,10 @@ of ``/`` marking the entrance.
 one letter is a room. *Unlabelled* layouts (the authors' building plans) only draw walls;
 rooms are then found as the areas closed off by door gaps: a free vertex between two wall
 vertices of a straight line, with free space on both sides of the line that widens on at
-least one side (in the authors' simulator a door is a missing vertex in a wall line).
-A one-cell-wide room whose door leads into another one-cell-wide room is found merged with
-it, and a one-cell-wide corridor behind a gap counts as a room.
+least one side (in the authors' simulator a door is a missing vertex in a wall line; wider
+gaps, up to ``max_door_cells``, must widen on both sides). A one-cell-wide room whose door
+leads into another one-cell-wide room is found merged with it, and a one-cell-wide corridor
+behind a gap counts as a room.
 
 Departure points: an unlabelled plan marks one with ``D`` (a group of ``D`` marks its
 centre). Labelled layouts follow the authors' runner: "center" at the middle of the bounds
@@ -220,6 +221,7 @@ def import_layout(
     name: str | None = None,
     departure_name: str = 'edge',
     departures: Mapping[str, tuple[float, float]] | None = None,
+    max_door_cells: int = 1,
 ) -> LayoutImport:
     """Read a ``.lay`` file and turn it into a validated site (see :func:`layout_to_site`)."""
     layout = read_layout(path)
@@ -230,6 +232,7 @@ def import_layout(
         name=name if name is not None else Path(path).stem,
         departure_name=departure_name,
         departures=departures,
+        max_door_cells=max_door_cells,
     )
 
 
@@ -241,6 +244,7 @@ def layout_to_site(
     name: str | None = None,
     departure_name: str = 'edge',
     departures: Mapping[str, tuple[float, float]] | None = None,
+    max_door_cells: int = 1,
     seed: int | None = None,
 ) -> LayoutImport:
     """Build and validate the site a layout describes.
@@ -254,12 +258,17 @@ def layout_to_site(
         departures: explicit departure points, name -> (line, column) in the file (1-based,
             fractional values allowed: (15.5, 30.5) lies between four characters). They
             replace the ``D`` mark or the runner's "center"/"edge".
+        max_door_cells: widest door gap of an unlabelled plan, in missing vertices (the
+            authors' doors miss one; a plan drawn with 0.8 m doors needs 2).
         seed: generator seed to record in the site, if the layout was generated.
 
     Raises:
         LayoutError: malformed or invalid layout, naming the line and column.
     """
     mode = LayoutMode(mode)
+    if max_door_cells < 1:
+        msg = f'max_door_cells must be at least 1, got {max_door_cells}'
+        raise LayoutError(layout.source, None, None, msg)
     if not (math.isfinite(cell_m) and cell_m > 0):
         raise LayoutError(
             layout.source, None, None, f'cell size must be positive, got {cell_m!r} m'
@@ -275,7 +284,7 @@ def layout_to_site(
     else:
         builder.check_unlabelled_characters()
         points = explicit or [builder.marked_departure_point(departure_name)]
-        rooms, doors = builder.rooms_behind_door_gaps(points[0])
+        rooms, doors = builder.rooms_behind_door_gaps(points[0], max_door_cells)
     site = Site(
         name=name if name is not None else layout.source,
         width_m=(layout.shape[1] - 1) * cell_m,
@@ -585,50 +594,31 @@ class _SiteBuilder:
         row, col = cells.mean(axis=0)
         return DeparturePoint(name, *self.xy(float(row), float(col)))
 
-    def rooms_behind_door_gaps(self, departure: DeparturePoint) -> tuple[list[Room], list[Door]]:
-        free = ~self.wall
-        free_up, free_down = free[:-2, 1:-1], free[2:, 1:-1]
-        free_left, free_right = free[1:-1, :-2], free[1:-1, 2:]
-        wall_left, wall_right = self.wall[1:-1, :-2], self.wall[1:-1, 2:]
-        wall_up, wall_down = self.wall[:-2, 1:-1], self.wall[2:, 1:-1]
-        # A diagonal neighbour widens the space beside a gap unless it is itself a gap in a
-        # wall line across it (a door of a one-cell-wide room is not room to turn in).
-        in_vertical_gap = np.zeros_like(self.wall)
-        in_vertical_gap[1:-1, :] = self.wall[:-2, :] & self.wall[2:, :]
-        in_horizontal_gap = np.zeros_like(self.wall)
-        in_horizontal_gap[:, 1:-1] = self.wall[:, :-2] & self.wall[:, 2:]
-        widens_h = free & ~in_vertical_gap  # beside a horizontal gap
-        widens_v = free & ~in_horizontal_gap  # beside a vertical gap
-        diagonal_up = widens_h[:-2, :-2] | widens_h[:-2, 2:]
-        diagonal_down = widens_h[2:, :-2] | widens_h[2:, 2:]
-        diagonal_left = widens_v[:-2, :-2] | widens_v[2:, :-2]
-        diagonal_right = widens_v[:-2, 2:] | widens_v[2:, 2:]
-        centre = free[1:-1, 1:-1] & (self.codes[1:-1, 1:-1] != DEPARTURE)
-        gap_h = np.zeros_like(self.wall)
-        gap_v = np.zeros_like(self.wall)
-        gap_h[1:-1, 1:-1] = (
-            centre & wall_left & wall_right & free_up & free_down & (diagonal_up | diagonal_down)
-        )
-        gap_v[1:-1, 1:-1] = (
-            centre & wall_up & wall_down & free_left & free_right & (diagonal_left | diagonal_right)
-        )
+    def rooms_behind_door_gaps(
+        self, departure: DeparturePoint, max_door_cells: int
+    ) -> tuple[list[Room], list[Door]]:
+        blocked = self.codes == DEPARTURE  # a departure mark is never a door
+        gaps = [(r, c, k, True) for r, c, k in _horizontal_gaps(self.wall, blocked, max_door_cells)]
+        gaps += [
+            (r, c, k, False) for c, r, k in _horizontal_gaps(self.wall.T, blocked.T, max_door_cells)
+        ]
+        gaps.sort()
+        closed = np.zeros_like(self.wall)
         closed_h = np.zeros((self.n_rows, self.n_cols - 1), dtype=bool)
         closed_v = np.zeros((self.n_rows - 1, self.n_cols), dtype=bool)
-        rows, cols = np.nonzero(gap_h)
-        closed_h[rows, cols - 1] = True
-        closed_h[rows, cols] = True
-        rows, cols = np.nonzero(gap_v)
-        closed_v[rows - 1, cols] = True
-        closed_v[rows, cols] = True
+        for r, c, k, horizontal in gaps:
+            if horizontal:
+                closed[r, c : c + k] = True
+                closed_h[r, c - 1 : c + k] = True
+            else:
+                closed[r : r + k, c] = True
+                closed_v[r - 1 : r + k, c] = True
         sealed = self.wall | (self.codes == CORRIDOR_DOOR)  # the entrance is closed too
-        areas, _ = lattice.square_labels(sealed, gap_h | gap_v, closed_h, closed_v)
+        areas, _ = lattice.square_labels(sealed, closed, closed_h, closed_v)
         row, col = lattice.xy_to_vertex(departure.x_m, departure.y_m, self.n_rows, self.cell_m)
         start_area = int(areas[min(int(row), self.n_rows - 2), min(int(col), self.n_cols - 2)])
-        gaps = [(int(r), int(c), True) for r, c in np.argwhere(gap_h)]
-        gaps += [(int(r), int(c), False) for r, c in np.argwhere(gap_v)]
-        gaps.sort()
         sides: list[tuple[int, int]] = []
-        for r, c, horizontal in gaps:
+        for r, c, _, horizontal in gaps:
             if horizontal:
                 sides.append((int(areas[r - 1, c]), int(areas[r, c])))
             else:
@@ -643,13 +633,13 @@ class _SiteBuilder:
             self.square_rooms[mask] = room_id
             rooms.append(Room(room_id, lattice.square_to_rects(mask, self.cell_m)))
         doors = []
-        for (r, c, horizontal), (a, b) in zip(gaps, sides, strict=True):
+        for (r, c, k, horizontal), (a, b) in zip(gaps, sides, strict=True):
             if a == b:
                 continue
             if horizontal:
-                segment = (*self.xy(r, c - 1), *self.xy(r, c + 1))
+                segment = (*self.xy(r, c - 1), *self.xy(r, c + k))
             else:
-                segment = (*self.xy(r + 1, c), *self.xy(r - 1, c))
+                segment = (*self.xy(r + k, c), *self.xy(r - 1, c))
             room_ids = tuple(sorted(room_of_area[x] for x in (a, b) if x in room_of_area))
             doors.append(Door(segment, room_ids))
         return rooms, doors
@@ -664,3 +654,41 @@ class _SiteBuilder:
             corners = [(i, j), (i, j + 1), (i + 1, j), (i + 1, j + 1)]
             row, col = next(((r, c) for r, c in corners if not self.wall[r, c]), (i, j))
             raise self.error(row, col, 'an enclosed area has no door (no gap in its walls)')
+
+
+def _horizontal_gaps(
+    wall: np.ndarray, blocked: np.ndarray, max_cells: int
+) -> list[tuple[int, int, int]]:
+    """Door gaps in the horizontal wall lines of an (H, W) vertex wall mask.
+
+    A gap is a run of 1..max_cells free vertices between two wall vertices of a row, with
+    free vertices above and below every one of them, where the space beside the line widens
+    beyond the run's ends: on at least one side for a single vertex (so a one-cell-wide
+    room's door is found), on both sides for longer runs (so the mouth of a narrow corridor
+    is not taken for a door). A free vertex that is itself a gap in a vertical line does not
+    widen anything. Vertices in ``blocked`` are never part of a gap.
+
+    Returns:
+        (row, first column, length) of every gap.
+    """
+    n_cols = wall.shape[1]
+    free = ~wall
+    in_vertical_gap = np.zeros_like(wall)
+    in_vertical_gap[1:-1] = wall[:-2] & wall[2:]
+    widens = free & ~in_vertical_gap
+    found: list[tuple[int, int, int]] = []
+    for length in range(1, max_cells + 1):
+        starts = n_cols - length - 1  # first columns 1 .. n_cols - length - 1
+        if starts < 1:
+            break
+        left, right = slice(0, starts), slice(length + 1, n_cols)
+        ok = wall[1:-1, left] & wall[1:-1, right]
+        for offset in range(length):
+            run = slice(1 + offset, 1 + offset + starts)
+            ok &= free[1:-1, run] & free[:-2, run] & free[2:, run] & ~blocked[1:-1, run]
+        above = widens[:-2, left] | widens[:-2, right]
+        below = widens[2:, left] | widens[2:, right]
+        ok &= (above | below) if length == 1 else (above & below)
+        rows, cols = np.nonzero(ok)
+        found += [(int(r) + 1, int(c) + 1, length) for r, c in zip(rows, cols, strict=True)]
+    return found
