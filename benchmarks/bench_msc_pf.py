@@ -70,11 +70,21 @@ def _run_one(job: tuple[str, int, int, int, float]) -> RunOutcome:
     return RunOutcome(scheme, n_targets, n_robots, seed, cct, finished, result.wall_time_s)
 
 
+def _log(outcome: RunOutcome) -> RunOutcome:
+    status = f'{outcome.cct_s:7.0f} s' if outcome.finished else 'unfinished'
+    print(
+        f'  {outcome.scheme:8s} {outcome.n_targets:2d} targets {outcome.n_robots:2d} robots '
+        f'seed {outcome.seed:2d}: CCT {status}, wall {outcome.wall_time_s:5.1f} s',
+        flush=True,
+    )
+    return outcome
+
+
 def _run_all(jobs: list[tuple[str, int, int, int, float]], workers: int) -> list[RunOutcome]:
     if workers <= 1:
-        return [_run_one(job) for job in jobs]
+        return [_log(_run_one(job)) for job in jobs]
     with ProcessPoolExecutor(max_workers=workers) as pool:
-        return list(pool.map(_run_one, jobs))
+        return [_log(outcome) for outcome in pool.map(_run_one, jobs)]
 
 
 def _stats(outcomes: list[RunOutcome]) -> tuple[float, float, int, float]:

@@ -180,6 +180,8 @@ class MscPfNode(Node):
             return
         for event in out.events:
             self.get_logger().info(event)
+        for change in out.swarm_changes:
+            self.get_logger().debug(change)
         self.last_output = out
         self._last_step_s = now
         self._waypoint = (

@@ -90,7 +90,8 @@ class StepOutput:
         movement: (2,) the movement vector before step limiting.
         broadcast: the peer message to send.
         status: the state record to publish.
-        events: human-readable notes worth logging (swarm changes, filter re-initialisations).
+        events: notes worth logging (captures, re-targeting, filter re-initialisations).
+        swarm_changes: membership changes (joins, splits), frequent in MSC phases.
     """
 
     displacement_m: np.ndarray
@@ -98,6 +99,7 @@ class StepOutput:
     broadcast: PeerInfo
     status: RobotStatus
     events: tuple[str, ...]
+    swarm_changes: tuple[str, ...] = ()
 
 
 class RobotController:
@@ -138,6 +140,7 @@ class RobotController:
         self._work_since_s = 0.0
         self._work_blocked_until_s = -math.inf
         self._far_since_s: float | None = None
+        self._swarm_changes: tuple[str, ...] = ()
 
     # ------------------------------------------------------------------ memory
     @property
@@ -259,8 +262,7 @@ class RobotController:
         own_target = self._own_target(now_s)
         self._update_work(now_s, own_target)
         change = self.membership.update(self._peers, own_target, self.phase)
-        if change:
-            events.append(change)
+        self._swarm_changes = (change,) if change else ()
 
         neighbours = np.array([p.position_m for p in self._peers.values()]).reshape(-1, 2)
         avoidance = avoidance_vector(position, neighbours, self.config.avoidance)
@@ -570,4 +572,5 @@ class RobotController:
             estimates=tuple(self._bank.estimates()) if self._bank is not None else (),
             captured_ids=tuple(sorted(self._captured)),
         )
-        return StepOutput(displacement, vector.copy(), broadcast, status, tuple(events))
+        changes, self._swarm_changes = self._swarm_changes, ()
+        return StepOutput(displacement, vector.copy(), broadcast, status, tuple(events), changes)

@@ -12,7 +12,8 @@ physics step:
 * every ``status_period_s`` and at each capture publishes ``/sim/targets``
   (swarm_interfaces/RssiTargetArray), the ground truth the algorithm nodes never read.
 
-The mission is done when every target is captured.
+The mission is done one physics step after the step that captured the last target, so the
+final ``/sim/targets`` message reaches subscribers (e.g. a bag recorder) before the run stops.
 """
 
 from __future__ import annotations
@@ -53,6 +54,8 @@ class RssiExtension:
         self._next_sample = 1
         self._next_status_s = 0.0
         self._last_time_s: float | None = None
+        self._final_published = False
+        self._done = False
         self._names: tuple[str, ...] = ()
         self._rssi_pubs: list[Any] = []
         self._captured_pubs: list[Any] = []
@@ -79,6 +82,7 @@ class RssiExtension:
 
     def on_step(self, sim_time_s: float, states: RobotStates) -> None:
         """Work, capture, sample and publish for the physics step ending at ``sim_time_s``."""
+        self._done = self._final_published
         positions = np.asarray(states.poses, dtype=float)[:, :2]
         dt = 0.0 if self._last_time_s is None else sim_time_s - self._last_time_s
         self._last_time_s = sim_time_s
@@ -98,6 +102,7 @@ class RssiExtension:
         if captures or sim_time_s + _EPS_T >= self._next_status_s:
             self._targets_pub.publish(self.targets_message(sim_time_s))
             self._next_status_s = sim_time_s + self._status_period_s
+            self._final_published = self._final_published or self.targets.all_captured
 
     def _publish_rssi(self, time_s: float, positions: np.ndarray) -> None:
         samples = self.targets.sample_rssi(positions, self._rng)
@@ -135,5 +140,5 @@ class RssiExtension:
         return msg
 
     def is_done(self) -> bool:
-        """True when every target is captured."""
-        return self.targets.all_captured
+        """True one step after every target was captured and reported."""
+        return self._done
