@@ -88,6 +88,11 @@ class BearingCollector:
             self.last_seen_s[report.tag_id] = time_s
         return True
 
+    def ages_s(self, now_s: float) -> dict[str, float]:
+        """Seconds since each tag was last heard (thread-safe copy)."""
+        with self._lock:
+            return {tag: now_s - seen_s for tag, seen_s in self.last_seen_s.items()}
+
     def take(self) -> list[PeerBearingData]:
         """Latest bearing of each tag heard since the previous call, sorted by tag id."""
         with self._lock:

@@ -166,9 +166,8 @@ class AoaReceiverNode(Node):
             )
             if not server.client_connected:
                 note = (DiagnosticLevel.WARN, 'AoA locator not connected')
-        now_s = self._device_clock()
-        for tag, seen_s in sorted(collector.last_seen_s.items()):
-            extra[f'tag {tag} age_s'] = f'{now_s - seen_s:.1f}'
+        for tag, age_s in sorted(collector.ages_s(self._device_clock()).items()):
+            extra[f'tag {tag} age_s'] = f'{age_s:.1f}'
         entry = self._monitor.entry(now_ns, self._poller.worker, extra, note=note)
         publish_diagnostics(self._diag_pub, [entry], now_ns)
 
@@ -196,6 +195,9 @@ def main(args: list[str] | None = None) -> None:
         rclpy.spin(node)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
+    except ConfigurationError as err:
+        rclpy.logging.get_logger('aoa_receiver_node').fatal(f'invalid parameters: {err}')
+        raise SystemExit(2) from err
     finally:
         if node is not None:
             node.destroy_node()

@@ -201,6 +201,9 @@ def main(args: list[str] | None = None) -> None:
         rclpy.spin(node)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
+    except ConfigurationError as err:
+        rclpy.logging.get_logger('mpu6050_node').fatal(f'invalid parameters: {err}')
+        raise SystemExit(2) from err
     finally:
         if node is not None:
             node.destroy_node()

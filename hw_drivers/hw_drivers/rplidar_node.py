@@ -38,8 +38,8 @@ from hw_drivers.node_common import (
     seconds_clock,
 )
 from hw_drivers.rplidar_device import RPLidarConfig, RPLidarSession, connect_rplidar
-from hw_drivers.rplidar_protocol import Revolution, ScanBinning, bin_revolution
-from hw_drivers.worker import DeviceWorker
+from hw_drivers.rplidar_protocol import HealthStatus, Revolution, ScanBinning, bin_revolution
+from hw_drivers.worker import DeviceWorker, DiagnosticLevel
 
 __all__ = ['PARAMETERS', 'RPLidarNode', 'main']
 
@@ -179,7 +179,11 @@ class RPLidarNode(Node):
                 'health': session.health.status.name,
                 'firmware': session.info.firmware,
             }
-        entry = self._monitor.entry(now_ns, self._poller.worker, extra)
+        note = None
+        if session is not None and session.health.status is HealthStatus.WARNING:
+            code = session.health.error_code
+            note = (DiagnosticLevel.WARN, f'lidar reports health Warning (code 0x{code:04X})')
+        entry = self._monitor.entry(now_ns, self._poller.worker, extra, note=note)
         publish_diagnostics(self._diag_pub, [entry], now_ns)
 
     def destroy_node(self) -> None:
@@ -201,6 +205,9 @@ def main(args: list[str] | None = None) -> None:
         rclpy.spin(node)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
+    except ConfigurationError as err:
+        rclpy.logging.get_logger('rplidar_node').fatal(f'invalid parameters: {err}')
+        raise SystemExit(2) from err
     finally:
         if node is not None:
             node.destroy_node()

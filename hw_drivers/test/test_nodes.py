@@ -19,6 +19,8 @@ from swarm_runtime.ros import (
 )
 from swarm_runtime.simulation import spin_until, wall_time_s
 
+from hw_drivers import gas_node
+
 sensor_msgs = message_module('sensor_msgs')
 swarm_interfaces = message_module('swarm_interfaces')
 diagnostic_msgs = message_module('diagnostic_msgs')
@@ -206,3 +208,9 @@ def test_aoa_node_reports_a_missing_locator_as_stale(ros):
     assert status.level == diagnostic_msgs.DiagnosticStatus.ERROR
     assert 'stale' in status.message
     assert wall_time_s() > 2.0
+
+
+def test_main_exits_with_status_2_on_invalid_parameters():
+    with pytest.raises(SystemExit) as exit_info:
+        gas_node.main(['--ros-args', '-p', 'backend:=pcf8591'])
+    assert exit_info.value.code == 2
