@@ -30,11 +30,12 @@ from sim_bridge.sites.validation import DEFAULT_ROBOT_RADIUS_M, validate_site
 __all__ = ['build_parser', 'load_any', 'main']
 
 
-def load_any(path: str | Path, **layout_options: object) -> Site:
-    """Load a site from a ``.yaml``/``.yml`` site file or a ``.lay`` layout."""
+def load_any(path: str | Path) -> Site:
+    """Load a site from a ``.yaml``/``.yml`` site file or a ``.lay`` layout (default import
+    options)."""
     suffix = Path(path).suffix.lower()
     if suffix == '.lay':
-        return import_layout(path, **layout_options).site  # type: ignore[arg-type]
+        return import_layout(path).site
     if suffix in ('.yaml', '.yml'):
         return load_site(path)
     msg = f'{path}: unknown site file type {suffix!r}; use a .yaml site file or a .lay layout'
