@@ -2,9 +2,11 @@
 
 import os
 import threading
+import time
 
 import pytest
 import serial
+from hw_drivers.backoff import BackoffConfig
 from hw_drivers.errors import DeviceHealthError, DeviceTimeoutError, ProtocolError
 from hw_drivers.fakes.clock import FakeClock
 from hw_drivers.fakes.lidar import FakeRPLidar, FakeRPLidarPort
@@ -225,3 +227,47 @@ def test_driver_reads_revolutions_from_a_fake_lidar_on_a_pty():
         os.close(slave)
     assert len(received) >= 2
     assert all(len(r) == 120 for r in received)
+
+
+def test_worker_thread_streams_and_stops_cleanly_in_real_time():
+    device = FakeRPLidar(samples_per_revolution=120)
+    ports = []
+    received = []
+
+    def open_port(_cfg):
+        ports.append(FakeRPLidarPort(device, samples_per_s=4000.0))
+        return ports[-1]
+
+    worker = DeviceWorker(
+        'lidar', lambda: connect_rplidar(FAST, received.append, open_port=open_port)
+    )
+    worker.start()
+    deadline = time.monotonic() + 5.0
+    while len(received) < 3 and time.monotonic() < deadline:
+        time.sleep(0.01)
+    worker.stop()
+    assert len(received) >= 3
+    assert ports[-1].closed
+    assert ports[-1].dtr is True  # motor stopped on the way out
+
+
+def test_worker_thread_outlives_a_driver_bug_and_reports_it():
+    calls = []
+
+    class Buggy:
+        def poll(self):
+            calls.append('poll')
+            raise KeyError('driver bug')
+
+        def close(self):
+            calls.append('close')
+
+    worker = DeviceWorker('buggy', Buggy, backoff=BackoffConfig(initial_s=0.01, max_s=0.02))
+    worker.start()
+    deadline = time.monotonic() + 5.0
+    while calls.count('close') < 2 and time.monotonic() < deadline:
+        time.sleep(0.01)
+    worker.stop()
+    assert calls.count('close') >= 2  # reconnected after each failure
+    assert 'unexpected' in worker.status.message
+    assert 'driver bug' in worker.status.message
