@@ -308,7 +308,11 @@ def run_mission(
             executor.add_node(node)
         observer = _Observer(bridge, spec)
         engine = bridge.engine
-        state = {'reason': StopReason.BUDGET, 'next_report_s': 0.0}
+        state: dict[str, Any] = {
+            'reason': StopReason.BUDGET,
+            'next_report_s': 0.0,
+            'checked_step': -1,
+        }
 
         def snapshot() -> MissionProgress:
             return MissionProgress(
@@ -319,6 +323,10 @@ def run_mission(
             )
 
         def finished() -> bool:
+            # The state only changes at physics steps; skip the checks between them.
+            if engine.step_index == state['checked_step']:
+                return False
+            state['checked_step'] = engine.step_index
             if spec.stop_when_all_rooms_covered and engine.coverage.complete:
                 state['reason'] = StopReason.ALL_ROOMS_COVERED
                 return True
