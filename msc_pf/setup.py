@@ -34,6 +34,8 @@ setup(
     ),
     license='Apache-2.0',
     entry_points={
-        'console_scripts': [],
+        'console_scripts': [
+            'msc_pf_node = msc_pf.node:main',
+        ],
     },
 )

@@ -1,0 +1,130 @@
+"""Message <-> core translations: round trips and rejection of malformed input."""
+
+import math
+
+import numpy as np
+import pytest
+from msc_pf.particle_filter import TargetEstimate
+from msc_pf.peers import PeerInfo, Phase, Role
+from msc_pf.robot import RobotStatus
+from swarm_runtime.messages import get_message_module
+
+from msc_pf import conversions
+
+swarm = get_message_module('swarm_interfaces')
+builtin = get_message_module('builtin_interfaces')
+nav = get_message_module('nav_msgs')
+geometry = get_message_module('geometry_msgs')
+
+PEER = PeerInfo(
+    robot_id=4,
+    stamp_s=12.5,
+    position_m=(1000.25, 990.5),
+    movement=(0.6, -0.8),
+    role=Role.LEADER,
+    leader_id=4,
+    members=(6, 9),
+    phase=Phase.FAR_LOCALISATION,
+    target_id=3,
+    target_rssi_dbm=-84.5,
+    evaluation=-84.5,
+    readings=((3, -84.25), (7, -99.0)),
+    captured_ids=(1, 2),
+    visited_cell=5049,
+)
+
+
+def test_peer_round_trip_keeps_every_field():
+    msg = conversions.peer_to_ros(PEER, 'r4', swarm, builtin)
+    assert msg.robot == 'r4'
+    assert conversions.peer_from_ros(msg) == PEER
+
+
+def test_peer_with_mismatched_readings_is_rejected():
+    msg = conversions.peer_to_ros(PEER, 'r4', swarm, builtin)
+    msg.reading_rssi_dbm = [-80.0]
+    with pytest.raises(ValueError, match='2 reading IDs but 1 values'):
+        conversions.peer_from_ros(msg)
+
+
+def test_peer_with_unknown_phase_or_bad_position_is_rejected():
+    msg = conversions.peer_to_ros(PEER, 'r4', swarm, builtin)
+    msg.phase = 42
+    with pytest.raises(ValueError, match='unknown role or phase'):
+        conversions.peer_from_ros(msg)
+    msg = conversions.peer_to_ros(PEER, 'r4', swarm, builtin)
+    msg.position_x = math.inf
+    with pytest.raises(ValueError, match='non-finite position'):
+        conversions.peer_from_ros(msg)
+
+
+def test_readings_drop_non_finite_repeated_and_unknown_emitters():
+    msg = swarm.RssiArray(
+        readings=[
+            swarm.EmitterRssi(emitter_id=1, rssi_dbm=-70.0),
+            swarm.EmitterRssi(emitter_id=1, rssi_dbm=-71.0),
+            swarm.EmitterRssi(emitter_id=2, rssi_dbm=math.nan),
+            swarm.EmitterRssi(emitter_id=50, rssi_dbm=-60.0),
+        ]
+    )
+    readings, ignored = conversions.readings_from_ros(msg, accepted_ids={1, 2})
+    assert readings == {1: -70.0}
+    assert ignored == 3
+    readings, _ = conversions.readings_from_ros(msg)
+    assert readings == {1: -70.0, 50: -60.0}
+
+
+def test_status_is_translated_with_estimates():
+    estimate = TargetEstimate(
+        3, np.array([1100.0, 950.0]), 12.5, np.array([1101.0, 951.0]), True, 40
+    )
+    status = RobotStatus(
+        robot_id=4,
+        stamp_s=3.0,
+        phase=Phase.DIRECT_APPROACH,
+        role=Role.FOLLOWER,
+        swarm_id=1,
+        target_id=3,
+        target_rssi_dbm=-90.0,
+        goal_m=np.array([1100.0, 950.0]),
+        estimates=(estimate,),
+        captured_ids=(1,),
+    )
+    msg = conversions.status_to_ros(status, 'r4', 'proposed', swarm, builtin)
+    assert msg.phase == swarm.MscPfState.PHASE_DIRECT_APPROACH
+    assert (msg.role, msg.swarm_id, msg.target_id) == (1, 1, 3)
+    assert (msg.goal_x, msg.goal_y) == (1100.0, 950.0)
+    item = msg.estimates[0]
+    assert (item.target_id, item.x, item.y, item.converged, item.updates) == (
+        3,
+        1100.0,
+        950.0,
+        True,
+        40,
+    )
+    assert list(msg.captured_ids) == [1]
+
+
+def test_stamp_round_trip_and_odometry_pose():
+    stamp = conversions.stamp_to_ros(1234.567891234, builtin)
+    assert conversions.stamp_from_ros(stamp) == pytest.approx(1234.567891234, abs=1e-9)
+    odom = nav.Odometry()
+    odom.pose.pose.position.x = 3.0
+    odom.pose.pose.position.y = -2.0
+    odom.pose.pose.orientation.z = math.sin(0.4)
+    odom.pose.pose.orientation.w = math.cos(0.4)
+    x, y, yaw = conversions.pose_from_odometry(odom)
+    assert (x, y) == (3.0, -2.0)
+    assert yaw == pytest.approx(0.8)
+
+
+def test_robot_ids_come_from_names_and_bad_names_are_rejected():
+    assert conversions.robot_id_from_name('/r12') == 12
+    with pytest.raises(ValueError, match='r<number>'):
+        conversions.robot_id_from_name('robot')
+
+
+def test_twist_carries_python_floats():
+    msg = conversions.twist_to_ros(np.float32(0.5), 1, geometry)
+    assert msg.linear.x == 0.5
+    assert msg.angular.z == 1.0
