@@ -4,6 +4,7 @@ import signal
 import sys
 from pathlib import Path
 
+import pytest
 import yaml
 from hw_drivers.robot_bringup import cli
 from hw_drivers.robot_bringup.cli import BringupOptions, ChildSpec, build_plan, driver_parameters
@@ -80,13 +81,14 @@ def test_example_parameter_file_names_real_parameters():
         assert set(section['ros__parameters']) <= names, node
 
 
+@pytest.mark.slow
 def test_the_locator_is_respawned_alone(monkeypatch, tmp_path):
     runs = tmp_path / 'runs'
     runs.mkdir()
     locator = f'import pathlib, uuid; (pathlib.Path({str(runs)!r}) / uuid.uuid4().hex).touch()'
     plan = [
         ChildSpec('aoa_locator', (sys.executable, '-c', locator), respawn=True),
-        ChildSpec('crashing_later', (sys.executable, '-c', 'import time; time.sleep(3)')),
+        ChildSpec('crashing_later', (sys.executable, '-c', 'import time; time.sleep(1)')),
     ]
     monkeypatch.setattr(cli, 'build_plan', lambda options: plan)
     assert cli.run(BringupOptions(), grace_s=2.0, respawn_delay_s=0.1) == 1

@@ -246,6 +246,7 @@ def _child(mode, tmp_path):
     )
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize('signum', [signal.SIGTERM, signal.SIGINT])
 def test_signals_turn_the_pump_off_before_the_process_exits(tmp_path, signum):
     child = _child('signal', tmp_path)
@@ -260,6 +261,7 @@ def test_signals_turn_the_pump_off_before_the_process_exits(tmp_path, signum):
     assert lines.index('LEVEL 0') < lines.index('INTERRUPTED')
 
 
+@pytest.mark.slow
 def test_atexit_turns_the_pump_off_on_an_unplanned_exit(tmp_path):
     child = _child('atexit', tmp_path)
     out, _ = child.communicate(timeout=10)
