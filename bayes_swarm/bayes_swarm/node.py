@@ -219,6 +219,7 @@ class BayesSwarmNode(Node):
         )
 
     def _on_glowworm(self) -> None:
+        s = self.settings
         if self._glow is None or self._pose is None or self._waypoint is None:
             return
         position = np.array(self._pose[:2])
@@ -238,7 +239,20 @@ class BayesSwarmNode(Node):
         peers = list(self._glow_peers.values())
         positions = np.array([p[1] for p in peers]).reshape(-1, 2)
         lucs = np.array([p[2] for p in peers])
-        self._waypoint = self._glow.next_waypoint(position, positions, lucs)
+        target = self._glow.next_waypoint(position, positions, lucs)
+        step = target - position
+        length = float(np.hypot(*step))
+        if length <= 0.0:
+            self._waypoint = position  # no brighter neighbour: stay
+        else:
+            # A GSO step (mm at 100 Hz) is below the follower's arrival tolerance: steer toward
+            # a point a few control periods ahead on the same heading, so the robot moves at V.
+            follower = self.settings.follower
+            lookahead = max(
+                2.0 * follower.arrival_tolerance_m,
+                2.0 * follower.speed_mps / self.settings.control_rate_hz,
+            )
+            self._waypoint = s.planner.arena.clip(position + step * (lookahead / length))
         self._decisions += 1
 
 

@@ -49,6 +49,7 @@ DEFAULT_RECORD_TOPICS = (
     '/r*/peers/out',
 )
 _UNUSED_SENSOR_RATE_HZ = 0.01
+GLOWWORM_RATE_HZ = 100.0
 _POINT_ROBOT_RADIUS_M = 1e-3
 
 
@@ -231,6 +232,9 @@ def run(settings: SpawnSettings, progress: Any = None) -> BayesSwarmRun:
     from bayes_swarm.node import BayesSwarmNode
 
     case = _check(settings)
+    if settings.algorithm == 'glowworm':
+        # Glowworm decides at 100 Hz on fresh samples (the paper's observation frequency 100).
+        case = replace(case, observation_rate_hz=GLOWWORM_RATE_HZ)
     n = settings.robots or case.default_robots
     layout = _robot_layout(case, n)
     poses = np.array(
