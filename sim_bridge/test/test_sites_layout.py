@@ -18,6 +18,7 @@ from sim_bridge.sites import (
     import_layout,
     layout_to_site,
 )
+from sim_bridge.sites.door_gaps import DoorGap, closing_masks, find_door_gaps
 from sim_bridge.sites.layout import parse_layout, read_layout, write_layout
 
 CONFIG_DIR = Path(__file__).resolve().parents[1] / 'config' / 'sites'
@@ -328,3 +329,16 @@ def test_an_empty_or_tiny_layout_is_reported(tmp_path: Path) -> None:
         import_text(tmp_path, '\n\n')
     with pytest.raises(LayoutError, match='at least 3 x 3'):
         import_text(tmp_path, '%%\n%%\n')
+
+
+def test_door_gaps_are_missing_vertices_in_wall_lines_not_narrow_passages() -> None:
+    # A door (line 4, column 3) into a room, and a one-cell-wide room (column 7) whose
+    # interior vertices lie between walls too but are no doors.
+    plan = parse_layout('%%%%%%%%%\n%   % % %\n%   % % %\n%% %%% %%\n%       %\n%%%%%%%%%\n')
+    wall = plan.codes == ord('%')
+    gaps = find_door_gaps(wall, np.zeros_like(wall), max_cells=1)
+    assert gaps == [DoorGap(3, 2, 1, True), DoorGap(3, 6, 1, True)]
+    closed, closed_h, closed_v = closing_masks(gaps, wall.shape)
+    assert closed[3, 2]
+    assert closed_h[3, 1:3].all()
+    assert not closed_v.any()

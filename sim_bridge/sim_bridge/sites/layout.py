@@ -45,6 +45,7 @@ import numpy as np
 from scipy import ndimage
 
 from sim_bridge.sites import lattice
+from sim_bridge.sites.door_gaps import closing_masks, find_door_gaps
 from sim_bridge.sites.errors import LayoutError, SiteValidationError
 from sim_bridge.sites.model import CELL_M, NO_ROOM, DeparturePoint, Door, Room, Site
 from sim_bridge.sites.validation import validate_site
@@ -598,28 +599,16 @@ class _SiteBuilder:
         self, departure: DeparturePoint, max_door_cells: int
     ) -> tuple[list[Room], list[Door]]:
         blocked = self.codes == DEPARTURE  # a departure mark is never a door
-        gaps = [(r, c, k, True) for r, c, k in _horizontal_gaps(self.wall, blocked, max_door_cells)]
-        gaps += [
-            (r, c, k, False) for c, r, k in _horizontal_gaps(self.wall.T, blocked.T, max_door_cells)
-        ]
-        gaps.sort()
-        closed = np.zeros_like(self.wall)
-        closed_h = np.zeros((self.n_rows, self.n_cols - 1), dtype=bool)
-        closed_v = np.zeros((self.n_rows - 1, self.n_cols), dtype=bool)
-        for r, c, k, horizontal in gaps:
-            if horizontal:
-                closed[r, c : c + k] = True
-                closed_h[r, c - 1 : c + k] = True
-            else:
-                closed[r : r + k, c] = True
-                closed_v[r - 1 : r + k, c] = True
+        gaps = find_door_gaps(self.wall, blocked, max_door_cells)
+        closed, closed_h, closed_v = closing_masks(gaps, self.wall.shape)
         sealed = self.wall | (self.codes == CORRIDOR_DOOR)  # the entrance is closed too
         areas, _ = lattice.square_labels(sealed, closed, closed_h, closed_v)
         row, col = lattice.xy_to_vertex(departure.x_m, departure.y_m, self.n_rows, self.cell_m)
         start_area = int(areas[min(int(row), self.n_rows - 2), min(int(col), self.n_cols - 2)])
         sides: list[tuple[int, int]] = []
-        for r, c, _, horizontal in gaps:
-            if horizontal:
+        for gap in gaps:
+            r, c = gap.row, gap.col
+            if gap.horizontal:
                 sides.append((int(areas[r - 1, c]), int(areas[r, c])))
             else:
                 sides.append((int(areas[r, c - 1]), int(areas[r, c])))
@@ -633,10 +622,11 @@ class _SiteBuilder:
             self.square_rooms[mask] = room_id
             rooms.append(Room(room_id, lattice.square_to_rects(mask, self.cell_m)))
         doors = []
-        for (r, c, k, horizontal), (a, b) in zip(gaps, sides, strict=True):
+        for gap, (a, b) in zip(gaps, sides, strict=True):
             if a == b:
                 continue
-            if horizontal:
+            r, c, k = gap.row, gap.col, gap.length
+            if gap.horizontal:
                 segment = (*self.xy(r, c - 1), *self.xy(r, c + k))
             else:
                 segment = (*self.xy(r + k, c), *self.xy(r - 1, c))
@@ -654,41 +644,3 @@ class _SiteBuilder:
             corners = [(i, j), (i, j + 1), (i + 1, j), (i + 1, j + 1)]
             row, col = next(((r, c) for r, c in corners if not self.wall[r, c]), (i, j))
             raise self.error(row, col, 'an enclosed area has no door (no gap in its walls)')
-
-
-def _horizontal_gaps(
-    wall: np.ndarray, blocked: np.ndarray, max_cells: int
-) -> list[tuple[int, int, int]]:
-    """Door gaps in the horizontal wall lines of an (H, W) vertex wall mask.
-
-    A gap is a run of 1..max_cells free vertices between two wall vertices of a row, with
-    free vertices above and below every one of them, where the space beside the line widens
-    beyond the run's ends: on at least one side for a single vertex (so a one-cell-wide
-    room's door is found), on both sides for longer runs (so the mouth of a narrow corridor
-    is not taken for a door). A free vertex that is itself a gap in a vertical line does not
-    widen anything. Vertices in ``blocked`` are never part of a gap.
-
-    Returns:
-        (row, first column, length) of every gap.
-    """
-    n_cols = wall.shape[1]
-    free = ~wall
-    in_vertical_gap = np.zeros_like(wall)
-    in_vertical_gap[1:-1] = wall[:-2] & wall[2:]
-    widens = free & ~in_vertical_gap
-    found: list[tuple[int, int, int]] = []
-    for length in range(1, max_cells + 1):
-        starts = n_cols - length - 1  # first columns 1 .. n_cols - length - 1
-        if starts < 1:
-            break
-        left, right = slice(0, starts), slice(length + 1, n_cols)
-        ok = wall[1:-1, left] & wall[1:-1, right]
-        for offset in range(length):
-            run = slice(1 + offset, 1 + offset + starts)
-            ok &= free[1:-1, run] & free[:-2, run] & free[2:, run] & ~blocked[1:-1, run]
-        above = widens[:-2, left] | widens[:-2, right]
-        below = widens[2:, left] | widens[2:, right]
-        ok &= (above | below) if length == 1 else (above & below)
-        rows, cols = np.nonzero(ok)
-        found += [(int(r) + 1, int(c) + 1, length) for r, c in zip(rows, cols, strict=True)]
-    return found
