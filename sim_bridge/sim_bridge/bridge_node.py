@@ -89,7 +89,11 @@ class SimBridgeNode(Node):
             self.declare_parameter(spec.name, default, _descriptor(spec.description))
         declare = self.declare_parameter
         declare('robot_count', 1, _descriptor('Robots r0..r{n-1} (ignored with start poses).'))
-        declare('site_file', '', _descriptor('Site file to load when no site is given.'))
+        declare(
+            'site_file',
+            '',
+            _descriptor('Site when none is given: small/medium/big (seeded), .lay or site file.'),
+        )
         declare('departure', 'center', _descriptor("Departure point of the site: 'center'/'edge'."))
         declare('heading_bias_rad', 0.0, _descriptor('Common bias of the departure fan [rad].'))
         declare('real_time_factor', 1.0, _descriptor('Sim seconds per wall second (wall timer).'))
@@ -169,7 +173,7 @@ class SimBridgeNode(Node):
                 raise ConfigurationError('no site given: set the site_file parameter')
             from sim_bridge.site_loading import load_site
 
-            site = load_site(path)
+            site = load_site(path, seed=self.config.seed)
             self._site_model = site
         return geometry_from_site(site)
 
