@@ -208,6 +208,10 @@ class OABugFsm:
                 mem.mode = Mode.FOLLOW
             else:
                 return wrap_corner(mem.wall_side, cfg.motion)
+        elif front_blocked:
+            # Turning away from an inner corner swings the old wall out of the abeam strip
+            # before the new one comes in: that is no outer corner.
+            self._corners.reset()
         elif self._corners.update(scan.side(mem.wall_side)):
             self._on_outer_corner(snap)
             if mem.mode is Mode.TURN:

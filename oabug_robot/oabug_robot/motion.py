@@ -8,7 +8,6 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from oabug_robot.heading import angle_difference
 from oabug_robot.scan_features import SideWall
 from oabug_robot.settings import MotionConfig
 
@@ -53,32 +52,28 @@ def go_straight(error_rad: float, cfg: MotionConfig) -> Twist2D:
 
 
 def follow_wall(side: int, wall: SideWall, front_blocked: bool, cfg: MotionConfig) -> Twist2D:
-    """Keep the wall on ``side`` (+1 left, -1 right) at ``cfg.wall_distance_m``.
+    """Keep the wall on ``side`` (+1 left, -1 right) parallel at ``cfg.wall_distance_m``.
 
-    The nearest wall return on that side is held abeam (bearing side * 90 deg) at the set
-    distance, so the robot runs along straight walls, wraps round wall ends and door jambs
-    (the return stays at the set distance while it circles the end) and turns away from a
-    wall that blocks the way (inner corner).
+    Turns on the spot away from a wall that blocks the way (inner corner) and, with no wall
+    beside it, arcs towards its side until one is back.
 
     Args:
         side: the followed side.
-        wall: the nearest wall return on that side.
+        wall: the wall beside the robot on that side.
         front_blocked: a wall is within hit distance ahead.
         cfg: speeds and gains.
     """
     if front_blocked:
         return Twist2D(0.0, -side * cfg.turn_rate_radps)
     if not wall.found:
-        # Lost the wall: arc towards its side until it is back in capture range.
         speed = 0.5 * cfg.forward_speed_mps
         return Twist2D(speed, side * min(cfg.turn_rate_radps, speed / cfg.wall_distance_m))
-    angle_error = angle_difference(wall.bearing_rad, side * math.pi / 2)
     distance_error = wall.distance_m - cfg.wall_distance_m
     rate = (
-        cfg.wall_angle_gain_per_s * angle_error
+        cfg.wall_angle_gain_per_s * wall.angle_rad
         + side * cfg.wall_distance_gain_radps_per_m * distance_error
     )
-    fraction = max(_MIN_FOLLOW_FRACTION, math.cos(min(abs(angle_error), math.pi / 2)))
+    fraction = max(_MIN_FOLLOW_FRACTION, math.cos(min(abs(wall.angle_rad), math.pi / 2)))
     return Twist2D(cfg.forward_speed_mps * fraction, _clamp(rate, cfg.turn_rate_radps))
 
 

@@ -50,23 +50,25 @@ class LaserScanData:
 
 @dataclass(frozen=True)
 class SideWall:
-    """The wall on one side of the robot.
+    """The wall beside the robot on one side, from the returns abeam and just behind.
 
     Attributes:
-        distance_m: range of the nearest wall return [m]; inf when there is none within
-            capture range.
-        bearing_rad: its direction in the robot frame [rad]; NaN when there is none.
-        abeam: a wall return lies beside the robot's body (the abeam strip), i.e. the robot
+        distance_m: perpendicular distance from the lidar to the wall line [m]; inf when no
+            wall return lies beside the robot within capture range.
+        angle_rad: direction of the wall relative to the robot's heading [rad], in
+            (-pi/2, pi/2]: 0 when parallel, positive when the wall runs away to the left
+            ahead (counter-clockwise); 0 when there is no wall.
+        abeam: a wall return lies right beside the lidar (the abeam strip), i.e. the robot
             has not yet passed the end of the wall on this side.
     """
 
     distance_m: float = math.inf
-    bearing_rad: float = math.nan
+    angle_rad: float = 0.0
     abeam: bool = False
 
     @property
     def found(self) -> bool:
-        """True when a wall return lies on this side within capture range."""
+        """True when a wall lies on this side within capture range."""
         return math.isfinite(self.distance_m)
 
 
@@ -193,10 +195,10 @@ class ScanFeatureExtractor:
                 front &= is_wall
                 captured &= is_wall
         front_wall = float(x[front].min()) if front.any() else math.inf
-        captured &= x <= cfg.side_lookahead_m
-        strip = captured & (x >= -cfg.abeam_behind_m) & (np.abs(y) <= cfg.abeam_reach_m)
-        left = self._nearest(r, index, rays, captured & (y >= -cfg.side_overlap_m), strip & (y > 0))
-        right = self._nearest(r, index, rays, captured & (y <= cfg.side_overlap_m), strip & (y < 0))
+        beside = captured & (x <= cfg.side_lookahead_m) & (x >= -cfg.side_window_behind_m)
+        left = self._side_wall(x, y, beside & (y > 0.0))
+        right = self._side_wall(x, -y, beside & (y < 0.0))
+        right = SideWall(right.distance_m, -right.angle_rad, right.abeam)
         return ScanFeatures(
             front_wall_m=front_wall,
             front_robot_m=front_robot,
@@ -256,15 +258,48 @@ class ScanFeatureExtractor:
         is_peer[near] = window & body & ~heard_through_wall[which]
         return is_peer
 
-    @staticmethod
-    def _nearest(
-        r: np.ndarray, index: np.ndarray, rays: _RayTable, mask: np.ndarray, strip: np.ndarray
-    ) -> SideWall:
+    def _side_wall(self, x: np.ndarray, lateral: np.ndarray, mask: np.ndarray) -> SideWall:
+        """Fit the wall beside the robot on one side.
+
+        Args:
+            x: (K,) forward coordinates of the returns [m].
+            lateral: (K,) their distance towards this side [m] (y on the left, -y on the
+                right), so the fit is the same for both sides.
+            mask: (K,) the returns of this side's window.
+
+        Returns:
+            The wall with its angle as seen on the left; the caller mirrors the right side.
+        """
+        cfg = self._config
         if not mask.any():
             return SideWall()
-        best = int(np.argmin(np.where(mask, r, math.inf)))
-        return SideWall(
-            distance_m=float(r[best]),
-            bearing_rad=float(rays.angles_rad[index[best]]),
-            abeam=bool(strip.any()),
-        )
+        xs = x[mask]
+        ls = lateral[mask]
+        # Only the nearest wall: drop returns well beyond the closest lateral distance
+        # (a perpendicular wall behind, the far side of a door).
+        near = ls <= ls.min() + cfg.side_wall_band_m
+        xs = xs[near]
+        ls = ls[near]
+        abeam = bool(np.any((xs >= -cfg.abeam_behind_m) & (ls <= cfg.abeam_reach_m)))
+        if xs.size < 3 or np.ptp(xs) < 0.05:
+            return SideWall(distance_m=float(ls.min()), angle_rad=0.0, abeam=abeam)
+        angle, distance = _fit_line(xs, ls)
+        # Once more without the returns off that line (a corner inside the window).
+        residual = np.abs(xs * math.sin(angle) - ls * math.cos(angle) + distance)
+        on_line = residual <= cfg.side_wall_fit_tolerance_m
+        if 3 <= np.count_nonzero(on_line) < xs.size:
+            angle, distance = _fit_line(xs[on_line], ls[on_line])
+        return SideWall(distance_m=distance, angle_rad=angle, abeam=abeam)
+
+
+def _fit_line(xs: np.ndarray, ls: np.ndarray) -> tuple[float, float]:
+    """Least-squares line through (x, lateral) points: (direction [rad], distance [m]).
+
+    The direction is in (-pi/2, pi/2] from the x axis; the distance is from the origin.
+    """
+    mx = float(xs.mean())
+    ml = float(ls.mean())
+    dx = xs - mx
+    dl = ls - ml
+    angle = math.atan2(float(dx @ dl), float(dx @ dx))
+    return angle, abs(mx * math.sin(angle) - ml * math.cos(angle))

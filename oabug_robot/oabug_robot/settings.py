@@ -135,13 +135,18 @@ class PerceptionConfig:
         feature_range_m: returns farther than this (or than the capture and hit distances,
             whichever is largest) are ignored [m].
         follow_capture_m: a side return farther than this does not count as the followed wall [m].
-        side_overlap_m: how far past the centre line a return may lie and still count for a
-            side [m].
-        side_lookahead_m: side returns farther ahead than this do not count for the followed
-            wall, so the jamb across a door gap cannot pull the robot past the door (it wraps
-            round the near jamb into the room instead); walls ahead are the front check's [m].
-        abeam_behind_m: the abeam strip reaches this far behind the lidar (the body's trailing
-            edge): the robot has passed a wall's end once no return lies in the strip [m].
+        side_lookahead_m: returns farther ahead than this do not count for the wall beside
+            the robot, so the jamb across a door gap cannot pull the robot past the door (it
+            wraps round the near jamb into the room instead); walls ahead are the front
+            check's [m].
+        side_window_behind_m: returns up to this far behind the lidar count for the wall
+            beside the robot [m].
+        side_wall_band_m: returns more than this beyond the closest one (laterally) are not
+            part of the wall beside the robot [m].
+        side_wall_fit_tolerance_m: returns farther than this from the first line fit are
+            left out of the second (a corner inside the window) [m].
+        abeam_behind_m: the abeam strip reaches this far behind the lidar: the robot has
+            passed a wall's end once no return lies in the strip [m].
         abeam_reach_m: lateral extent of the abeam strip [m].
         lidar_yaw_offset_rad: yaw of the lidar's zero ray in the robot frame [rad].
     """
@@ -158,9 +163,11 @@ class PerceptionConfig:
     peer_distance_factor: float = 2.0
     feature_range_m: float = 1.0
     follow_capture_m: float = 0.8
-    side_overlap_m: float = 0.05
     side_lookahead_m: float = 0.05
-    abeam_behind_m: float = 0.1
+    side_window_behind_m: float = 0.15
+    side_wall_band_m: float = 0.1
+    side_wall_fit_tolerance_m: float = 0.02
+    abeam_behind_m: float = 0.02
     abeam_reach_m: float = 0.45
     lidar_yaw_offset_rad: float = 0.0
 

@@ -5,8 +5,8 @@ from __future__ import annotations
 from oabug_robot.corners import CornerDetector
 from oabug_robot.scan_features import SideWall
 
-ABEAM = SideWall(0.25, 1.57, abeam=True)
-PASSED = SideWall(0.3, 2.4, abeam=False)
+ABEAM = SideWall(0.25, 0.0, abeam=True)
+PASSED = SideWall(0.3, 0.0, abeam=False)
 NO_WALL = SideWall()
 
 

@@ -34,8 +34,8 @@ def robot_ahead() -> ScanFeatures:
     return ScanFeatures(front_robot_m=0.3)
 
 
-def side_wall(side: int, bearing_deg: float = 90.0, abeam: bool = True) -> ScanFeatures:
-    wall = SideWall(0.25, side * math.radians(bearing_deg), abeam=abeam)
+def side_wall(side: int, abeam: bool = True) -> ScanFeatures:
+    wall = SideWall(0.25, 0.0, abeam=abeam)
     return ScanFeatures(left=wall) if side > 0 else ScanFeatures(right=wall)
 
 
@@ -83,7 +83,7 @@ class Script:
 
     def pass_outer_corner(self, side: int):
         """The wall is behind the body now: nothing abeam any more, the wall has ended."""
-        return self.step(side_wall(side, bearing_deg=90.0 + 50.0, abeam=False))
+        return self.step(side_wall(side, abeam=False))
 
 
 def make(variant: Variant, **overrides) -> OABugFsm:
@@ -200,6 +200,21 @@ def test_minimum_always_returns_to_the_initial_preferred_direction() -> None:
         script.pass_outer_corner(1)
         assert fsm.memory.target_yaw_rad == pytest.approx(phi)
         script.step(free(), yaw_rad=phi)
+
+
+def test_turning_away_at_an_inner_corner_is_not_an_outer_corner() -> None:
+    fsm = make(Variant.GAS)
+    script = Script(fsm)
+    reach_wall(script)
+    script.follow_straight(1)
+    # A wall ahead: the robot turns on the spot; meanwhile the old wall leaves the strip.
+    blocked = ScanFeatures(front_wall_m=0.2, left=SideWall(0.3, 0.9, abeam=False))
+    command = script.step(blocked)
+    assert command.angular_radps < 0.0
+    script.step(blocked)
+    script.step(side_wall(1, abeam=False))
+    assert Event.OUTER_CORNER not in fsm.memory.counts
+    assert fsm.memory.mode is Mode.FOLLOW
 
 
 def test_a_wall_already_being_followed_does_not_retrigger_wall_hits() -> None:

@@ -55,11 +55,13 @@ def test_wall_ahead_is_measured_along_the_driving_corridor(extractor) -> None:
 
 
 def test_side_walls_are_found_abeam_at_their_distance(extractor) -> None:
-    features = extractor.extract(scan_of(box_ranges(5.0, 0.3, 5.0, 0.5)))
+    features = extractor.extract(scan_of(box_ranges(5.0, 0.3, 5.0, 0.4)))
     assert features.left.distance_m == pytest.approx(0.3, abs=1e-3)
-    assert features.left.bearing_rad == pytest.approx(math.pi / 2, abs=math.radians(1.5))
-    assert features.right.distance_m == pytest.approx(0.5, abs=1e-3)
-    assert features.right.bearing_rad == pytest.approx(-math.pi / 2, abs=math.radians(1.5))
+    assert features.left.angle_rad == pytest.approx(0.0, abs=math.radians(1.0))
+    assert features.left.abeam
+    assert features.right.distance_m == pytest.approx(0.4, abs=1e-3)
+    assert features.right.angle_rad == pytest.approx(0.0, abs=math.radians(1.0))
+    assert features.right.abeam
 
 
 def test_returns_beyond_the_feature_range_are_ignored(extractor) -> None:
@@ -72,7 +74,7 @@ def test_side_walls_beyond_capture_range_are_not_followed(extractor) -> None:
     features = extractor.extract(scan_of(box_ranges(5.0, 3.0, 5.0, 3.0)))
     assert not features.left.found
     assert not features.right.found
-    assert math.isnan(features.left.bearing_rad)
+    assert not features.left.abeam
 
 
 def test_a_peer_ahead_is_a_robot_not_a_wall_when_its_bearing_is_heard(extractor) -> None:
@@ -96,11 +98,12 @@ def test_a_wall_behind_a_peer_stays_a_wall(extractor) -> None:
 
 def test_a_peer_beside_the_followed_wall_is_not_taken_for_the_wall(extractor) -> None:
     ranges = add_disc(box_ranges(5.0, 0.6, 5.0, 3.0), 0.0, 0.3, 0.12)
-    features = extractor.extract(scan_of(ranges), np.array([math.pi / 2]))
-    # The nearest left return is the wall just beside the peer's shadow, not the peer.
-    assert features.left.distance_m >= 0.6
-    assert abs(features.left.bearing_rad - math.pi / 2) < math.radians(30.0)
-    assert features.front_robot_m == math.inf, 'a peer abeam is outside the front cone'
+    heard = extractor.extract(scan_of(ranges), np.array([math.pi / 2]))
+    # The peer hides the wall beside the robot; its own returns are not a wall.
+    assert not heard.left.found
+    assert heard.front_robot_m == math.inf, 'a peer abeam is outside the front cone'
+    unheard = extractor.extract(scan_of(ranges))
+    assert unheard.left.distance_m == pytest.approx(0.18, abs=0.01)
 
 
 def test_bearings_with_nan_azimuth_mask_nothing(extractor) -> None:
@@ -166,3 +169,47 @@ def test_a_partial_scan_uses_its_own_angles(extractor) -> None:
     scan = LaserScanData(ranges, -math.pi / 2, math.pi / 180, 0.05, 12.0)
     features = extractor.extract(scan)
     assert features.front_wall_m == pytest.approx(0.5 * math.cos(0.0), abs=0.01)
+
+
+def segment_ranges(segments: list[tuple[float, float, float, float]]) -> np.ndarray:
+    """Ranges from the origin to thin wall segments (x0, y0, x1, y1) in the robot frame."""
+    c, s = np.cos(ANGLES), np.sin(ANGLES)
+    best = np.full(RAYS, np.inf)
+    for x0, y0, x1, y1 in segments:
+        ex, ey = x1 - x0, y1 - y0
+        denom = c * ey - s * ex
+        with np.errstate(divide='ignore', invalid='ignore'):
+            t = (x0 * ey - y0 * ex) / denom
+            u = (x0 * s - y0 * c) / denom
+        hit = (np.abs(denom) > 1e-12) & (t > 0) & (u >= 0) & (u <= 1)
+        best = np.where(hit & (t < best), t, best)
+    return best
+
+
+@pytest.mark.parametrize('side', [1, -1])
+def test_a_wall_converging_ahead_has_the_angle_of_its_direction(extractor, side: int) -> None:
+    # The wall runs from 0.4 m beside the robot at x = -0.5 to 0.2 m at x = 0.5.
+    tilt = math.atan2(-0.2, 1.0)
+    ranges = segment_ranges([(-0.5, side * 0.4, 0.5, side * 0.2)])
+    wall = extractor.extract(scan_of(ranges)).side(side)
+    assert wall.angle_rad == pytest.approx(side * tilt, abs=math.radians(2.0))
+    assert wall.distance_m == pytest.approx(0.3 * math.cos(tilt), abs=0.01)
+
+
+def test_the_far_jamb_of_a_door_does_not_pull_the_follower_past_it(extractor) -> None:
+    # Following a wall on the left that ends 5 cm behind the lidar; a 0.5 m door, then the
+    # wall goes on. Nothing beside the robot any more: the corner is passed.
+    ranges = segment_ranges([(-1.0, 0.25, -0.05, 0.25), (0.45, 0.25, 1.5, 0.25)])
+    features = extractor.extract(scan_of(ranges))
+    assert not features.left.abeam
+    assert features.left.distance_m == pytest.approx(0.25, abs=0.01), 'the wall just behind'
+    before_the_end = extractor.extract(scan_of(segment_ranges([(-1.0, 0.25, 0.1, 0.25)])))
+    assert before_the_end.left.abeam
+
+
+def test_a_perpendicular_wall_behind_is_not_part_of_the_wall_beside(extractor) -> None:
+    # Just through a door: the jamb wall on the left, the corridor wall behind, across.
+    ranges = segment_ranges([(-0.1, 0.25, 1.0, 0.25), (-0.12, 0.25, -0.12, 1.0)])
+    wall = extractor.extract(scan_of(ranges)).left
+    assert wall.distance_m == pytest.approx(0.25, abs=0.01)
+    assert wall.angle_rad == pytest.approx(0.0, abs=math.radians(2.0))
