@@ -89,6 +89,7 @@ class DeviceWorker:
         self._thread: threading.Thread | None = None
         self.connect_count = 0
         self.fault_count = 0
+        self.close_errors = 0
 
     @property
     def status(self) -> DeviceStatus:
@@ -150,10 +151,14 @@ class DeviceWorker:
         )
 
     def close_session(self) -> None:
-        """Close the current session, if any."""
+        """Close the current session, if any; a failing close is counted, never raised."""
         session, self._session = self._session, None
-        if session is not None:
+        if session is None:
+            return
+        try:
             session.close()
+        except Exception:  # closing a vanished device must not stop the reconnect loop
+            self.close_errors += 1
 
     def start(self) -> None:
         """Run the loop in a daemon thread until :meth:`stop`."""
