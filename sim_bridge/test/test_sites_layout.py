@@ -332,9 +332,19 @@ def test_an_empty_or_tiny_layout_is_reported(tmp_path: Path) -> None:
 
 
 def test_door_gaps_are_missing_vertices_in_wall_lines_not_narrow_passages() -> None:
-    # A door (line 4, column 3) into a room, and a one-cell-wide room (column 7) whose
-    # interior vertices lie between walls too but are no doors.
-    plan = parse_layout('%%%%%%%%%\n%   % % %\n%   % % %\n%% %%% %%\n%       %\n%%%%%%%%%\n')
+    # Doors at line 4, columns 3 and 7; the second leads into a one-cell-wide room whose
+    # interior vertices lie between two walls as well but are no doors.
+    plan = parse_layout(
+        """\
+%%%%%%%%%
+%   %% %%
+%   %% %%
+%% %%% %%
+%       %
+%       %
+%%%%%%%%%
+"""
+    )
     wall = plan.codes == ord('%')
     gaps = find_door_gaps(wall, np.zeros_like(wall), max_cells=1)
     assert gaps == [DoorGap(3, 2, 1, True), DoorGap(3, 6, 1, True)]
