@@ -7,7 +7,12 @@ import time
 import pytest
 import serial
 from hw_drivers.backoff import BackoffConfig
-from hw_drivers.errors import DeviceHealthError, DeviceTimeoutError, ProtocolError
+from hw_drivers.errors import (
+    DeviceHealthError,
+    DeviceTimeoutError,
+    DeviceUnavailableError,
+    ProtocolError,
+)
 from hw_drivers.fakes.clock import FakeClock
 from hw_drivers.fakes.lidar import FakeRPLidar, FakeRPLidarPort
 from hw_drivers.rplidar_device import (
@@ -17,6 +22,7 @@ from hw_drivers.rplidar_device import (
     connect_rplidar,
 )
 from hw_drivers.rplidar_protocol import Command, HealthStatus
+from hw_drivers.serial_transport import open_serial_port
 from hw_drivers.worker import DeviceWorker, DiagnosticLevel
 
 FAST = RPLidarConfig(port='fake', reset_settle_s=0.01, spin_up_s=0.01, stop_settle_s=0.001)
@@ -271,3 +277,8 @@ def test_worker_thread_outlives_a_driver_bug_and_reports_it():
     assert calls.count('close') >= 2  # reconnected after each failure
     assert 'unexpected' in worker.status.message
     assert 'driver bug' in worker.status.message
+
+
+def test_missing_serial_device_is_a_recoverable_error():
+    with pytest.raises(DeviceUnavailableError, match='cannot open /dev/no-such-lidar'):
+        open_serial_port('/dev/no-such-lidar', baudrate=115200, timeout_s=0.1)
