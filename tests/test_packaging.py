@@ -76,7 +76,7 @@ def test_setup_py_installs_the_marker_and_package_xml(package_dir: Path) -> None
     call = _setup_call(package_dir)
     keywords = {keyword.arg for keyword in call.keywords}
     assert {'name', 'packages', 'data_files', 'entry_points', 'install_requires'} <= keywords
-    assert "share/ament_index/resource_index/packages" in source
+    assert 'share/ament_index/resource_index/packages' in source
     assert "'package.xml'" in source
 
 
