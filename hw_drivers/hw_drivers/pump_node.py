@@ -48,7 +48,7 @@ diagnostic_msgs = message_module('diagnostic_msgs')
 
 PARAMETERS: list[ParamSpec] = [
     ('chip', '/dev/gpiochip0', 'GPIO chip device (Pi 4 40-pin header: /dev/gpiochip0)'),
-    ('line', 'GPIO17', 'GPIO line: name (GPIO17) or offset (17); authors: BCM 17'),
+    ('line', 'GPIO17', "GPIO line name (GPIO17) or offset as a string ('17'); authors: BCM 17"),
     ('active_low', False, 'true if the driver stage is inverting (line low = pump on)'),
     ('max_on_s', 1.0, 'longest pulse the driver allows [s] (paper pulse: 0.5 s)'),
     ('min_off_s', 1.0, 'shortest pause between pulses [s]'),

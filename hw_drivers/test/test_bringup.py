@@ -93,3 +93,9 @@ def test_the_locator_is_respawned_alone(monkeypatch, tmp_path):
     monkeypatch.setattr(cli, 'build_plan', lambda options: plan)
     assert cli.run(BringupOptions(), grace_s=2.0, respawn_delay_s=0.1) == 1
     assert len(list(runs.iterdir())) >= 2
+
+
+def test_numeric_looking_strings_are_quoted_so_ros_keeps_them_strings():
+    plan = build_plan(BringupOptions(robot='r0', own_tag_id='42', launcher='ros2'))
+    command = next(spec.command for spec in plan if spec.name == 'aoa_receiver_node')
+    assert "own_tag_id:='42'" in command

@@ -88,11 +88,29 @@ def driver_parameters(robot: str, *, own_tag_id: str = '', fake: bool = False) -
     return params
 
 
+_YAML_NON_STRINGS = {'', 'true', 'false', 'yes', 'no', 'on', 'off', 'null', '~'}
+
+
+def _looks_like_a_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
 def _format_value(value: Any) -> str:
+    """A ``-p name:=value`` value; strings that YAML would read as something else are quoted.
+
+    ROS parses command-line parameter values as YAML, so a tag id such as ``42`` would become
+    an integer and fail against the string parameter.
+    """
     if isinstance(value, bool):
         return 'true' if value else 'false'
     if isinstance(value, str):
-        return value if value else "''"
+        if value.lower() in _YAML_NON_STRINGS or _looks_like_a_number(value):
+            return f"'{value}'"
+        return value
     return str(value)
 
 
