@@ -12,7 +12,8 @@ first), an exception in a callback, and ``atexit``. SIGKILL and power loss canno
 the hardware gate pull-down and the systemd ``ExecStopPost=`` line (docs/hardware.md) cover
 those.
 
-Publishes ``pump/state`` (std_msgs/Bool, the actual output) and /diagnostics.
+Publishes ``pump/state`` (std_msgs/Bool, the actual output; on every change and once a
+second) and /diagnostics.
 
 Run: ``ros2 run hw_drivers pump_node --ros-args -r __ns:=/r0 -p line:=GPIO17``.
 """
@@ -155,7 +156,9 @@ class PumpNode(Node):
                 self._guard.cancel()
 
     def _publish_diagnostics(self) -> None:
+        """Once a second: diagnostics, and the pump state again for late subscribers."""
         now_ns = self.get_clock().now().nanoseconds
+        self._state_pub.publish(pump_state_to_ros(self.line.is_on))
         controller = self._controller
         level, message = DiagnosticLevel.OK, 'pump on' if self.line.is_on else 'pump off'
         if self.line.off_failures:
