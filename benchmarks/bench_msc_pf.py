@@ -38,6 +38,7 @@ from msc_pf.settings import ParticleFilterConfig, RadioConfig  # noqa: E402
 from sim_bridge.msc_pf_batch import BatchScenario, run_batch  # noqa: E402
 
 SCHEMES = ('proposed', 'msc_pf', 'msc')
+CSV_HEADER = 'scheme,targets,robots,seed,cct_s,finished,wall_s\n'
 EXPERIMENTS = ('main', 'robots', 'pf')
 
 
@@ -70,7 +71,13 @@ def _run_one(job: tuple[str, int, int, int, float]) -> RunOutcome:
     return RunOutcome(scheme, n_targets, n_robots, seed, cct, finished, result.wall_time_s)
 
 
-def _log(outcome: RunOutcome) -> RunOutcome:
+def _log(outcome: RunOutcome, csv_path: Path | None) -> RunOutcome:
+    if csv_path is not None:
+        new = not csv_path.exists()
+        with csv_path.open('a') as stream:
+            if new:
+                stream.write(CSV_HEADER)
+            stream.write(_csv_row(outcome))
     status = f'{outcome.cct_s:7.0f} s' if outcome.finished else 'unfinished'
     print(
         f'  {outcome.scheme:8s} {outcome.n_targets:2d} targets {outcome.n_robots:2d} robots '
@@ -80,11 +87,20 @@ def _log(outcome: RunOutcome) -> RunOutcome:
     return outcome
 
 
-def _run_all(jobs: list[tuple[str, int, int, int, float]], workers: int) -> list[RunOutcome]:
+def _csv_row(o: RunOutcome) -> str:
+    return (
+        f'{o.scheme},{o.n_targets},{o.n_robots},{o.seed},{o.cct_s:.0f},{o.finished:d},'
+        f'{o.wall_time_s:.1f}\n'
+    )
+
+
+def _run_all(
+    jobs: list[tuple[str, int, int, int, float]], workers: int, csv_path: Path | None
+) -> list[RunOutcome]:
     if workers <= 1:
-        return [_log(_run_one(job)) for job in jobs]
+        return [_log(_run_one(job), csv_path) for job in jobs]
     with ProcessPoolExecutor(max_workers=workers) as pool:
-        return [_log(outcome) for outcome in pool.map(_run_one, jobs)]
+        return [_log(outcome, csv_path) for outcome in pool.map(_run_one, jobs)]
 
 
 def _stats(outcomes: list[RunOutcome]) -> tuple[float, float, int, float]:
@@ -129,21 +145,25 @@ def run(
     runs: int = 10,
     sweep_runs: int = 5,
     schemes: tuple[str, ...] = SCHEMES,
-    max_time_s: float = 30000.0,
+    max_time_s: float = 20000.0,
     first_seed: int = 0,
     workers: int = 1,
+    csv_path: Path | None = None,
 ) -> tuple[str, list[RunOutcome]]:
-    """Run the experiments; return the report (markdown) and every run's outcome."""
+    """Run the experiments; return the report (markdown) and every run's outcome.
+
+    With ``csv_path``, every outcome is appended to that CSV file as soon as it is known.
+    """
     lines: list[str] = []
     outcomes: list[RunOutcome] = []
     if 'main' in experiments:
         jobs = [
             (scheme, n, robots, first_seed + s, max_time_s)
             for n in targets
-            for scheme in schemes
             for s in range(runs)
+            for scheme in schemes
         ]
-        main = _run_all(jobs, workers)
+        main = _run_all(jobs, workers, csv_path)
         outcomes += main
         lines += [
             f'## CCT [s], {robots} robots, {runs} seeded runs per cell (mean +- std)',
@@ -180,10 +200,10 @@ def run(
         jobs = [
             (scheme, sweep_targets, count, first_seed + s, max_time_s)
             for count in robot_counts
-            for scheme in schemes
             for s in range(sweep_runs)
+            for scheme in schemes
         ]
-        sweep = _run_all(jobs, workers)
+        sweep = _run_all(jobs, workers, csv_path)
         outcomes += sweep
         lines += [
             f'## CCT [s] against robot count, {sweep_targets} targets, {sweep_runs} runs per cell',
@@ -227,13 +247,15 @@ def main() -> None:
     parser.add_argument('--runs', type=int, default=10)
     parser.add_argument('--sweep-runs', type=int, default=5)
     parser.add_argument('--schemes', nargs='+', choices=SCHEMES, default=list(SCHEMES))
-    parser.add_argument('--max-time', type=float, default=30000.0, help='T_max per run [s]')
+    parser.add_argument('--max-time', type=float, default=20000.0, help='T_max per run [s]')
     parser.add_argument('--first-seed', type=int, default=0)
     parser.add_argument('--workers', type=int, default=1, help='processes (one core each)')
-    parser.add_argument('--out', type=Path, help='also write the report to this file')
+    parser.add_argument(
+        '--out', type=Path, help='write the report here and every run to <out>.csv as it ends'
+    )
     args = parser.parse_args()
     start = time.perf_counter()
-    report, outcomes = run(
+    report, _ = run(
         experiments=tuple(args.experiments),
         targets=tuple(args.targets),
         robots=args.robots,
@@ -245,19 +267,12 @@ def main() -> None:
         max_time_s=args.max_time,
         first_seed=args.first_seed,
         workers=args.workers,
+        csv_path=args.out.with_suffix('.csv') if args.out is not None else None,
     )
     report += f'\nTotal wall time: {time.perf_counter() - start:.0f} s\n'
     print(report)
     if args.out is not None:
-        rows = '\n'.join(
-            f'{o.scheme},{o.n_targets},{o.n_robots},{o.seed},{o.cct_s:.0f},{o.finished:d},'
-            f'{o.wall_time_s:.1f}'
-            for o in outcomes
-        )
         args.out.write_text(report)
-        args.out.with_suffix('.csv').write_text(
-            'scheme,targets,robots,seed,cct_s,finished,wall_s\n' + rows + '\n'
-        )
 
 
 if __name__ == '__main__':

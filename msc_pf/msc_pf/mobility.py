@@ -6,6 +6,7 @@ frame; a "movement vector" is what the robot steers along (spec 0.2 turns it int
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 
 import numpy as np
@@ -29,7 +30,9 @@ __all__ = [
 
 
 def avoidance_vector(
-    position_m: np.ndarray, neighbour_positions_m: np.ndarray, config: AvoidanceConfig
+    position_m: np.ndarray,
+    neighbour_positions_m: np.ndarray | Sequence[tuple[float, float]],
+    config: AvoidanceConfig,
 ) -> np.ndarray:
     """Collision-avoidance vector S_i (spec 1.3).
 
@@ -42,17 +45,21 @@ def avoidance_vector(
     Returns:
         (2,) vector; zero when nobody is close. Coincident robots are skipped.
     """
-    if len(neighbour_positions_m) == 0:
-        return np.zeros(2)
-    diff = position_m[None, :] - np.asarray(neighbour_positions_m, dtype=np.float64)
-    d = np.hypot(diff[:, 0], diff[:, 1])
-    if config.form == 'linear':
-        near = (d < config.safety_radius_m) & (d > 1e-9)
-        gain = (1.0 - d[near] / config.safety_radius_m) / d[near]
-    else:
-        near = (d < config.inverse_square_range_m) & (d > 1e-9)
-        gain = 1.0 / d[near] ** 3
-    return (diff[near] * gain[:, None]).sum(axis=0) if near.any() else np.zeros(2)
+    px, py = float(position_m[0]), float(position_m[1])
+    linear = config.form == 'linear'
+    reach = config.safety_radius_m if linear else config.inverse_square_range_m
+    sx = sy = 0.0
+    # A plain loop: a robot hears at most a few tens of neighbours, and numpy's per-call
+    # overhead would dominate.
+    for qx, qy in neighbour_positions_m:
+        dx, dy = px - float(qx), py - float(qy)
+        d = math.hypot(dx, dy)
+        if d >= reach or d <= 1e-9:
+            continue
+        gain = (1.0 - d / config.safety_radius_m) / d if linear else 1.0 / d**3
+        sx += gain * dx
+        sy += gain * dy
+    return np.array([sx, sy])
 
 
 def count_closer_heading_to(own_rssi_dbm: float, neighbour_rssi_dbm: Sequence[float]) -> int:

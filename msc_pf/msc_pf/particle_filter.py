@@ -288,11 +288,11 @@ class ParticleFilterBank:
     ) -> tuple[np.ndarray, np.ndarray]:
         obs = np.asarray(observer_xy, dtype=np.float64)
         values = np.asarray(rssi_dbm, dtype=np.float64)
-        if obs.shape != (2,) or not np.all(np.isfinite(obs)):
+        if obs.shape != (2,) or not (math.isfinite(obs[0]) and math.isfinite(obs[1])):
             raise ObservationError(f'observer position must be 2 finite numbers, got {obs!r}')
         if values.shape != (len(target_ids),):
             raise ObservationError(f'{len(target_ids)} target IDs but RSSI of shape {values.shape}')
-        if not np.all(np.isfinite(values)):
+        if not all(math.isfinite(v) for v in values.tolist()):
             raise ObservationError(f'RSSI values must be finite, got {values!r}')
         if len(set(target_ids)) != len(target_ids):
             raise ObservationError(f'target IDs repeat within one observation: {target_ids}')

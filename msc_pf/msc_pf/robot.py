@@ -141,6 +141,7 @@ class RobotController:
         self._work_blocked_until_s = -math.inf
         self._far_since_s: float | None = None
         self._swarm_changes: tuple[str, ...] = ()
+        self._with_estimates = True
 
     # ------------------------------------------------------------------ memory
     @property
@@ -199,6 +200,8 @@ class RobotController:
         readings: Mapping[int, float],
         peers: Sequence[PeerInfo] = (),
         captured_ids: Iterable[int] = (),
+        *,
+        with_estimates: bool = True,
     ) -> StepOutput:
         """Run one control period.
 
@@ -210,6 +213,8 @@ class RobotController:
             peers: peer messages received since the last step (own messages are ignored,
                 older duplicates dropped).
             captured_ids: targets this robot learned are captured (e.g. its task finished).
+            with_estimates: put the PF estimates into the status (False saves time when
+                nobody reads them, e.g. in batch simulations).
 
         Raises:
             ObservationError: position not finite, or time not advancing.
@@ -220,6 +225,7 @@ class RobotController:
         if not now_s > self._last_step_s:
             raise ObservationError(f'time {now_s} s does not advance past {self._last_step_s} s')
         self._last_step_s = now_s
+        self._with_estimates = with_estimates
         if self._start_s is None:
             self._start_s = now_s
         events: list[str] = []
@@ -326,6 +332,8 @@ class RobotController:
         else:
             groups = [[observation] for observation in observations]
         for group in groups:
+            if not group:
+                continue
             for target in self._bank.update_joint(group):
                 events.append(f'filter of target {target} degenerated: re-initialised')
         self._bank.end_step()
@@ -569,7 +577,11 @@ class RobotController:
             target_id=target,
             target_rssi_dbm=rssi,
             goal_m=goal,
-            estimates=tuple(self._bank.estimates()) if self._bank is not None else (),
+            estimates=(
+                tuple(self._bank.estimates())
+                if self._bank is not None and self._with_estimates
+                else ()
+            ),
             captured_ids=tuple(sorted(self._captured)),
         )
         changes, self._swarm_changes = self._swarm_changes, ()

@@ -138,7 +138,11 @@ def run_batch(
         outputs = []
         for i, controller in enumerate(controllers):
             heard = {int(t): float(samples[i, t]) for t in np.flatnonzero(~np.isnan(samples[i]))}
-            outputs.append(controller.step(now, positions[i], heard, inbox[i], notices[i]))
+            outputs.append(
+                controller.step(
+                    now, positions[i], heard, inbox[i], notices[i], with_estimates=False
+                )
+            )
         broadcast_positions = positions.copy()
         steps = np.array([out.displacement_m for out in outputs])
         positions = np.clip(positions + steps, 0.0, config.field_size_m)
