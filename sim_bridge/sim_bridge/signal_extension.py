@@ -139,10 +139,17 @@ class SignalMissionModel:
 
 
 class SignalExtension:
-    """SimExtension publishing ``signal`` per robot and ``/sim/source_search``."""
+    """SimExtension publishing ``signal`` per robot and ``/sim/source_search``.
 
-    def __init__(self, model: SignalMissionModel) -> None:
+    After the mission ends it lingers ``linger_s`` of sim time before reporting done, so a
+    recorder still receives the final status and true poses past the detection.
+    """
+
+    def __init__(self, model: SignalMissionModel, linger_s: float = 1.0) -> None:
         self.model = model
+        self.linger_s = linger_s
+        self._end_time_s: float | None = None
+        self._time_s = 0.0
         self._signal_pubs: list[Any] = []
         self._status_pub: Any = None
         self._names: tuple[str, ...] = ()
@@ -166,6 +173,7 @@ class SignalExtension:
         return self._builtin.Time(sec=int(ns // 1_000_000_000), nanosec=int(ns % 1_000_000_000))
 
     def on_step(self, sim_time_s: float, states: RobotStates) -> None:
+        self._time_s = sim_time_s
         if self._final_sent:
             return
         batch = self.model.step(sim_time_s, states.poses[:, :2])
@@ -181,6 +189,8 @@ class SignalExtension:
             self._status_pub.publish(self.status_message(sim_time_s))
             self._next_status_s = sim_time_s + _STATUS_PERIOD_S
             self._final_sent = self.model.done
+            if self._final_sent:
+                self._end_time_s = sim_time_s
 
     def status_message(self, time_s: float) -> Any:
         """The SourceSearchStatus describing the mission at ``time_s``."""
@@ -206,4 +216,4 @@ class SignalExtension:
         return msg
 
     def is_done(self) -> bool:
-        return self.model.done
+        return self._end_time_s is not None and self._time_s >= self._end_time_s + self.linger_s

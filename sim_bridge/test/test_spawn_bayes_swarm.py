@@ -16,7 +16,7 @@ from swarm_analysis.tau import tau_from_bag
 
 def _recorder_available():
     try:
-        from swarm_runtime.bag import BagRecorderNode  # noqa: F401
+        from swarm_runtime.bag import BagRecorder  # noqa: F401
     except ImportError:
         return False
     return True
@@ -44,6 +44,7 @@ def test_a_recorded_case_1_bag_gives_the_same_tau(tmp_path):
     assert from_bag.reported_tau == pytest.approx(result.tau)
     # /sim/poses is sampled at 2 Hz: the recomputed detection may lag by one sample.
     assert from_bag.found_time_s == pytest.approx(result.found_time_s, abs=0.5)
+    assert from_bag.tau == pytest.approx(result.tau, abs=0.5 * 0.1 / math.sqrt(5.0))
 
 
 @pytest.mark.slow

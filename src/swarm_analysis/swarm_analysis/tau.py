@@ -3,9 +3,9 @@
 tau = (t_achieved - t_idealized) / t_idealized, where t_idealized is the straight-line
 travel time at the nominal speed V from the start of the robot that found the source to the
 source. From a bag, the mission constants (source, eps, V, robots) come from the simulator's
-``/sim/source_search`` status, and the detection is recomputed from the true poses on
-``/sim/poses``: the first instant a robot, moving straight between two pose samples, comes
-within eps of the source.
+``/sim/source_search`` status (with the start positions), and the detection is recomputed
+from the true poses on ``/sim/poses``: the first instant a robot, moving straight between
+two pose samples, comes within eps of the source.
 """
 
 from __future__ import annotations
@@ -116,13 +116,18 @@ def tau_from_tracks(
     source_m: np.ndarray,
     radius_m: float,
     velocity_mps: float,
+    starts_m: np.ndarray | None = None,
 ) -> TauResult:
-    """tau from (k,) times and (k, n, 2) true positions of ``robots``."""
+    """tau from (k,) times and (k, n, 2) true positions of ``robots``.
+
+    ``starts_m`` (n, 2) are the start positions; None takes the first sample of each track.
+    """
     hit = first_detection(times_s, positions_m, source_m, radius_m)
     if hit is None:
         return TauResult(False, math.nan, '', math.nan)
     time_s, index = hit
-    start = np.asarray(positions_m)[0, index]
+    starts = np.asarray(positions_m)[0] if starts_m is None else np.asarray(starts_m)
+    start = starts[index]
     tau = relative_completion_time(time_s, start, source_m, velocity_mps)
     return TauResult(True, time_s, robots[index], tau)
 
@@ -160,6 +165,9 @@ def tau_from_bag(
         msg_text = f'{path}: no {poses_topic} message with all robots {robots}'
         raise TauError(msg_text)
     positions = np.array([[rows[k][r] for r in robots] for k in complete])
+    starts = None
+    if len(status.start_x) == len(robots) == len(status.start_y):
+        starts = np.column_stack([np.asarray(status.start_x), np.asarray(status.start_y)])
     result = tau_from_tracks(
         np.array([times[k] for k in complete]),
         positions,
@@ -167,5 +175,6 @@ def tau_from_bag(
         np.array([status.source_x, status.source_y]),
         float(status.detection_radius_m),
         float(status.velocity_mps),
+        starts,
     )
     return TauResult(result.found, result.found_time_s, result.finder, result.tau, reported)
