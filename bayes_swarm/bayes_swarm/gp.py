@@ -227,9 +227,13 @@ class GaussianProcess:
         q = np.asarray(query_m, dtype=float).reshape(-1, 2)
         k_q = se_kernel(self._x, q, self._hyper)
         mean = k_q.T @ self._weights
-        if self._chol_inv is None:
-            self._chol_inv = _inverse_factor(self._chol)
-        v = self._chol_inv @ k_q
+        if self._chol_inv is None and 4 * q.shape[0] < self._chol.shape[0]:
+            # A few queries: two triangular solves are cheaper than forming the inverse.
+            v = solve_triangular(self._chol, k_q, lower=True, check_finite=False)
+        else:
+            if self._chol_inv is None:
+                self._chol_inv = _inverse_factor(self._chol)
+            v = self._chol_inv @ k_q
         var = self._hyper.signal_variance - np.einsum('ij,ij->j', v, v)
         return mean, np.sqrt(np.maximum(var, 0.0))
 

@@ -43,7 +43,7 @@ __all__ = ['BayesSwarmPlanner', 'ascend_mean', 'first_waypoint']
 
 _MEAN_GRID_SIZE = 16
 _MAX_RAY_STEPS = 25
-_REFINE_LEVELS = 3
+_REFINE_LEVELS = 2
 
 
 def first_waypoint(
@@ -388,7 +388,7 @@ def _negated_mean(x: np.ndarray, gp: GaussianProcess) -> tuple[float, np.ndarray
 
 
 def ascend_mean(
-    gp: GaussianProcess, seeds_m: np.ndarray, arena: Arena, max_iterations: int = 25
+    gp: GaussianProcess, seeds_m: np.ndarray, arena: Arena, max_iterations: int = 15
 ) -> np.ndarray:
     """Eq. 5 from several starts at once: projected trust-region Newton ascent of the GP mean.
 
