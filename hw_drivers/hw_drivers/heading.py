@@ -12,7 +12,16 @@ import numpy as np
 
 from hw_drivers.errors import CalibrationError, ConfigurationError
 
-__all__ = ['BiasCalibrator', 'CalibrationConfig', 'CalibrationResult', 'YawIntegrator', 'wrap_pi']
+__all__ = [
+    'BiasCalibrator',
+    'CalibrationConfig',
+    'CalibrationResult',
+    'StillnessDetector',
+    'YawIntegrator',
+    'ZuptConfig',
+    'track_bias',
+    'wrap_pi',
+]
 
 
 def wrap_pi(angle_rad: float) -> float:
@@ -134,3 +143,72 @@ class YawIntegrator:
                 self.yaw_variance += self.yaw_rate_variance * dt
         self._last = (time_s, corrected)
         return self.yaw_rad
+
+
+@dataclass(frozen=True)
+class ZuptConfig:
+    """Zero-velocity bias tracking (HARDWARE.md §3.5): while the robot is commanded to stand
+    still, the gyro-Z bias slowly follows the measured rate, removing warm-up drift.
+
+    Attributes:
+        enabled: track the bias at all.
+        hold_s: the zero command must have lasted this long [s].
+        max_rate_radps: only rates this close to the bias count (a push is not a bias).
+        time_constant_s: time constant of the exponential bias average [s].
+        command_timeout_s: commands older than this do not prove stillness [s].
+    """
+
+    enabled: bool = True
+    hold_s: float = 1.0
+    max_rate_radps: float = math.radians(0.5)
+    time_constant_s: float = 20.0
+    command_timeout_s: float = 0.5
+
+    def __post_init__(self) -> None:
+        if min(self.hold_s, self.max_rate_radps, self.time_constant_s) <= 0.0:
+            raise ConfigurationError('ZUPT hold, rate limit and time constant must be > 0')
+        if self.command_timeout_s <= 0.0:
+            raise ConfigurationError('ZUPT command_timeout_s must be > 0')
+
+
+class StillnessDetector:
+    """Whether velocity commands say the robot stands still.
+
+    The executor records commands, the device thread asks; the state is one tuple that is
+    replaced, never mutated, so a reader always sees a consistent pair.
+    """
+
+    def __init__(self, config: ZuptConfig) -> None:
+        self.config = config
+        self._state: tuple[float, float] | None = None  # (last command time, zero since)
+
+    def command(self, time_s: float, moving: bool) -> None:
+        """Record a velocity command received at ``time_s``."""
+        state = self._state
+        if moving:
+            zero_since_s = math.inf
+        elif state is None or math.isinf(state[1]):
+            zero_since_s = time_s
+        else:
+            zero_since_s = state[1]
+        self._state = (time_s, zero_since_s)
+
+    def still(self, time_s: float) -> bool:
+        """True when a fresh zero command has held for ``hold_s``."""
+        state = self._state
+        if state is None or not self.config.enabled:
+            return False
+        last_s, zero_since_s = state
+        fresh = 0.0 <= time_s - last_s <= self.config.command_timeout_s
+        return fresh and time_s - zero_since_s >= self.config.hold_s
+
+
+def track_bias(
+    integrator: YawIntegrator, rate_radps: float, dt_s: float, config: ZuptConfig
+) -> bool:
+    """Move the integrator's bias toward ``rate_radps`` (robot known still); True if updated."""
+    if abs(rate_radps - integrator.bias_radps) > config.max_rate_radps or dt_s <= 0.0:
+        return False
+    weight = min(dt_s / config.time_constant_s, 1.0)
+    integrator.bias_radps += weight * (rate_radps - integrator.bias_radps)
+    return True

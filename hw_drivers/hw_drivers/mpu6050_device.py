@@ -23,7 +23,14 @@ from hw_drivers.errors import (
     ProtocolError,
     RecoverableDeviceError,
 )
-from hw_drivers.heading import BiasCalibrator, CalibrationConfig, YawIntegrator
+from hw_drivers.heading import (
+    BiasCalibrator,
+    CalibrationConfig,
+    StillnessDetector,
+    YawIntegrator,
+    ZuptConfig,
+    track_bias,
+)
 from hw_drivers.i2c_transport import SMBusLike, i2c_error
 from hw_drivers.mpu6050_protocol import (
     DATA_BLOCK_LENGTH,
@@ -141,6 +148,8 @@ class HeadingState:
     """Calibration and yaw that outlive a reconnect."""
 
     calibration: CalibrationConfig = field(default_factory=CalibrationConfig)
+    stillness: StillnessDetector = field(default_factory=lambda: StillnessDetector(ZuptConfig()))
+    zupt_updates: int = 0
     integrator: YawIntegrator | None = None
     calibrator: BiasCalibrator | None = None
     calibration_failures: int = 0
@@ -279,6 +288,10 @@ class ImuSession:
                 return False
             heading.integrator = YawIntegrator(result.bias_radps, nominal_dt_s=self.period_s)
         integrator = heading.integrator
+        if heading.stillness.still(now) and track_bias(
+            integrator, gyro[2], self.period_s, heading.stillness.config
+        ):
+            heading.zupt_updates += 1
         yaw = integrator.update(now, gyro[2])
         corrected = (gyro[0], gyro[1], gyro[2] - integrator.bias_radps)
         self._on_reading(

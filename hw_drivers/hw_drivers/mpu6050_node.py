@@ -3,8 +3,10 @@
 
 At start the robot must stand still for ``calibration_s`` while the gyro-Z bias is measured;
 nothing is published before that (a wrong bias would make every heading wrong). If the robot
-moves during calibration, it is repeated. After a reconnect (brown-out, loose cable) the yaw
-continues from where it was.
+moves during calibration, it is repeated. Afterwards, whenever ``cmd_vel`` has been zero for
+``zupt_hold_s``, the bias slowly follows the measured rate (zero-velocity update), which
+removes most warm-up drift. After a reconnect (brown-out, loose cable) the yaw continues
+from where it was.
 
 Run: ``ros2 run hw_drivers mpu6050_node --ros-args -r __ns:=/r0 -p i2c_bus:=1``.
 """
@@ -29,7 +31,7 @@ from hw_drivers.backoff import BackoffConfig
 from hw_drivers.conversions import imu_to_ros
 from hw_drivers.errors import ConfigurationError
 from hw_drivers.fakes.i2c import FakeMpu6050, FakeSMBus
-from hw_drivers.heading import CalibrationConfig
+from hw_drivers.heading import CalibrationConfig, StillnessDetector, ZuptConfig
 from hw_drivers.i2c_transport import SMBusLike, open_smbus
 from hw_drivers.mpu6050_device import HeadingState, ImuReading, ImuSession, Mounting, Mpu6050
 from hw_drivers.mpu6050_protocol import Mpu6050Config
@@ -47,6 +49,7 @@ from hw_drivers.worker import DeviceWorker
 __all__ = ['PARAMETERS', 'Mpu6050Node', 'main']
 
 sensor_msgs = message_module('sensor_msgs')
+geometry_msgs = message_module('geometry_msgs')
 diagnostic_msgs = message_module('diagnostic_msgs')
 
 PARAMETERS: list[ParamSpec] = [
@@ -61,6 +64,9 @@ PARAMETERS: list[ParamSpec] = [
     ('mounting', 'z_up', 'board orientation: z_up, or z_down (upside down)'),
     ('calibration_s', 4.0, 'still time for the gyro-Z bias calibration at start [s]'),
     ('calibration_max_std_dps', 0.3, 'gyro-Z spread above which the robot moved [deg/s]'),
+    ('zupt', True, 'track the gyro-Z bias while cmd_vel has been zero for zupt_hold_s'),
+    ('zupt_hold_s', 1.0, 'how long cmd_vel must be zero before the bias is tracked [s]'),
+    ('zupt_time_constant_s', 20.0, 'time constant of the bias tracking [s]'),
     ('frame_id', 'imu_link', 'frame of the published messages'),
     ('stale_timeout_s', 0.5, 'no message published for this long is reported stale [s]'),
     ('device_thread', True, 'run the device loop in its own thread (false: from a timer)'),
@@ -90,11 +96,17 @@ class Mpu6050Node(Node):
         self._rate_hz = float(values['rate_hz'])
         if not self._rate_hz > 0.0:
             raise ConfigurationError(f'rate_hz must be > 0, got {self._rate_hz}')
+        zupt = ZuptConfig(
+            enabled=bool(values['zupt']),
+            hold_s=float(values['zupt_hold_s']),
+            time_constant_s=float(values['zupt_time_constant_s']),
+        )
         self._heading = HeadingState(
             CalibrationConfig(
                 duration_s=float(values['calibration_s']),
                 max_std_radps=math.radians(float(values['calibration_max_std_dps'])),
-            )
+            ),
+            stillness=StillnessDetector(zupt),
         )
         self._frame_id = str(values['frame_id'])
         self._threaded = bool(values['device_thread'])
@@ -110,6 +122,7 @@ class Mpu6050Node(Node):
         self._readings: deque[ImuReading] = deque(maxlen=50)
         self._session: ImuSession | None = None
         self._imu_pub = self.create_publisher(sensor_msgs.Imu, 'imu', qos_profile_sensor_data)
+        self.create_subscription(geometry_msgs.Twist, 'cmd_vel', self._on_cmd_vel, 10)
         self._diag_pub = self.create_publisher(
             diagnostic_msgs.DiagnosticArray, DIAGNOSTICS_TOPIC, 10
         )
@@ -128,6 +141,13 @@ class Mpu6050Node(Node):
         )
         self.create_timer(1.0 / self._rate_hz, self._publish_readings)
         self.create_timer(1.0, self._publish_diagnostics)
+
+    def _on_cmd_vel(self, msg: Any) -> None:
+        moving = any(
+            v != 0.0
+            for v in (msg.linear.x, msg.linear.y, msg.angular.z, msg.angular.x, msg.angular.y)
+        )
+        self._heading.stillness.command(self._device_clock(), moving)
 
     def _open_bus(self) -> SMBusLike:
         if self._fake_chip is not None:
@@ -176,6 +196,7 @@ class Mpu6050Node(Node):
             extra['gyro_z_bias_dps'] = f'{math.degrees(heading.integrator.bias_radps):.4f}'
             extra['yaw_deg'] = f'{math.degrees(heading.integrator.yaw_rad):.2f}'
             extra['dt_outliers'] = str(heading.integrator.dt_outliers)
+            extra['zupt_updates'] = str(heading.zupt_updates)
         if self._session is not None:
             extra['read_errors'] = str(self._session.read_errors)
             extra['saturations'] = str(self._session.saturations)

@@ -14,7 +14,15 @@ from hw_drivers.errors import (
 )
 from hw_drivers.fakes.clock import FakeClock
 from hw_drivers.fakes.i2c import FakeMpu6050, FakeSMBus
-from hw_drivers.heading import BiasCalibrator, CalibrationConfig, YawIntegrator, wrap_pi
+from hw_drivers.heading import (
+    BiasCalibrator,
+    CalibrationConfig,
+    StillnessDetector,
+    YawIntegrator,
+    ZuptConfig,
+    track_bias,
+    wrap_pi,
+)
 from hw_drivers.mpu6050_device import HeadingState, ImuSession, Mounting, Mpu6050
 from hw_drivers.mpu6050_protocol import Mpu6050Config, decode_data_block, scale_sample
 from hw_drivers.worker import DeviceWorker, DiagnosticLevel
@@ -228,3 +236,56 @@ def test_integrator_caps_long_gaps_and_counts_them():
 )
 def test_wrap_pi_returns_the_half_open_interval(angle, wrapped):
     assert wrap_pi(angle) == pytest.approx(wrapped)
+
+
+def test_stillness_needs_a_fresh_zero_command_held_long_enough():
+    detector = StillnessDetector(ZuptConfig(hold_s=1.0, command_timeout_s=0.5))
+    assert not detector.still(0.0)  # no command yet: unknown, not still
+    for k in range(12):
+        detector.command(k * 0.1, moving=False)
+    assert detector.still(1.1)
+    assert not detector.still(2.0)  # commands went stale
+    detector.command(2.0, moving=True)
+    detector.command(2.1, moving=False)
+    assert not detector.still(2.2)  # the zero has to hold again
+
+
+def test_bias_tracking_ignores_rates_far_from_the_bias():
+    integrator = YawIntegrator(0.0)
+    config = ZuptConfig(max_rate_radps=0.01, time_constant_s=1.0)
+    assert not track_bias(integrator, 0.5, 0.01, config)  # a push, not a bias
+    assert track_bias(integrator, 0.005, 0.5, config)
+    assert integrator.bias_radps == pytest.approx(0.0025)
+
+
+def _drift_after_warm_up(zupt_enabled):
+    """Bias steps from 0.5 to 0.8 deg/s after calibration; the robot stands still for 60 s."""
+    clock = FakeClock()
+    chip = FakeMpu6050(clock, bias_dps=0.5, noise_dps=0.02)
+    bus = FakeSMBus({0x68: chip})
+    device = Mpu6050(bus, Mpu6050Config(), sleep=clock.sleep)
+    device.initialise()
+    heading = HeadingState(
+        CalibrationConfig(duration_s=2.0),
+        stillness=StillnessDetector(ZuptConfig(enabled=zupt_enabled, time_constant_s=5.0)),
+    )
+    readings = []
+    session = ImuSession(device, heading, readings.append, sleep=clock.sleep, clock=clock)
+    next_command_s = 0.0
+    while clock() < 62.0:
+        if clock() >= 3.0:
+            chip.bias_dps = 0.8
+        if clock() >= next_command_s:
+            heading.stillness.command(clock(), moving=False)
+            next_command_s += 0.1
+        session.poll()
+    return abs(math.degrees(readings[-1].yaw_rad)), heading
+
+
+def test_zero_velocity_updates_remove_most_warm_up_drift():
+    drift_without, _ = _drift_after_warm_up(zupt_enabled=False)
+    drift_with, heading = _drift_after_warm_up(zupt_enabled=True)
+    assert drift_without == pytest.approx(0.3 * 59, rel=0.05)  # 0.3 deg/s for 59 s
+    assert drift_with < drift_without / 5
+    assert heading.zupt_updates > 0
+    assert math.degrees(heading.integrator.bias_radps) == pytest.approx(0.8, abs=0.02)
