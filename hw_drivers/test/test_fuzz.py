@@ -13,6 +13,7 @@ from hw_drivers.gas_protocol import (
     AdsConfig,
     decode_ads_conversion,
     decode_xiao_reply,
+    grove_ratio_to_raw10,
 )
 from hw_drivers.mpu6050_protocol import decode_data_block
 from hw_drivers.pump_control import PumpController, PumpLimits
@@ -268,3 +269,10 @@ def test_pump_never_breaks_its_limits_whatever_the_commands(steps, max_on, min_o
             on_since = t
         if not out and on_since is not None:
             off_since, on_since = t, None
+
+
+@FUZZ
+@given(st.integers(-(2**16), 2**16))
+def test_grove_ratio_register_maps_or_raises_only_protocol_errors(word):
+    raw10 = _only_protocol_errors(grove_ratio_to_raw10, word)
+    assert raw10 is None or 0 <= raw10 <= 1023
