@@ -50,6 +50,13 @@ class RadioConfig:
 
     The paper's "P0 = 40.046" is the reference loss at 1 m (Friis at 2.4 GHz), so the RSSI at
     1 m is ``tx_power_dbm - reference_loss_db`` = -27.046 dBm.
+
+    Attributes:
+        tx_power_dbm: target transmit power [dBm] (Table I: 13).
+        reference_loss_db: path loss at 1 m [dB] (Table I's P0: 40.046).
+        path_loss_exponent: K of eq. (4) (Table I: 3).
+        noise_std_db: receiver noise standard deviation [dB] (Table I: variance 1).
+        detection_threshold_dbm: gamma_D, weaker signals are not heard [dBm] (Table I: -101).
     """
 
     tx_power_dbm: float = 13.0

@@ -104,7 +104,6 @@ class SwarmMembership:
         peers: Mapping[int, PeerInfo],
         own_target: int,
         own_phase: Phase,
-        leader_target: int | None = None,
     ) -> str | None:
         """Apply rules 2-5 once, after this step's peer messages arrived.
 
@@ -112,8 +111,6 @@ class SwarmMembership:
             peers: latest message of every robot in range, by ID.
             own_target: the target this robot would choose itself (NO_TARGET for none).
             own_phase: this robot's phase (WORK makes it lead itself).
-            leader_target: unused by leaders; for followers the leader's target, when known
-                from elsewhere than ``peers``.
 
         Returns:
             A short description of a membership change, or None.
@@ -127,12 +124,10 @@ class SwarmMembership:
             self.members = self._accepted_members(peers)
             return None
         if self.role is Role.FOLLOWER:
-            return self._update_follower(peers, own_target, leader_target)
+            return self._update_follower(peers, own_target)
         return self._update_leader(peers, own_target, own_phase)
 
-    def _update_follower(
-        self, peers: Mapping[int, PeerInfo], own_target: int, leader_target: int | None
-    ) -> str | None:
+    def _update_follower(self, peers: Mapping[int, PeerInfo], own_target: int) -> str | None:
         leader = peers.get(self.leader_id)
         if leader is None:
             lost = self.leader_id
@@ -152,7 +147,7 @@ class SwarmMembership:
             if self._unlisted_steps > self._cfg.membership_grace_steps:
                 self._lead_alone()
                 return f'not accepted by leader {leader.robot_id}: leads itself'
-        target = leader.target_id if leader_target is None else leader_target
+        target = leader.target_id
         if own_target != NO_TARGET and target != NO_TARGET and own_target != target:
             return self._split(peers, own_target)
         return None

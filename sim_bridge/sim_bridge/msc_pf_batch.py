@@ -85,7 +85,11 @@ class BatchResult:
 
 
 def _deliver(
-    outputs: list[StepOutput], positions: np.ndarray, comm_range_m: float, loss: float, rng
+    outputs: list[StepOutput],
+    positions: np.ndarray,
+    comm_range_m: float,
+    loss: float,
+    rng: np.random.Generator,
 ) -> list[list[PeerInfo]]:
     """Peer messages each robot receives: senders within range, minus random losses."""
     n = len(outputs)
