@@ -44,7 +44,7 @@ class GasSensorConfig:
 
     rate_hz: float = 10.0
     rise_time_constant_s: float = 3.0
-    fall_time_constant_s: float = 10.0
+    fall_time_constant_s: float = 5.0
     baseline_raw: float = 60.0
     half_response_ppm: float = 400.0
     noise_std_raw: float = 4.0

@@ -43,7 +43,7 @@ class ScentConfig:
         walls_block: when True, vapour does not cross walls.
     """
 
-    deposit_rate_ppm_m2_per_s: float = 100.0
+    deposit_rate_ppm_m2_per_s: float = 80.0
     deposit_period_s: float = 0.25
     initial_spread_m: float = 0.08
     final_spread_m: float = 0.15
