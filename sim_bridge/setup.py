@@ -23,12 +23,14 @@ setup(
         ('share/ament_index/resource_index/packages', [f'resource/{PACKAGE_NAME}']),
         (f'share/{PACKAGE_NAME}', ['package.xml']),
         *share_files('config'),
+        *share_files('config/sites'),
     ],
     install_requires=[
         'numpy',
         'scipy',
         'matplotlib',
         'pybullet',
+        'PyYAML',
         'swarm_runtime',
         'swarm_analysis',
     ],
@@ -46,6 +48,7 @@ setup(
             'spawn = sim_bridge.spawn:main',
             'spawn_bayes_swarm = sim_bridge.spawn_bayes_swarm:main',
             'spawn_msc_pf = sim_bridge.spawn_msc_pf:main',
+            'site_tool = sim_bridge.sites.cli:main',
         ],
     },
 )
