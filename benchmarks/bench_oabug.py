@@ -14,6 +14,7 @@ from __future__ import annotations
 import argparse
 import math
 import multiprocessing
+import sys
 import time
 from collections import defaultdict
 from collections.abc import Sequence
@@ -162,7 +163,17 @@ def run(
     else:
         context = multiprocessing.get_context('spawn')
         with context.Pool(workers, maxtasksperchild=20) as pool:
-            outcomes = list(pool.imap_unordered(run_job, jobs, chunksize=1))
+            outcomes = []
+            for outcome in pool.imap_unordered(run_job, jobs, chunksize=1):
+                outcomes.append(outcome)
+                job = outcome.job
+                print(
+                    f'[{len(outcomes)}/{len(jobs)}] site {job.site_seed} {job.departure} '
+                    f'{job.variant}: {100.0 * outcome.coverage:.1f} % '
+                    f'in {outcome.wall_time_s:.0f} s wall',
+                    file=sys.stderr,
+                    flush=True,
+                )
     return outcomes, time.perf_counter() - start
 
 
