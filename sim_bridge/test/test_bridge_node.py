@@ -10,6 +10,7 @@ from sim_bridge.bridge_node import SimBridgeNode
 from sim_bridge.bridge_parameters import values_from_config
 from sim_bridge.engine import EngineConfig
 from sim_bridge.errors import ConfigurationError
+from sim_bridge.site_loading import load_site
 from swarm_runtime.ros import (
     Node,
     Parameter,
@@ -131,3 +132,40 @@ def test_config_file_mirrors_the_engine_defaults():
     params = yaml.safe_load(CONFIG.read_text())['/sim_bridge']['ros__parameters']
     for name, value in values_from_config(EngineConfig()).items():
         assert params[name] == pytest.approx(value), name
+
+
+class PeerProbe(Node):
+    """Robot-side endpoints of the peer relay for robots r0..r2."""
+
+    def __init__(self):
+        super().__init__('peer_probe', parameter_overrides=[Parameter('use_sim_time', value=True)])
+        std_msgs = message_module('std_msgs')
+        self.out = [
+            self.create_publisher(std_msgs.String, f'/r{i}/peers/out', 10) for i in range(3)
+        ]
+        self.received = {i: [] for i in range(3)}
+        for i in range(3):
+            self.create_subscription(
+                std_msgs.String, f'/r{i}/peers/in', self.received[i].append, 10
+            )
+        self.string = std_msgs.String
+
+
+def test_peer_relay_forwards_within_range_only(ros):
+    poses = np.array([[1.0, 1.7, 0.0], [2.0, 1.7, 0.0], [5.5, 1.7, 0.0]])
+    bridge = SimBridgeNode(
+        site=load_site(str(FIVE_ROOMS)),
+        initial_poses=poses,
+        parameter_overrides=[
+            Parameter('peer_msg_type', value='std_msgs/msg/String'),
+            Parameter('comm_range_m', value=2.0),
+        ],
+    )
+    probe = PeerProbe()
+    for node in (bridge, probe):
+        ros.add_node(node)
+    probe.out[0].publish(probe.string(data='hello from r0'))
+    spin_until(ros, lambda: bridge.sim_time_s >= 0.5, max_wall_time_s=5.0)
+    assert [m.data for m in probe.received[1]] == ['hello from r0']
+    assert probe.received[0] == []
+    assert probe.received[2] == []
