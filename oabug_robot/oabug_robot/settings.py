@@ -155,7 +155,7 @@ class PerceptionConfig:
     front_half_width_m: float = 0.12
     wall_hit_distance_m: float = 0.28
     wrap_stop_distance_m: float = 0.18
-    robot_hit_distance_m: float = 0.40
+    robot_hit_distance_m: float = 0.25
     robot_cone_half_angle_rad: float = math.radians(30.0)
     peer_bearing_tolerance_rad: float = math.radians(10.0)
     peer_mask_range_m: float = 1.0

@@ -11,6 +11,7 @@ from oabug_robot.heading import angle_difference
 from oabug_robot.scan_features import ScanFeatures, SideWall
 from oabug_robot.settings import (
     OABugConfig,
+    PerceptionConfig,
     SoundMemory,
     SoundTurnRule,
     TurnDirection,
@@ -30,8 +31,11 @@ def wall_ahead() -> ScanFeatures:
     return ScanFeatures(front_wall_m=0.2, left=SideWall(0.2, 0.0), right=SideWall(0.2, 0.0))
 
 
-def robot_ahead() -> ScanFeatures:
-    return ScanFeatures(front_robot_m=0.3)
+HIT_M = PerceptionConfig().robot_hit_distance_m
+
+
+def robot_ahead(distance_m: float = HIT_M - 0.05) -> ScanFeatures:
+    return ScanFeatures(front_robot_m=distance_m)
 
 
 def side_wall(side: int, abeam: bool = True) -> ScanFeatures:
@@ -166,6 +170,15 @@ def test_hitting_another_robot_while_heading_out_stays_just_started(variant: Var
     script.step(robot_ahead())
     assert fsm.memory.event is Event.HIT_ROBOT
     assert fsm.memory.state is FsmState.JUST_STARTED
+
+
+def test_a_peer_just_beyond_the_hit_distance_is_not_hit() -> None:
+    fsm = make(Variant.GAS)
+    script = Script(fsm)
+    script.step(free())
+    script.step(robot_ahead(HIT_M + 0.05))
+    assert Event.HIT_ROBOT not in fsm.memory.counts
+    assert fsm.memory.mode is Mode.STRAIGHT
 
 
 def test_a_peer_is_not_hit_while_turning_in_place() -> None:
