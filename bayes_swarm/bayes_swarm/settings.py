@@ -109,8 +109,8 @@ class GpConfig:
     signal_variance_bounds: tuple[float, float] = (1e-5, 1e5)
     initial_length_scale_m: float = 1.0
     initial_signal_variance: float = 1.0
-    max_fit_points: int = 150
-    refit_growth_factor: float = 1.5
+    max_fit_points: int = 80
+    refit_growth_factor: float = 2.0
     max_jitter: float = 1e-2
 
     def __post_init__(self) -> None:
