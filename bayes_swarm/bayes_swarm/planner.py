@@ -404,11 +404,13 @@ def ascend_mean(
     tolerance = 1e-7 * max(ell, 1e-9)
     for _ in range(max_iterations):
         step = grad * (ell * ell / np.maximum(np.abs(mean), 1e-12))[:, None]
-        det = hess[:, 0, 0] * hess[:, 1, 1] - hess[:, 0, 1] * hess[:, 1, 0]
-        concave = (hess[:, 0, 0] < 0.0) & (det > 0.0)
-        if np.any(concave):
-            newton = -np.linalg.solve(hess[concave], grad[concave][:, :, None])[:, :, 0]
-            step[concave] = newton
+        h00, h01, h11 = hess[:, 0, 0], hess[:, 0, 1], hess[:, 1, 1]
+        det = h00 * h11 - h01 * h01
+        concave = (h00 < 0.0) & (det > 0.0)
+        safe_det = np.where(concave, det, 1.0)
+        newton_x = -(h11 * grad[:, 0] - h01 * grad[:, 1]) / safe_det
+        newton_y = -(h00 * grad[:, 1] - h01 * grad[:, 0]) / safe_det
+        step = np.where(concave[:, None], np.column_stack([newton_x, newton_y]), step)
         norm = np.hypot(step[:, 0], step[:, 1])
         scale = np.minimum(1.0, radius / np.maximum(norm, 1e-300))
         candidate = arena.clip(x + step * scale[:, None])
