@@ -57,7 +57,10 @@ class CoverageTracker:
         if np.any(rects[:, 2] <= rects[:, 0]) or np.any(rects[:, 3] <= rects[:, 1]):
             raise WorldGeometryError('every room rectangle needs x_max > x_min and y_max > y_min')
         self._rects = rects
-        self._rect_room = np.repeat(np.arange(len(per_room)), [len(r) for r in per_room])
+        rect_room = np.repeat(np.arange(len(per_room)), [len(r) for r in per_room])
+        # (R, K) 0/1 matrix: rectangle r belongs to room k.
+        self._membership = np.zeros((len(rects), len(per_room)), dtype=np.int32)
+        self._membership[np.arange(len(rects)), rect_room] = 1
         self._num_rooms = len(per_room)
         self._room_index_at = room_index_at
         self._radius_m = float(robot_radius_m)
@@ -97,9 +100,7 @@ class CoverageTracker:
         dx = np.maximum(np.maximum(r[None, :, 0] - x, x - r[None, :, 2]), 0.0)
         dy = np.maximum(np.maximum(r[None, :, 1] - y, y - r[None, :, 3]), 0.0)
         in_rect = dx * dx + dy * dy < self._radius_m**2
-        result = np.zeros((len(xy), self._num_rooms), dtype=bool)
-        for k in range(len(r)):
-            result[:, self._rect_room[k]] |= in_rect[:, k]
+        result = (in_rect.astype(np.int32) @ self._membership) > 0
         if self._room_index_at is not None:
             index = np.asarray(self._room_index_at(xy), dtype=int)
             robots = np.flatnonzero((index >= 0) & (index < self._num_rooms))
