@@ -141,6 +141,105 @@ def pf_update_time_ms(
     return 1e3 * float(np.median(wall)), 1e3 * float(np.median(cpu))
 
 
+def _cell(outcomes: list[RunOutcome]) -> tuple[str, float, int, float]:
+    if not outcomes:
+        return '-', math.nan, 0, math.nan
+    mean, std, late, wall = _stats(outcomes)
+    return f'{mean:.0f} +- {std:.0f} (n={len(outcomes)})', mean, late, wall
+
+
+def main_table(outcomes: list[RunOutcome], robots: int, schemes: tuple[str, ...]) -> list[str]:
+    """CCT per target count and scheme with the ratios of the means (markdown lines)."""
+    rows = [o for o in outcomes if o.n_robots == robots]
+    lines = [
+        f'## CCT [s], {robots} robots (mean +- std over n seeded runs)',
+        '',
+        '| targets | '
+        + ' | '.join(schemes)
+        + ' | proposed/msc | msc_pf/msc | proposed/msc_pf | unfinished | wall s/run |',
+        '|---' * (len(schemes) + 6) + '|',
+    ]
+    for n in sorted({o.n_targets for o in rows}):
+        cells, means, unfinished, walls = [], {}, [], []
+        for scheme in schemes:
+            text, mean, late, wall = _cell(
+                [o for o in rows if o.n_targets == n and o.scheme == scheme]
+            )
+            means[scheme] = mean
+            cells.append(text)
+            unfinished.append(f'{scheme}:{late}')
+            walls.append(f'{scheme}:{wall:.0f}')
+
+        def ratio(a: str, b: str, means: dict[str, float] = means) -> str:
+            if a in means and b in means and means[b] > 0:
+                return f'{means[a] / means[b]:.2f}'
+            return '-'
+
+        lines.append(
+            f'| {n} | '
+            + ' | '.join(cells)
+            + f' | {ratio("proposed", "msc")} | {ratio("msc_pf", "msc")}'
+            + f' | {ratio("proposed", "msc_pf")} | {" ".join(unfinished)}'
+            + f' | {" ".join(walls)} |'
+        )
+    return [*lines, '']
+
+
+def robot_table(outcomes: list[RunOutcome], n_targets: int, schemes: tuple[str, ...]) -> list[str]:
+    """CCT per robot count and scheme at ``n_targets`` targets (markdown lines)."""
+    rows = [o for o in outcomes if o.n_targets == n_targets]
+    lines = [
+        f'## CCT [s] against robot count, {n_targets} targets',
+        '',
+        '| robots | ' + ' | '.join(schemes) + ' | unfinished |',
+        '|---' * (len(schemes) + 2) + '|',
+    ]
+    for count in sorted({o.n_robots for o in rows}):
+        cells, unfinished = [], []
+        for scheme in schemes:
+            text, _, late, _ = _cell(
+                [o for o in rows if o.n_robots == count and o.scheme == scheme]
+            )
+            cells.append(text)
+            unfinished.append(f'{scheme}:{late}')
+        lines.append(f'| {count} | ' + ' | '.join(cells) + f' | {" ".join(unfinished)} |')
+    return [*lines, '']
+
+
+def read_outcomes(path: Path) -> list[RunOutcome]:
+    """Outcomes from a CSV written by :func:`run` (e.g. of an interrupted benchmark)."""
+    outcomes = []
+    for line in path.read_text().splitlines()[1:]:
+        scheme, targets, robots, seed, cct, finished, wall = line.split(',')
+        outcomes.append(
+            RunOutcome(
+                scheme,
+                int(targets),
+                int(robots),
+                int(seed),
+                float(cct),
+                bool(int(finished)),
+                float(wall),
+            )
+        )
+    return outcomes
+
+
+def pf_table() -> list[str]:
+    """Particle-filter update times (markdown lines)."""
+    one = pf_update_time_ms(20, observers=1)
+    three = pf_update_time_ms(20, observers=3)
+    return [
+        '## Particle-filter update time (20 targets x 5041 particles, median)',
+        '',
+        '| update | wall ms | CPU ms |',
+        '|---|---|---|',
+        f'| one observation of 20 targets | {one[0]:.2f} | {one[1]:.2f} |',
+        f'| fused step: 3 observers x 20 targets | {three[0]:.2f} | {three[1]:.2f} |',
+        '',
+    ]
+
+
 def run(
     *,
     experiments: tuple[str, ...] = EXPERIMENTS,
@@ -171,37 +270,7 @@ def run(
         ]
         main = _run_all(jobs, workers, csv_path)
         outcomes += main
-        lines += [
-            f'## CCT [s], {robots} robots, {runs} seeded runs per cell (mean +- std)',
-            '',
-            '| targets | ' + ' | '.join(schemes) + ' | proposed/msc | msc_pf/msc | '
-            'proposed/msc_pf | unfinished | wall s/run |',
-            '|---' * (len(schemes) + 6) + '|',
-        ]
-        for n in targets:
-            cells, means, unfinished, walls = [], {}, [], []
-            for scheme in schemes:
-                mean, std, late, wall = _stats(
-                    [o for o in main if o.n_targets == n and o.scheme == scheme]
-                )
-                means[scheme] = mean
-                cells.append(f'{mean:.0f} +- {std:.0f}')
-                unfinished.append(f'{scheme}:{late}')
-                walls.append(f'{scheme}:{wall:.0f}')
-
-            def ratio(a: str, b: str, means: dict[str, float] = means) -> str:
-                if a in means and b in means and means[b] > 0:
-                    return f'{means[a] / means[b]:.2f}'
-                return '-'
-
-            lines.append(
-                f'| {n} | '
-                + ' | '.join(cells)
-                + f' | {ratio("proposed", "msc")} | {ratio("msc_pf", "msc")}'
-                + f' | {ratio("proposed", "msc_pf")} | {" ".join(unfinished)}'
-                + f' | {" ".join(walls)} |'
-            )
-        lines.append('')
+        lines += main_table(main, robots, schemes)
     if 'robots' in experiments:
         jobs = [
             (scheme, sweep_targets, count, first_seed + s, max_time_s)
@@ -211,34 +280,9 @@ def run(
         ]
         sweep = _run_all(jobs, workers, csv_path)
         outcomes += sweep
-        lines += [
-            f'## CCT [s] against robot count, {sweep_targets} targets, {sweep_runs} runs per cell',
-            '',
-            '| robots | ' + ' | '.join(schemes) + ' | unfinished |',
-            '|---' * (len(schemes) + 2) + '|',
-        ]
-        for count in robot_counts:
-            cells, unfinished = [], []
-            for scheme in schemes:
-                mean, std, late, _ = _stats(
-                    [o for o in sweep if o.n_robots == count and o.scheme == scheme]
-                )
-                cells.append(f'{mean:.0f} +- {std:.0f}')
-                unfinished.append(f'{scheme}:{late}')
-            lines.append(f'| {count} | ' + ' | '.join(cells) + f' | {" ".join(unfinished)} |')
-        lines.append('')
+        lines += robot_table(sweep, sweep_targets, schemes)
     if 'pf' in experiments:
-        one = pf_update_time_ms(20, observers=1)
-        three = pf_update_time_ms(20, observers=3)
-        lines += [
-            '## Particle-filter update time (20 targets x 5041 particles, median)',
-            '',
-            '| update | wall ms | CPU ms |',
-            '|---|---|---|',
-            f'| one observation of 20 targets | {one[0]:.2f} | {one[1]:.2f} |',
-            f'| fused step: 3 observers x 20 targets | {three[0]:.2f} | {three[1]:.2f} |',
-            '',
-        ]
+        lines += pf_table()
     return '\n'.join(lines), outcomes
 
 
@@ -259,7 +303,18 @@ def main() -> None:
     parser.add_argument(
         '--out', type=Path, help='write the report here and every run to <out>.csv as it ends'
     )
+    parser.add_argument(
+        '--table-from', type=Path, help='only print the tables of a CSV of finished runs'
+    )
     args = parser.parse_args()
+    if args.table_from is not None:
+        outcomes = read_outcomes(args.table_from)
+        schemes = tuple(args.schemes)
+        lines = main_table(outcomes, args.robots, schemes)
+        if len({o.n_robots for o in outcomes}) > 1:
+            lines += robot_table(outcomes, args.sweep_targets, schemes)
+        print('\n'.join(lines))
+        return
     start = time.perf_counter()
     report, _ = run(
         experiments=tuple(args.experiments),
