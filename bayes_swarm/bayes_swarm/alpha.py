@@ -30,6 +30,7 @@ class AlphaBranch(Enum):
     NO_PEER_NEAR = 'no_peer_near'
     SCHEDULE = 'schedule'
     EXPLORE = 'explore'
+    FIXED = 'fixed'
 
 
 @dataclass(frozen=True)

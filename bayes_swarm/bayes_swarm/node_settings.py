@@ -61,6 +61,9 @@ PARAMETERS: tuple[ParameterSpec, ...] = (
     ParameterSpec('n_max', 1000, 'N_max: observations kept for the GP after downsampling.'),
     ParameterSpec('noise_std', 1e-3, 'GP observation noise std (signal units).'),
     ParameterSpec('alpha_time_scale', 1.0, 'Factor on T_max in the alpha schedule (code: 0.1).'),
+    ParameterSpec(
+        'fixed_alpha', -1.0, 'Constant alpha in [0, 1] instead of Algorithm 2 (-1: off).'
+    ),
     ParameterSpec('outer_optimizer', 'grid', 'Eq. 1 solver: grid, cobyla or pso.'),
     ParameterSpec('authors_negated_m', False, "Authors' defect: M = -max(mu) (inert penalty)."),
     ParameterSpec('authors_origin_paths', False, "Authors' defect: paths measured from (0, 0)."),
@@ -131,6 +134,7 @@ def settings_from_values(values: dict[str, Any]) -> NodeSettings:
         robot_size_m=float(v['robot_size_m']),
         n_max=int(v['n_max']),
         alpha_time_scale=float(v['alpha_time_scale']),
+        fixed_alpha=None if float(v['fixed_alpha']) < 0.0 else float(v['fixed_alpha']),
         outer_optimizer=v['outer_optimizer'],
         gp=GpConfig(noise_std=float(v['noise_std'])),
         authors_negated_m=bool(v['authors_negated_m']),

@@ -278,14 +278,18 @@ class BayesSwarmPlanner:
         peers = list(self._peer_plans.values())
         peer_starts = np.array([p[0] for p in peers]).reshape(-1, 2)
         peer_waypoints = np.array([p[1] for p in peers]).reshape(-1, 2)
-        alpha = exploitation_weight(
-            expected,
-            peer_waypoints,
-            self.weaker_sources,
-            robot_size_m=cfg.robot_size_m,
-            time_s=time_s,
-            max_mission_time_s=cfg.max_mission_time_s,
-            time_scale=cfg.alpha_time_scale,
+        alpha = (
+            AlphaDecision(cfg.fixed_alpha, AlphaBranch.FIXED)
+            if cfg.fixed_alpha is not None
+            else exploitation_weight(
+                expected,
+                peer_waypoints,
+                self.weaker_sources,
+                robot_size_m=cfg.robot_size_m,
+                time_s=time_s,
+                max_mission_time_s=cfg.max_mission_time_s,
+                time_scale=cfg.alpha_time_scale,
+            )
         )
         if cfg.authors_origin_paths:
             starts = np.zeros_like(peer_starts)

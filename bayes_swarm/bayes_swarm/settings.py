@@ -133,6 +133,7 @@ class BayesSwarmConfig:
     Defaults are the paper's Case 1 (V = 0.1 m/s, T = 10 s, eps = 0.05 m, T_max = 100 s,
     M = 1.2, L = 2, delta theta = 90 deg, f = 1 Hz, N_max = 1000, l_robot = 0.1 m).
     ``robot_index`` is 0-based; the first decision uses r = robot_index + 1 as in Algorithm 1.
+    ``fixed_alpha`` replaces Algorithm 2 by a constant (the paper's 'alpha = 1' variant).
     """
 
     arena: Arena = field(default_factory=lambda: Arena(0.0, 2.4, 0.0, 2.4))
@@ -150,6 +151,7 @@ class BayesSwarmConfig:
     robot_size_m: float = 0.1
     n_max: int = 1000
     alpha_time_scale: float = 1.0
+    fixed_alpha: float | None = None
     outer_optimizer: OuterOptimizer = 'grid'
     inner_optimizer: Literal['newton', 'lbfgsb'] = 'newton'
     n_candidate_headings: int = 24
@@ -183,6 +185,8 @@ class BayesSwarmConfig:
         ):
             _positive(name, getattr(self, name))
         _finite('max_signal', self.max_signal)
+        if self.fixed_alpha is not None:
+            _require(0.0 <= self.fixed_alpha <= 1.0, 'fixed_alpha must be in [0, 1] or None')
         _require(
             0.0 < self.initial_direction_range_deg <= 360.0,
             'initial_direction_range_deg must be in (0, 360]',

@@ -179,3 +179,13 @@ def test_newton_ascent_finds_the_gp_mean_maximum_found_by_a_dense_grid():
     best = grid[np.argmax(gp.predict_mean(grid))]
     assert np.hypot(*(found - best)) < 0.01
     assert gp.predict_mean(found[None])[0] >= gp.predict_mean(best[None])[0] - 1e-9
+
+
+def test_fixed_alpha_replaces_the_adaptive_schedule():
+    planner = planner_with_data()
+    assert planner.decide([0.71, 0.71], 50.0).alpha == 0.8  # Algorithm 2, no peers
+    cfg = BayesSwarmConfig(fixed_alpha=1.0)
+    fixed = BayesSwarmPlanner(cfg, 'r0', seed=4)
+    fixed.decide([0, 0], 0.0)
+    leg(fixed, [0, 0], [0.71, 0.71])
+    assert fixed.decide([0.71, 0.71], 50.0).alpha == 1.0
