@@ -107,7 +107,10 @@ def estimates_converged(
 
 
 def systematic_counts(
-    weights: np.ndarray, offsets: np.ndarray, out: np.ndarray | None = None
+    weights: np.ndarray,
+    offsets: np.ndarray,
+    out: np.ndarray | None = None,
+    work: np.ndarray | None = None,
 ) -> np.ndarray:
     """Copies of each particle under systematic resampling, row by row.
 
@@ -121,12 +124,13 @@ def systematic_counts(
         weights: (k, N) normalised weights (float32).
         offsets: (k, 1) offsets u_r in [0, 1).
         out: optional (k, N) int32 array to write the counts to.
+        work: optional (k, N) float32 scratch array (saves an allocation).
 
     Returns:
         (k, N) int32 copy counts, each row summing to N.
     """
     k, n = weights.shape
-    c = np.cumsum(weights, axis=1, dtype=np.float32)
+    c = np.cumsum(weights, axis=1, dtype=np.float32, out=work)
     np.minimum(c, np.float32(1.0), out=c)
     c *= np.float32(n)
     c -= offsets.astype(np.float32)
@@ -207,6 +211,7 @@ class ParticleFilterBank:
         self._buf_b = np.empty((capacity, n), np.float32)
         self._buf_c32 = np.empty((capacity, n), np.float32)
         self._buf_d32 = np.empty((capacity, n), np.float32)
+        self._buf_cum = np.empty((capacity, n), np.float32)
         self._buf_nx = np.empty((capacity, n), np.float32)
         self._buf_ny = np.empty((capacity, n), np.float32)
         self._buf_x = np.empty((capacity, n), np.float32)
@@ -464,7 +469,8 @@ class ParticleFilterBank:
         n = self._n
         counts = self._counts[:k]
         if self._cfg.resampling == 'systematic':
-            systematic_counts(weights, self._rng.random((k, 1), dtype=np.float32), out=counts)
+            offsets = self._rng.random((k, 1), dtype=np.float32)
+            systematic_counts(weights, offsets, out=counts, work=self._buf_cum[:k])
         else:
             probabilities = weights.astype(np.float64)
             probabilities /= probabilities.sum(axis=1, keepdims=True)
