@@ -129,6 +129,19 @@ def test_unknown_and_non_finite_rssi_is_ignored(make_harness):
     assert h.node.controller.filters.tracked_ids == (5,)
 
 
+def test_rssi_stamped_before_the_last_accepted_message_is_ignored(make_harness):
+    h = make_harness(scheme='msc_pf')
+    builtin = get_message_module('builtin_interfaces')
+    newer = swarm.RssiArray(readings=[swarm.EmitterRssi(emitter_id=1, rssi_dbm=-80.0)])
+    newer.header.stamp = builtin.Time(sec=5, nanosec=0)
+    older = swarm.RssiArray(readings=[swarm.EmitterRssi(emitter_id=2, rssi_dbm=-80.0)])
+    older.header.stamp = builtin.Time(sec=3, nanosec=0)
+    h.rssi_pub.publish(newer)
+    h.rssi_pub.publish(older)
+    h.spin_for(1.05)
+    assert list(h.peers[-1].reading_ids) == [1]
+
+
 def test_invalid_parameters_stop_the_node_at_start(make_harness):
     with pytest.raises(ConfigError, match='gamma1 < gamma2 < gamma3'):
         make_harness(**{'phases.gamma2_dbm': -90.0})
