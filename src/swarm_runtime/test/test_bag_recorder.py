@@ -4,9 +4,12 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 from pathlib import Path
+from typing import Any
 
 import pytest
+import yaml
 from swarm_runtime.bag import BagRecorder, TruncatedBagWarning, read_bag_info, read_messages
+from swarm_runtime.builtin.errors import BuiltinRuntimeUnsupported
 from swarm_runtime.ros import (
     Node,
     Parameter,
@@ -119,9 +122,142 @@ def test_topics_that_appear_later_are_discovered(ros: None, tmp_path: Path) -> N
     assert [m.message.data for m in read] == list(range(read[0].message.data, late.count))
 
 
-def test_offered_qos_is_recorded_when_the_runtime_cannot_report_it(
+def _metadata_qos(bag: Path, topic: str) -> list[dict[str, Any]]:
+    """The offered_qos_profiles of ``topic`` as written in metadata.yaml."""
+    metadata = yaml.safe_load((bag / 'metadata.yaml').read_text())
+    for entry in metadata['rosbag2_bagfile_information']['topics_with_message_count']:
+        if entry['topic_metadata']['name'] == topic:
+            return entry['topic_metadata']['offered_qos_profiles']
+    msg = f'{topic} is not in the metadata'
+    raise AssertionError(msg)
+
+
+class SitePublisher(Node):
+    """Latches a site layout on /sim/site, as the sim bridge does."""
+
+    def __init__(self) -> None:
+        super().__init__('site_publisher')
+        latched = QoSProfile(depth=1, durability=QoSDurabilityPolicy.TRANSIENT_LOCAL)
+        self.publisher = self.create_publisher(std_msgs.String, '/sim/site', latched)
+        self.publisher.publish(std_msgs.String(data='site layout'))
+
+
+def test_latched_message_published_before_the_recorder_started_is_recorded_with_its_qos(
     ros: None, tmp_path: Path
 ) -> None:
+    executor = rclpy.executors.SingleThreadedExecutor()
+    site = SitePublisher()
+    executor.add_node(site)
+    _spin(executor, 3)
+    recorder = BagRecorder(tmp_path / 'bag', topics=['/sim/site'])
+    executor.add_node(recorder)
+    _spin(executor, 5)
+    recorder.destroy_node()
+
+    assert [m.message.data for m in read_messages(tmp_path / 'bag')] == ['site layout']
+    (profile,) = _metadata_qos(tmp_path / 'bag', '/sim/site')
+    assert profile['durability'] == 'transient_local'
+    assert profile['reliability'] == 'reliable'
+    assert profile['history'] == 'unknown'
+
+
+def test_each_publishers_offered_qos_is_recorded_and_the_subscription_matches_all(
+    ros: None, tmp_path: Path
+) -> None:
+    executor = rclpy.executors.SingleThreadedExecutor()
+    site = SitePublisher()
+    volatile = Node('volatile_site')
+    volatile_publisher = volatile.create_publisher(std_msgs.String, '/sim/site', 10)
+    recorder = BagRecorder(tmp_path / 'bag', topics=['/sim/site'])
+    for node in (site, volatile, recorder):
+        executor.add_node(node)
+    volatile_publisher.publish(std_msgs.String(data='live'))
+    _spin(executor, 3)
+    recorder.destroy_node()
+
+    # One publisher is volatile, so the recorder cannot ask for history (it would not match
+    # that publisher): the latched message before the recorder started is not recorded.
+    assert [m.message.data for m in read_messages(tmp_path / 'bag')] == ['live']
+    durabilities = [p['durability'] for p in _metadata_qos(tmp_path / 'bag', '/sim/site')]
+    assert durabilities == ['transient_local', 'volatile']
+
+
+def test_topics_created_after_the_recorder_started_are_recorded_from_the_next_discovery(
+    ros: None, tmp_path: Path
+) -> None:
+    executor = rclpy.executors.SingleThreadedExecutor()
+    recorder = BagRecorder(tmp_path / 'bag', topics=['/late/*', '/sim/*'])
+    executor.add_node(recorder)
+    _spin(executor, 3)
+    late = Counter('late')
+    site = SitePublisher()
+    executor.add_node(late)
+    executor.add_node(site)
+    _spin(executor, 30)
+    recorder.destroy_node()
+
+    read = list(read_messages(tmp_path / 'bag'))
+    counts = [m.message.data for m in read if m.topic == '/late/count']
+    # The counter publishes every 0.1 s and discovery polls every 0.1 s: nothing is missed
+    # (but the last count, if the spinning stopped right after it was published).
+    assert counts == list(range(len(counts)))
+    assert len(counts) >= late.count - 1 >= 5
+    assert [m.message.data for m in read if m.topic == '/sim/site'] == ['site layout']
+
+
+class LazyPublisher(Node):
+    """Creates its publisher in a timer callback and publishes right away (same step)."""
+
+    def __init__(self, qos: QoSProfile) -> None:
+        super().__init__('lazy')
+        self._qos = qos
+        self.publisher: Any = None
+        self._timer = self.create_timer(0.25, self._start)
+
+    def _start(self) -> None:
+        self.destroy_timer(self._timer)
+        self.publisher = self.create_publisher(std_msgs.String, '/lazy/status', self._qos)
+        self.publisher.publish(std_msgs.String(data='first'))
+
+
+def test_a_latched_message_published_as_its_topic_is_created_is_recorded(
+    ros: None, tmp_path: Path
+) -> None:
+    executor = rclpy.executors.SingleThreadedExecutor()
+    recorder = BagRecorder(tmp_path / 'bag', topics=['/lazy/*'])
+    lazy = LazyPublisher(QoSProfile(depth=1, durability=QoSDurabilityPolicy.TRANSIENT_LOCAL))
+    executor.add_node(recorder)
+    executor.add_node(lazy)
+    _spin(executor, 10)
+    lazy.publisher.publish(std_msgs.String(data='second'))
+    _spin(executor, 3)
+    recorder.destroy_node()
+    assert [m.message.data for m in read_messages(tmp_path / 'bag')] == ['first', 'second']
+
+
+def test_a_volatile_message_published_as_its_topic_is_created_is_missed_like_ros2_bag_record(
+    ros: None, tmp_path: Path
+) -> None:
+    executor = rclpy.executors.SingleThreadedExecutor()
+    recorder = BagRecorder(tmp_path / 'bag', topics=['/lazy/*'])
+    lazy = LazyPublisher(QoSProfile(depth=10))
+    executor.add_node(recorder)
+    executor.add_node(lazy)
+    _spin(executor, 10)
+    lazy.publisher.publish(std_msgs.String(data='second'))
+    _spin(executor, 3)
+    recorder.destroy_node()
+    # Nobody was subscribed when 'first' went out; recording starts at the next discovery.
+    assert [m.message.data for m in read_messages(tmp_path / 'bag')] == ['second']
+
+
+def test_declared_qos_is_used_where_the_runtime_cannot_report_publishers(
+    ros: None, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    def unsupported(self: Node, topic_name: str, no_mangle: bool = False) -> list[Any]:
+        raise BuiltinRuntimeUnsupported('no endpoint info here')
+
+    monkeypatch.setattr(BagRecorder, 'get_publishers_info_by_topic', unsupported)
     executor = rclpy.executors.SingleThreadedExecutor()
     counter = Counter('r0')
     recorder = BagRecorder(
@@ -136,18 +272,19 @@ def test_offered_qos_is_recorded_when_the_runtime_cannot_report_it(
     assert profile.depth == qos_profile_sensor_data.depth
 
 
-def test_latched_topics_declared_in_offered_qos_keep_their_history(
+def test_declared_qos_applies_to_a_topic_that_has_no_publisher_yet(
     ros: None, tmp_path: Path
 ) -> None:
     latched = QoSProfile(depth=1, durability=QoSDurabilityPolicy.TRANSIENT_LOCAL)
     executor = rclpy.executors.SingleThreadedExecutor()
-    site = Node('site_publisher')
-    site.create_publisher(std_msgs.String, '/sim/site', latched).publish(
-        std_msgs.String(data='site layout')
-    )
+    listener = Node('listener')
+    listener.create_subscription(std_msgs.String, '/sim/site', lambda msg: None, latched)
     recorder = BagRecorder(tmp_path / 'bag', topics=['/sim/site'], offered_qos={'/sim/*': latched})
-    executor.add_node(site)
+    executor.add_node(listener)
     executor.add_node(recorder)
+    _spin(executor, 2)
+    site = SitePublisher()
+    executor.add_node(site)
     _spin(executor, 5)
     recorder.destroy_node()
     read = list(read_messages(tmp_path / 'bag'))

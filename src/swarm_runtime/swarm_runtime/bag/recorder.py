@@ -1,16 +1,22 @@
 """A node that records topics of the running graph into a rosbag2 MCAP bag.
 
 It works like ``ros2 bag record -s mcap`` and runs on both runtimes: it discovers topics with
-``get_topic_names_and_types()`` (at start and then periodically), subscribes to the chosen
-ones with ``raw=True`` so messages arrive as CDR bytes and are written without decoding, and
-stamps each message with the node's clock (sim time under ``use_sim_time``).
+``get_topic_names_and_types()`` (at start and then every ``discovery_period_s``, by default
+0.1 s like rosbag2's polling interval), subscribes to the chosen ones with ``raw=True`` so
+messages arrive as CDR bytes and are written without decoding, and stamps each message with
+the node's clock (sim time under ``use_sim_time``).
 
-For each topic it records the QoS profiles the publishers offer (``get_publishers_info_by_topic``)
-and subscribes with a profile that matches all of them (reliable only if every publisher is,
-transient-local only if every publisher is, so latched messages published before the recorder
-started are recorded too). Where the runtime cannot report publisher QoS, the profile declared
-for the topic in ``offered_qos`` is used in its place; a topic without one gets a best-effort,
+For each topic it records the QoS profiles its publishers announce
+(``get_publishers_info_by_topic``) as ``offered_qos_profiles`` and subscribes with a profile
+that matches all of them: reliable only if every publisher is, transient-local only if every
+publisher is, so a latched message published before the recorder started or before its
+discovery found the topic is recorded too. Where no publisher can be reported (the topic has
+only subscriptions so far, or a runtime lacks endpoint info), the profile declared for the
+topic in ``offered_qos`` is used in its place; a topic without one gets a best-effort,
 volatile subscription, which matches any publisher but misses latched history.
+
+As with ``ros2 bag record``, a volatile message published before discovery found its topic
+is not recorded.
 """
 
 from __future__ import annotations
@@ -58,10 +64,11 @@ class BagRecorder(Node):
         topics: Topic names or glob patterns ('/r*/scan'); None records every topic.
         exclude: Names or patterns never recorded.
         include_hidden: Also record hidden topics (a name part starting with '_').
-        offered_qos: Topic name or pattern -> QoS profile to record as offered when the
-            runtime cannot report the publishers' profiles.
+        offered_qos: Topic name or pattern -> QoS profile to record as offered (and to
+            subscribe for) when no publisher of the topic can be reported.
         node_name: Name of the recorder node.
-        discovery_period_s: How often new topics are looked for [s, node clock].
+        discovery_period_s: How often new topics are looked for [s, node clock] (rosbag2's
+            default polling interval).
         flush_period_s: How often buffered messages are pushed to disk [s, node clock],
             so a crash loses at most this much.
         use_sim_time: Set the node's ``use_sim_time`` parameter (timestamps in sim time).
@@ -77,7 +84,7 @@ class BagRecorder(Node):
         include_hidden: bool = False,
         offered_qos: Mapping[str, QoSProfile] | None = None,
         node_name: str = 'bag_recorder',
-        discovery_period_s: float = 1.0,
+        discovery_period_s: float = 0.1,
         flush_period_s: float = 5.0,
         use_sim_time: bool | None = None,
         **node_kwargs: Any,
@@ -155,9 +162,7 @@ class BagRecorder(Node):
             self.get_logger().debug(str(err))
             self._skipped.add(topic)
             return
-        offered = self._publisher_qos(topic)
-        if offered is None:
-            offered = self._fallback_qos(topic)
+        offered = self._publisher_qos(topic) or self._fallback_qos(topic)
         try:
             self._writer.add_topic(
                 topic, typename, offered_qos_profiles=[qos_to_rosbags(q) for q in offered]
@@ -175,12 +180,12 @@ class BagRecorder(Node):
         )
         self.get_logger().info(f'recording {topic} ({typename})')
 
-    def _publisher_qos(self, topic: str) -> list[QoSProfile] | None:
-        """QoS offered by the topic's publishers, or None if the runtime cannot tell."""
+    def _publisher_qos(self, topic: str) -> list[QoSProfile]:
+        """QoS announced by the topic's publishers; empty if none can be reported."""
         try:
             endpoints = self.get_publishers_info_by_topic(topic)
         except (AttributeError, NotImplementedError, RuntimeError):
-            return None
+            return []
         return [endpoint.qos_profile for endpoint in endpoints]
 
     def _fallback_qos(self, topic: str) -> list[QoSProfile]:

@@ -5,6 +5,10 @@ message type and their QoS profiles are compatible (:func:`.qos.qos_check_compat
 on the effective profiles, see :mod:`.qos`). Each publisher keeps the tuple of its
 connected subscriptions, recomputed when an endpoint appears or goes, so that publishing
 is a loop over a ready-made tuple.
+
+The graph also answers the introspection queries (topic names and types, endpoint info). Each
+endpoint gets a 16-byte GID when it is registered: like a DDS GUID, a prefix shared by the
+context (one DDS participant per context in Jazzy) and an entity id unique within it.
 """
 
 from __future__ import annotations
@@ -12,16 +16,21 @@ from __future__ import annotations
 import itertools
 import sys
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
+from ._messages import type_hash_text
+from .duration import Infinite
 from .qos import (
     DurabilityPolicy,
     HistoryPolicy,
+    LivelinessPolicy,
     QoSCompatibility,
     QoSProfile,
     ReliabilityPolicy,
     qos_check_compatible,
 )
+from .topic_endpoint_info import TopicEndpointInfo, TopicEndpointTypeEnum
+from .type_hash import TypeHash
 
 if TYPE_CHECKING:
     from .node import Node
@@ -30,6 +39,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     'Graph',
+    'announced_qos',
     'effective_publisher_qos',
     'effective_subscription_qos',
     'queue_depth',
@@ -37,6 +47,12 @@ __all__ = [
 
 CLOCK_TOPIC = '/clock'
 CLOCK_TYPE = 'rosgraph_msgs/msg/Clock'
+
+# DDS entity kinds (last byte of a GUID) of user-defined writers and readers without a key.
+_WRITER_KIND = 0x03
+_READER_KIND = 0x04
+# Contexts created so far in this process: the GID prefix of the next one (values only compared).
+_context_numbers = itertools.count(1)
 
 
 def _copy(qos: QoSProfile) -> QoSProfile:
@@ -80,6 +96,39 @@ def effective_subscription_qos(
     return resolved
 
 
+def _announced_duration(duration: Any) -> Any:
+    """rmw turns an unspecified (0) or best-available duration into the DDS default: infinite."""
+    if duration.nanoseconds <= 0 or duration.nanoseconds >= Infinite.nanoseconds - 1:
+        return Infinite
+    return duration
+
+
+def announced_qos(effective: QoSProfile, *, is_publisher: bool) -> QoSProfile:
+    """The QoS an endpoint announces in discovery, as rmw reports it for endpoint info.
+
+    Reliability and durability as resolved for the endpoint; liveliness left to the system as
+    DDS resolves it (AUTOMATIC, or MANUAL_BY_TOPIC for a best-available publisher);
+    unspecified durations as infinite; history UNKNOWN with depth 0 (history is local to an
+    endpoint and not part of DDS discovery data).
+    """
+    liveliness = effective.liveliness
+    if liveliness == LivelinessPolicy.BEST_AVAILABLE and is_publisher:
+        liveliness = LivelinessPolicy.MANUAL_BY_TOPIC
+    elif liveliness in (LivelinessPolicy.SYSTEM_DEFAULT, LivelinessPolicy.BEST_AVAILABLE):
+        liveliness = LivelinessPolicy.AUTOMATIC
+    return QoSProfile(
+        history=HistoryPolicy.UNKNOWN,
+        depth=0,
+        reliability=effective.reliability,
+        durability=effective.durability,
+        lifespan=_announced_duration(effective.lifespan),
+        deadline=_announced_duration(effective.deadline),
+        liveliness=liveliness,
+        liveliness_lease_duration=_announced_duration(effective.liveliness_lease_duration),
+        avoid_ros_namespace_conventions=effective.avoid_ros_namespace_conventions,
+    )
+
+
 def queue_depth(qos: QoSProfile) -> int:
     """How many undelivered messages an endpoint keeps: KEEP_ALL unbounded, depth 0 means 1."""
     if qos.history == HistoryPolicy.KEEP_ALL:
@@ -119,6 +168,10 @@ class Graph:
         #: The last time published on /clock (ns), None before the first one.
         self.clock_ns: int | None = None
         self._warned_pairs: set[tuple[int, int]] = set()
+        self._gid_prefix = next(_context_numbers).to_bytes(12, 'big')
+        self._next_entity_id = itertools.count(1).__next__
+        # topic_names_and_types() until an endpoint appears or goes.
+        self._names_and_types: list[tuple[str, list[str]]] | None = None
 
     # Nodes
 
@@ -148,14 +201,22 @@ class Graph:
             topic = self._topics[name] = _Topic(name)
         return topic
 
+    def _new_gid(self, kind: int) -> tuple[int, ...]:
+        entity = self._next_entity_id().to_bytes(3, 'big')
+        return tuple(self._gid_prefix + entity + bytes((kind,)))
+
     def add_publisher(self, publisher: Publisher) -> None:
         """Register a publisher and connect it to the compatible subscriptions."""
+        publisher._gid = self._new_gid(_WRITER_KIND)
+        self._names_and_types = None
         topic = self._topic(publisher.topic_name)
         topic.publishers.append(publisher)
         self._reconnect(topic)
 
     def add_subscription(self, subscription: Subscription) -> None:
         """Register a subscription, connect it, and hand it latched (TRANSIENT_LOCAL) data."""
+        subscription._gid = self._new_gid(_READER_KIND)
+        self._names_and_types = None
         topic = self._topic(subscription.topic_name)
         subscription._set_effective_qos(
             effective_subscription_qos(subscription.qos_profile, topic.publishers)
@@ -176,6 +237,7 @@ class Graph:
         topic = self._topics.get(publisher.topic_name)
         if topic is not None and publisher in topic.publishers:
             topic.publishers.remove(publisher)
+            self._names_and_types = None
             self._reconnect(topic)
 
     def remove_subscription(self, subscription: Subscription) -> None:
@@ -183,6 +245,7 @@ class Graph:
         topic = self._topics.get(subscription.topic_name)
         if topic is not None and subscription in topic.subscriptions:
             topic.subscriptions.remove(subscription)
+            self._names_and_types = None
             self._reconnect(topic)
 
     def _reconnect(self, topic: _Topic) -> None:
@@ -227,15 +290,21 @@ class Graph:
     # Introspection
 
     def topic_names_and_types(self) -> list[tuple[str, list[str]]]:
-        """``(topic, [types])`` of every topic with at least one endpoint, sorted by name."""
-        result = []
-        for name in sorted(self._topics):
-            topic = self._topics[name]
-            types = {p._typename for p in topic.publishers}
-            types.update(s._typename for s in topic.subscriptions)
-            if types:
-                result.append((name, sorted(types)))
-        return result
+        """``(topic, [types])`` of every topic with at least one endpoint, sorted by name.
+
+        The answer is kept until an endpoint appears or goes (discovery polls it often); the
+        caller gets fresh lists each time.
+        """
+        if self._names_and_types is None:
+            result = []
+            for name in sorted(self._topics):
+                topic = self._topics[name]
+                types = {p._typename for p in topic.publishers}
+                types.update(s._typename for s in topic.subscriptions)
+                if types:
+                    result.append((name, sorted(types)))
+            self._names_and_types = result
+        return [(name, list(types)) for name, types in self._names_and_types]
 
     def count_publishers(self, topic_name: str) -> int:
         """Number of publishers on a fully qualified topic."""
@@ -251,3 +320,38 @@ class Graph:
         """The publishers on a fully qualified topic."""
         topic = self._topics.get(topic_name)
         return () if topic is None else tuple(topic.publishers)
+
+    def publishers_info(self, topic_name: str) -> list[TopicEndpointInfo]:
+        """Endpoint info of the publishers on a topic, in creation order."""
+        topic = self._topics.get(topic_name)
+        if topic is None:
+            return []
+        return [
+            _endpoint_info(p, p._effective_qos, TopicEndpointTypeEnum.PUBLISHER)
+            for p in topic.publishers
+        ]
+
+    def subscriptions_info(self, topic_name: str) -> list[TopicEndpointInfo]:
+        """Endpoint info of the subscriptions on a topic, in creation order."""
+        topic = self._topics.get(topic_name)
+        if topic is None:
+            return []
+        return [
+            _endpoint_info(s, s._effective_qos, TopicEndpointTypeEnum.SUBSCRIPTION)
+            for s in topic.subscriptions
+        ]
+
+
+def _endpoint_info(
+    endpoint: Publisher | Subscription, effective: QoSProfile, kind: TopicEndpointTypeEnum
+) -> TopicEndpointInfo:
+    node = endpoint._node
+    return TopicEndpointInfo(
+        node_name=node._name,
+        node_namespace=node._namespace,
+        topic_type=endpoint._typename,
+        topic_type_hash=TypeHash._from_text(type_hash_text(endpoint._typename)),
+        endpoint_type=kind,
+        endpoint_gid=list(endpoint._gid),
+        qos_profile=announced_qos(effective, is_publisher=kind == TopicEndpointTypeEnum.PUBLISHER),
+    )

@@ -19,6 +19,7 @@ __all__ = [
     'interface_class',
     'interface_module',
     'message_typename',
+    'type_hash_text',
 ]
 
 #: Environment variable: when truthy, every published message reaches each subscriber as a
@@ -68,3 +69,14 @@ def cdr_codec() -> tuple[Any, Any]:
     from swarm_runtime.messages import deserialize_cdr, serialize_cdr
 
     return serialize_cdr, deserialize_cdr
+
+
+@cache
+def type_hash_text(typename: str) -> str:
+    """The RIHS01 hash of a message type as text ('RIHS01_<hex>'); '' when it is unknown."""
+    from swarm_runtime.messages import default_registry
+
+    try:
+        return default_registry().typestore.hash_rihs01(typename)
+    except KeyError:
+        return ''

@@ -2,8 +2,8 @@
 
 Names, parameters and entity creation follow rclpy 7.1 (Jazzy), including its exception
 types; the parameter methods live in :mod:`._node_parameters`. What a Node of real rclpy
-offers and this one does not (services, clients, actions, rates, guard conditions, endpoint
-info) raises :class:`~.errors.BuiltinRuntimeUnsupported` naming the method.
+offers and this one does not (services, clients, actions, rates, guard conditions, names
+and types by node) raises :class:`~.errors.BuiltinRuntimeUnsupported` naming the method.
 """
 
 from __future__ import annotations
@@ -30,6 +30,7 @@ from .qos import QoSProfile, qos_profile_parameter_events
 from .subscription import Subscription, SubscriptionImpl
 from .time_source import TimeSource
 from .timer import Timer
+from .topic_endpoint_info import TopicEndpointInfo
 from .utilities import get_default_context
 from .validate_full_topic_name import validate_full_topic_name
 from .validate_namespace import validate_namespace
@@ -64,8 +65,6 @@ _UNSUPPORTED_METHODS = {
     'get_client_names_and_types_by_node': 'services are not simulated',
     'get_publisher_names_and_types_by_node': 'use get_topic_names_and_types()',
     'get_subscriber_names_and_types_by_node': 'use get_topic_names_and_types()',
-    'get_publishers_info_by_topic': 'use count_publishers()',
-    'get_subscriptions_info_by_topic': 'use count_subscribers()',
     'get_node_names_and_namespaces_with_enclaves': 'enclaves are not simulated',
     'wait_for_node': 'waiting would block the single-threaded simulation',
 }
@@ -508,6 +507,47 @@ class Node(NodeParameters):
         """Subscriptions on a topic (relative names expanded, not remapped)."""
         self._check_alive()
         return self._context._graph.count_subscribers(self._expand_for_count(topic_name))
+
+    def _topic_for_info(self, topic_name: str, no_mangle: bool) -> str:
+        """rclpy's name handling for endpoint info: expanded, validated and remapped.
+
+        With ``no_mangle`` the name is taken as the middleware's topic name; the built-in
+        runtime has no name mangling, so that is the graph's name as given.
+        """
+        if no_mangle:
+            return topic_name
+        expanded = expand_topic_name(topic_name, self._name, self._namespace)
+        validate_full_topic_name(expanded)
+        return self.resolve_topic_name(expanded)
+
+    def get_publishers_info_by_topic(
+        self, topic_name: str, no_mangle: bool = False
+    ) -> list[TopicEndpointInfo]:
+        """Node, type, GID and announced QoS of each publisher on a topic.
+
+        ``topic_name`` may be relative or private (expanded with this node's namespace and
+        name, then remapped, as rclpy does). The QoS profile is what the publisher announces
+        in discovery (see :mod:`.topic_endpoint_info`): its resolved reliability and
+        durability, history UNKNOWN with depth 0.
+
+        Raises:
+            InvalidTopicNameException: an invalid topic name.
+        """
+        self._check_alive()
+        return self._context._graph.publishers_info(self._topic_for_info(topic_name, no_mangle))
+
+    def get_subscriptions_info_by_topic(
+        self, topic_name: str, no_mangle: bool = False
+    ) -> list[TopicEndpointInfo]:
+        """Node, type, GID and announced QoS of each subscription on a topic.
+
+        Name handling as in :meth:`get_publishers_info_by_topic`.
+
+        Raises:
+            InvalidTopicNameException: an invalid topic name.
+        """
+        self._check_alive()
+        return self._context._graph.subscriptions_info(self._topic_for_info(topic_name, no_mangle))
 
     def __repr__(self) -> str:
         return f'<{type(self).__name__} {self._fully_qualified_name!r} (built-in runtime)>'

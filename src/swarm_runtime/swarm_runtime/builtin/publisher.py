@@ -72,6 +72,8 @@ class Publisher:
         self._needs_bytes = self._roundtrip
         self._is_clock = self._topic_name == CLOCK_TOPIC and self._typename == CLOCK_TYPE
         self._sequence = 0
+        # Set by the graph when the publisher is registered.
+        self._gid: tuple[int, ...] = ()
         self._alive = True
         self._history: deque[Any] | None = None
         if self._effective_qos.durability == DurabilityPolicy.TRANSIENT_LOCAL:

@@ -84,6 +84,8 @@ class Subscription:
         self._queue: deque[tuple[Any, ...]] = deque()
         self._depth = queue_depth(qos_profile)
         self._owner: Executor | None = None
+        # Set by the graph when the subscription is registered.
+        self._gid: tuple[int, ...] = ()
         self._alive = True
         self._received = 0
         _, self._decode = cdr_codec()
