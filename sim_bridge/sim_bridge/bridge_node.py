@@ -318,6 +318,11 @@ class SimBridgeNode(Node):
             )
         )
 
+    def pause(self) -> None:
+        """Stop stepping the world (the physics timer is cancelled); messages already
+        published are still delivered."""
+        self._timer.cancel()
+
     @property
     def sim_time_s(self) -> float:
         """Sim time of the last physics step [s]."""

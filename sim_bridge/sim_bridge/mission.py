@@ -54,6 +54,9 @@ __all__ = [
 
 NodeFactory = Callable[..., Any]
 
+# Callbacks run per node after the stop, to deliver the messages of the last step.
+_DRAIN_CALLBACKS_PER_NODE = 20
+
 
 class StopReason:
     """Why a mission ended (string constants, also used in reports)."""
@@ -353,6 +356,10 @@ def run_mission(
         except Exception as err:
             msg = f'the mission failed at sim time {engine.time_s:.2f} s: {err!r}'
             raise MissionError(msg) from err
+        # Deliver what the last step published (e.g. to the bag) without stepping further.
+        bridge.pause()
+        for _ in range(_DRAIN_CALLBACKS_PER_NODE * len(nodes)):
+            executor.spin_once(timeout_sec=0.0)
         final = snapshot()
         if progress is not None:
             progress(final)

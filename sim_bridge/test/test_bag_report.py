@@ -47,6 +47,7 @@ def test_bag_paths_match_the_true_poses_of_the_run(recorded):
     run = load_run(bag)
     assert run.robot_names == ('r0', 'r1')
     assert run.times_s[-1] == pytest.approx(live.sim_time_s, abs=0.5)
+    assert run.coverage.end_time_s == pytest.approx(live.sim_time_s, abs=1e-6)
     # /sim/poses is sampled at 2 Hz, the live trajectory every 0.5 s: same instants.
     live_by_time = dict(zip(np.round(live.trajectory_times_s, 3), live.trajectories, strict=True))
     for t, poses in zip(run.times_s, run.poses, strict=True):

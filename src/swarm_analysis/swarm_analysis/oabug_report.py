@@ -1,7 +1,8 @@
 """OA-Bug run report from a recorded bag alone: summary, Fig.-6 PNG, coverage over time.
 
 Reads the simulator's ground truth from a rosbag2 directory (``/sim/site`` for walls and
-rooms, ``/sim/poses`` for the paths, ``/sim/coverage`` for the first entries) and rebuilds
+rooms, ``/sim/poses`` for the paths, ``/sim/coverage`` for the first entries, ``/clock`` if
+recorded for the end time) and rebuilds
 what the spawner printed and drew, without rerunning the simulation::
 
     python -m swarm_analysis.oabug_report path/to/bag --out-dir figures/
@@ -26,6 +27,7 @@ __all__ = ['RecordedRun', 'ReportError', 'load_run', 'main', 'write_report']
 SITE_TOPIC = '/sim/site'
 POSES_TOPIC = '/sim/poses'
 COVERAGE_TOPIC = '/sim/coverage'
+CLOCK_TOPIC = '/clock'
 
 
 class ReportError(Exception):
@@ -82,7 +84,7 @@ def load_run(bag: str | Path) -> RecordedRun:
     poses: list[np.ndarray] = []
     names: tuple[str, ...] = ()
     end_s = 0.0
-    for item in read_messages(bag, [SITE_TOPIC, POSES_TOPIC, COVERAGE_TOPIC]):
+    for item in read_messages(bag, [SITE_TOPIC, POSES_TOPIC, COVERAGE_TOPIC, CLOCK_TOPIC]):
         msg = item.message
         if item.topic == SITE_TOPIC and site_msg is None:
             site_msg = msg
@@ -98,6 +100,8 @@ def load_run(bag: str | Path) -> RecordedRun:
         elif item.topic == COVERAGE_TOPIC:
             coverage_msg = msg
             end_s = max(end_s, _seconds(msg.header.stamp))
+        elif item.topic == CLOCK_TOPIC:
+            end_s = max(end_s, _seconds(msg.clock))
     missing = [
         topic
         for topic, found in (
