@@ -15,6 +15,7 @@ The budget follows the paper: max actions per robot (Table II: Small 1000, Mediu
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import math
 import sys
 from collections.abc import Callable, Sequence
@@ -189,7 +190,7 @@ def build_mission(config: SpawnConfig) -> tuple[MissionSpec, float]:
             for i in range(config.robots):
                 topics += [f'/r{i}/state', f'/r{i}/cmd_vel', f'/r{i}/pump']
         recording = RecordingSpec(Path(config.record), tuple(topics))
-    engine = EngineConfig(**{**config.engine.__dict__, 'seed': int(config.seed)})
+    engine = dataclasses.replace(config.engine, seed=int(config.seed))
     spec = MissionSpec(
         site=site,
         initial_poses=poses,
