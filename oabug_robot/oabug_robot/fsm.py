@@ -121,6 +121,7 @@ class FsmMemory:
     last_scent_s: float = -math.inf
     started_s: float | None = None
     last_step_s: float | None = None
+    last_robot_hit_s: float = -math.inf
     random_distance_m: float = 0.0
     event: Event = Event.NONE
     counts: dict[Event, int] = field(default_factory=dict)
@@ -188,14 +189,17 @@ class OABugFsm:
         mem = self._memory
         cfg = self._config
         scan = snap.scan
-        if mem.mode is not Mode.TURN and scan.front_robot_m <= cfg.perception.robot_hit_distance_m:
+        front_blocked = scan.front_wall_m <= cfg.perception.wall_hit_distance_m
+        # Only a robot that drives can hit another: not while it turns on the spot (to a
+        # heading, or away from a wall at an inner corner).
+        driving = mem.mode is not Mode.TURN and not (mem.mode is Mode.FOLLOW and front_blocked)
+        if driving and scan.front_robot_m <= cfg.perception.robot_hit_distance_m:
             self._on_hit_robot(snap)
         if mem.mode is Mode.TURN:
             error = angle_difference(mem.target_yaw_rad, snap.yaw_rad)
             if abs(error) > cfg.motion.heading_tolerance_rad:
                 return turn_in_place(error, cfg.motion)
             mem.mode = Mode.STRAIGHT
-        front_blocked = scan.front_wall_m <= cfg.perception.wall_hit_distance_m
         if mem.mode is Mode.STRAIGHT:
             if not front_blocked:
                 error = angle_difference(mem.target_yaw_rad, snap.yaw_rad)
@@ -222,8 +226,21 @@ class OABugFsm:
         return follow_wall(mem.wall_side, scan.side(mem.wall_side), front_blocked, cfg.motion)
 
     def _on_hit_robot(self, snap: SensorSnapshot) -> None:
+        """Hitting others: turn right by 90 deg and start again (paper).
+
+        Two robots jammed in a corner can hit each other, turn into the wall, turn back and
+        hit each other again for ever (the authors' robots moved one at a time on a grid and
+        did not jam). A hit within ``robot_hit_repeat_s`` of the previous one therefore turns
+        to a random heading instead, which breaks the symmetry.
+        """
         mem = self._memory
-        self._turn_to(wrap_angle(snap.yaw_rad + self._fixed_turn_sign * math.pi / 2))
+        repeat_s = self._config.robot_hit_repeat_s
+        if snap.time_s - mem.last_robot_hit_s <= repeat_s:
+            heading = float(self._rng.uniform(-math.pi, math.pi))
+        else:
+            heading = snap.yaw_rad + self._fixed_turn_sign * math.pi / 2
+        mem.last_robot_hit_s = snap.time_s
+        self._turn_to(wrap_angle(heading))
         mem.state = FsmState.JUST_STARTED
         self._record(Event.HIT_ROBOT)
 

@@ -255,6 +255,8 @@ class OABugConfig:
             i.e. count revisits in a row (the paper's "nearby area thoroughly searched").
         fixed_turn: side turned to at a first wall contact without sound, and after hitting
             another robot (paper: "all turn right").
+        robot_hit_repeat_s: a robot hit this soon after the previous one turns to a random
+            heading instead of right, to break jams of two robots (0 disables) [s].
         sound_turn_rule: see SoundTurnRule (paper: away).
         sound_weighting: see SoundWeighting (paper: distance).
         sound_memory: see SoundMemory (paper: stored).
@@ -280,6 +282,7 @@ class OABugConfig:
     revisit_flip_count: int = 3
     visit_count_resets_on_fresh_corner: bool = True
     fixed_turn: TurnDirection = TurnDirection.RIGHT
+    robot_hit_repeat_s: float = 4.0
     sound_turn_rule: SoundTurnRule = SoundTurnRule.AWAY
     sound_weighting: SoundWeighting = SoundWeighting.DISTANCE
     sound_memory: SoundMemory = SoundMemory.STORED
@@ -304,7 +307,7 @@ class OABugConfig:
             f'gas_threshold must be on the 10-bit scale 0..1023, got {self.gas_threshold}',
         )
         _require(self.revisit_flip_count >= 1, 'revisit_flip_count must be >= 1')
-        for name in ('scent_window_s', 'bearing_timeout_s'):
+        for name in ('scent_window_s', 'bearing_timeout_s', 'robot_hit_repeat_s'):
             value = getattr(self, name)
             _require(math.isfinite(value) and value >= 0.0, f'{name} must be >= 0')
         _require(

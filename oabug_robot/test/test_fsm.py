@@ -181,6 +181,41 @@ def test_a_peer_just_beyond_the_hit_distance_is_not_hit() -> None:
     assert fsm.memory.mode is Mode.STRAIGHT
 
 
+def test_a_second_robot_hit_soon_after_the_first_turns_to_a_random_heading() -> None:
+    fsm = make(Variant.GAS, robot_hit_repeat_s=4.0, seed=3)
+    script = Script(fsm, yaw_rad=0.0)
+    script.step(free())
+    script.step(robot_ahead())
+    assert fsm.memory.target_yaw_rad == pytest.approx(-math.pi / 2)
+    script.step(free(), yaw_rad=-math.pi / 2)
+    script.step(robot_ahead())
+    assert fsm.memory.counts[Event.HIT_ROBOT] == 2
+    assert fsm.memory.target_yaw_rad != pytest.approx(-math.pi), 'not another right turn'
+    assert fsm.memory.state is FsmState.JUST_STARTED
+
+
+def test_robot_hits_far_apart_in_time_both_turn_right() -> None:
+    fsm = make(Variant.GAS, robot_hit_repeat_s=4.0)
+    script = Script(fsm, yaw_rad=0.0)
+    script.step(free())
+    script.step(robot_ahead())
+    script.step(free(), yaw_rad=-math.pi / 2)
+    for _ in range(45):
+        script.step(free())
+    script.step(robot_ahead())
+    assert abs(fsm.memory.target_yaw_rad) == pytest.approx(math.pi)
+
+
+def test_a_peer_ahead_while_turning_away_from_a_wall_is_not_hit() -> None:
+    fsm = make(Variant.GAS)
+    script = Script(fsm)
+    reach_wall(script)
+    jammed = ScanFeatures(front_wall_m=0.2, front_robot_m=0.1)
+    command = script.step(jammed)
+    assert Event.HIT_ROBOT not in fsm.memory.counts
+    assert command.angular_radps < 0.0, 'still turning away from the wall'
+
+
 def test_a_peer_is_not_hit_while_turning_in_place() -> None:
     fsm = make(Variant.GAS)
     script = Script(fsm, yaw_rad=0.0)
