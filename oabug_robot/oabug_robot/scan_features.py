@@ -213,10 +213,11 @@ class ScanFeatureExtractor:
     ) -> np.ndarray:
         """Return a (K,) mask of the returns that belong to the peers at ``azimuths``.
 
-        Each return is compared with the bearing closest to it in angle only (peers rarely
-        overlap in azimuth), which keeps the cost independent of the number of peers. A
-        bearing whose coarse distance is far beyond the nearest return in its window is a
-        peer heard through a wall: the wall stays a wall.
+        Per bearing: the returns within its angular window (tolerance plus the angle a body
+        spans at that range), the nearest of them and everything within one body diameter
+        behind it. A bearing whose coarse distance is far beyond that nearest return is a
+        peer heard through a wall: the wall stays a wall. The node passes only the peers
+        that may be near, so the loop is short.
 
         Args:
             r: (K,) ranges of the returns [m].
@@ -226,36 +227,27 @@ class ScanFeatureExtractor:
         """
         cfg = self._config
         is_peer = np.zeros(r.size, dtype=bool)
-        known = np.isfinite(azimuths)
         near = np.flatnonzero(r <= cfg.peer_mask_range_m)
-        if not known.any() or near.size == 0:
+        if near.size == 0:
             return is_peer
-        wrapped = np.arctan2(np.sin(azimuths[known]), np.cos(azimuths[known]))
-        order = np.argsort(wrapped)
-        bearings = wrapped[order]
-        bearing_distances = distances[known][order]
         r_near = r[near]
         a_near = angles[near]
-        after = np.searchsorted(bearings, a_near) % bearings.size
-        before = after - 1  # -1 wraps to the last bearing
-        off_after = np.abs(a_near - bearings[after])
-        off_after = np.minimum(off_after, 2.0 * math.pi - off_after)
-        off_before = np.abs(a_near - bearings[before])
-        off_before = np.minimum(off_before, 2.0 * math.pi - off_before)
-        closer_after = off_after < off_before
-        which = np.where(closer_after, after, before % bearings.size)
-        offset = np.where(closer_after, off_after, off_before)
-        window = offset <= cfg.peer_bearing_tolerance_rad + np.arctan2(cfg.robot_radius_m, r_near)
-        if not window.any():
-            return is_peer
-        nearest = np.full(bearings.size, math.inf)
-        np.minimum.at(nearest, which[window], r_near[window])
-        with np.errstate(invalid='ignore'):
-            heard_through_wall = bearing_distances > cfg.peer_distance_factor * (
-                nearest + cfg.robot_radius_m
-            )
-        body = r_near <= nearest[which] + 2.0 * cfg.robot_radius_m
-        is_peer[near] = window & body & ~heard_through_wall[which]
+        half_width = cfg.peer_bearing_tolerance_rad + np.arctan2(cfg.robot_radius_m, r_near)
+        body_m = 2.0 * cfg.robot_radius_m
+        peer_near = np.zeros(near.size, dtype=bool)
+        for azimuth, distance in zip(azimuths.tolist(), distances.tolist(), strict=True):
+            if not math.isfinite(azimuth):
+                continue
+            bearing = math.atan2(math.sin(azimuth), math.cos(azimuth))
+            offset = np.abs(a_near - bearing)
+            window = np.minimum(offset, 2.0 * math.pi - offset) <= half_width
+            if not window.any():
+                continue
+            nearest = float(r_near[window].min())
+            if distance > cfg.peer_distance_factor * (nearest + cfg.robot_radius_m):
+                continue  # heard through a wall (NaN compares False: kept)
+            peer_near |= window & (r_near <= nearest + body_m)
+        is_peer[near] = peer_near
         return is_peer
 
     def _side_wall(self, x: np.ndarray, lateral: np.ndarray, mask: np.ndarray) -> SideWall:
