@@ -13,7 +13,9 @@ bootstrap:
 	@scripts/bootstrap.sh
 
 demo: bootstrap
-	$(VENV)/bin/spawn --config small --robots $(ROBOTS) --variant $(VARIANT) --seed $(SEED) --record --output $(OUT)
+	rm -rf $(OUT)
+	$(VENV)/bin/spawn --site small --robots $(ROBOTS) --variant $(VARIANT) --seed $(SEED) \
+		--record $(OUT)/bag --out-dir $(OUT)
 
 test: bootstrap
 	$(PY) -m pytest -n 2 -q

@@ -34,6 +34,9 @@ setup(
     ),
     license='Apache-2.0',
     entry_points={
-        'console_scripts': [],
+        'console_scripts': [
+            'swarm_report = swarm_analysis.cli:main',
+            'oabug_report = swarm_analysis.oabug_report:main',
+        ],
     },
 )
