@@ -233,6 +233,18 @@ def plan_jobs(experiments: list[str], runs: int, baseline_runs: int, large_runs:
             Job(
                 'avalanche', f'{av}, Bayes-Swarm-P', 'avalanche', 'bayes_swarm_p', 6, baseline_runs
             ),
+            Job(
+                'avalanche', f'{av}, Bayes-Swarm-O', 'avalanche', 'bayes_swarm_o', 6, baseline_runs
+            ),
+            Job(
+                'avalanche',
+                f'{av}, Bayes-Swarm-P (alpha = 1)',
+                'avalanche',
+                'bayes_swarm_p',
+                6,
+                baseline_runs,
+                {'fixed_alpha': 1.0},
+            ),
             Job('avalanche', f'{av}, Glowworm', 'avalanche', 'glowworm', 6, baseline_runs),
             Job('avalanche', f'{av}, Levy walk', 'avalanche', 'levy', 6, baseline_runs),
             Job(
