@@ -106,13 +106,22 @@ def spin_until_time(
         False if ``max_wall_time_s`` of virtual wall time passed first, or shutdown.
     """
     executor = _builtin_executor(executor)
-    graph = executor.context._graph
+    context = executor.context
+    graph = context._graph
     target_ns = round(sim_time_s * 1e9)
 
     def reached() -> bool:
         return graph.clock_ns is not None and graph.clock_ns >= target_ns
 
-    if not spin_until(executor, reached, max_wall_time_s=max_wall_time_s):
-        return False
+    if not reached():
+        if not context.ok() or executor._is_shutdown:
+            return False
+        limit_ns = None
+        if max_wall_time_s is not None:
+            limit_ns = context._elapsed_ns + round(max_wall_time_s * 1e9)
+        # The executor checks the clock itself after each callback (no predicate call).
+        executor._run_callbacks(limit_ns, until_clock_ns=target_ns)
+        if not reached():
+            return False
     spin_ready(executor)
     return True

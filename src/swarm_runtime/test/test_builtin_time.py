@@ -238,3 +238,52 @@ def test_jump_callbacks_report_forward_jumps_of_ros_time(executor) -> None:
     handle.unregister()
     clock.set_ros_time_override(Time(seconds=9.0, clock_type=ClockType.ROS_TIME))
     assert jumps == [1_500_000_000]
+
+
+def _clock_cdr(sec: int, nanosec: int, *, little_endian: bool = True) -> bytes:
+    """A rosgraph_msgs/Clock in CDR, written by hand (header, int32 sec, uint32 nanosec)."""
+    order = 'little' if little_endian else 'big'
+    header = b'\x00\x01\x00\x00' if little_endian else b'\x00\x00\x00\x00'
+    return header + sec.to_bytes(4, order, signed=True) + nanosec.to_bytes(4, order)
+
+
+@pytest.mark.parametrize('little_endian', [True, False])
+def test_sim_time_follows_clock_messages_sent_as_cdr_bytes(
+    executor: SingleThreadedExecutor, monkeypatch: pytest.MonkeyPatch, little_endian: bool
+) -> None:
+    monkeypatch.setenv('SWARM_RUNTIME_CDR_ROUNDTRIP', '1')
+    node = Node('follower', parameter_overrides=SIM_TIME)
+    publisher = Node('bag_player').create_publisher(rosgraph_msgs.Clock, '/clock', 10)
+    executor.add_node(node)
+    publisher.publish(_clock_cdr(12, 345, little_endian=little_endian))
+    executor.spin_once(timeout_sec=0)
+    assert node.get_clock().now().nanoseconds == 12_000_000_345
+
+
+def test_a_clock_message_that_is_not_cdr_fails_like_any_bad_message(
+    executor: SingleThreadedExecutor, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from swarm_runtime.messages import DeserializationError
+
+    monkeypatch.setenv('SWARM_RUNTIME_CDR_ROUNDTRIP', '1')
+    node = Node('follower', parameter_overrides=SIM_TIME)
+    publisher = Node('bag_player').create_publisher(rosgraph_msgs.Clock, '/clock', 10)
+    executor.add_node(node)
+    with pytest.raises(DeserializationError):
+        publisher.publish(b'\x00\x01\x00')
+    with pytest.raises(DeserializationError):
+        node._time_source._clock_cdr_callback(b'\x00\x01\x00')
+    assert node.get_clock().now().nanoseconds == 0
+
+
+def test_time_to_msg_builds_what_the_constructor_builds_and_fails_where_it_fails() -> None:
+    time = Time(nanoseconds=1_700_000_000_123_456_789, clock_type=ClockType.ROS_TIME)
+    msg = time.to_msg()
+    assert msg == builtin_interfaces.Time(sec=1_700_000_000, nanosec=123_456_789)
+    assert msg._check_fields == builtin_interfaces.Time()._check_fields
+    beyond_int32 = Time(seconds=2**31, clock_type=ClockType.ROS_TIME)
+    if builtin_interfaces.Time()._check_fields:
+        with pytest.raises(AssertionError, match="The 'sec' field"):
+            beyond_int32.to_msg()
+    else:
+        assert beyond_int32.to_msg().sec == 2**31

@@ -64,11 +64,11 @@ def message_typename(msg_type: Any) -> str:
         raise RuntimeError(msg) from err
 
 
-def cdr_codec() -> tuple[Any, Any]:
-    """Return the ``(serialize_cdr, deserialize_cdr)`` functions."""
-    from swarm_runtime.messages import deserialize_cdr, serialize_cdr
+def cdr_codec(typename: str) -> Any:
+    """Return the CDR codec of a type (``.serialize(msg)``, ``.deserialize(data)``)."""
+    from swarm_runtime.messages import get_cdr_codec
 
-    return serialize_cdr, deserialize_cdr
+    return get_cdr_codec(typename)
 
 
 @cache

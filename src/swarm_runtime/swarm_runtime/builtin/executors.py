@@ -190,9 +190,11 @@ class Executor:
         *,
         stop: Callable[[], bool] | None = None,
         max_callbacks: int | None = None,
+        until_clock_ns: int | None = None,
     ) -> int:
         """Run callbacks in order until ``stop()`` (checked after each), ``max_callbacks``,
-        shutdown, or nothing is left to run before the virtual wall clock reaches ``limit_ns``.
+        shutdown, ``/clock`` reaching ``until_clock_ns`` (checked after each, without a call),
+        or nothing is left to run before the virtual wall clock reaches ``limit_ns``.
 
         Returns:
             How many callbacks ran.
@@ -204,6 +206,7 @@ class Executor:
         ready = self._ready
         context = self._context
         heappop = heapq.heappop
+        graph = context._graph
         count = 0
         while True:
             ran = False
@@ -212,8 +215,10 @@ class Executor:
                 queue = subscription._queue
                 if queue and queue[0][0] == seq and subscription._owner is self:
                     entry = queue.popleft()
-                    data = entry[1]
-                    if subscription._plain and type(data) is not bytes:
+                    if subscription._plain:
+                        data = entry[1]
+                        if type(data) is bytes and subscription._decode_bytes:
+                            data = subscription._codec.deserialize(data)
                         subscription._callback(data)
                     else:
                         subscription._deliver(entry)
@@ -232,6 +237,10 @@ class Executor:
                     return count
                 if stop is not None and stop():
                     return count
+                if until_clock_ns is not None:
+                    clock_ns = graph.clock_ns
+                    if clock_ns is not None and clock_ns >= until_clock_ns:
+                        return count
             elif not self._advance_wall_clock(limit_ns):
                 return count
 

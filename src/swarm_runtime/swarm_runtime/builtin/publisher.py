@@ -64,7 +64,7 @@ class Publisher:
         self._graph = self._context._graph
         self._effective_qos = effective_publisher_qos(qos_profile)
         self._roundtrip = cdr_roundtrip_enabled()
-        self._serialize, self._deserialize = cdr_codec()
+        self._codec = cdr_codec(self._typename)
         self._connected: tuple[Subscription, ...] = ()
         # Per connected subscription: (subscription, its queue, its depth, wants CDR bytes,
         # wants MessageInfo), so that publish() reads everything from one tuple.
@@ -127,7 +127,7 @@ class Publisher:
         if raw:
             payload = msg
         elif self._needs_bytes:
-            payload = self._serialize(msg)
+            payload = self._codec.serialize(msg)
         else:
             payload = None
         self._sequence += 1
@@ -148,14 +148,14 @@ class Publisher:
         if self._history is not None:
             self._history.append(payload if raw else msg)
         if self._is_clock:
-            clock_msg = self._deserialize(msg, self._typename) if raw else msg
+            clock_msg = self._codec.deserialize(msg) if raw else msg
             self._graph.clock_ns = clock_msg.clock.sec * 1_000_000_000 + clock_msg.clock.nanosec
 
     def _latched_data_for(self, data: Any, subscription: Subscription) -> Any:
         """Data from the TRANSIENT_LOCAL history, as ``subscription`` should receive it."""
         if isinstance(data, bytes) or not (self._roundtrip or subscription.raw):
             return data
-        return self._serialize(data)
+        return self._codec.serialize(data)
 
     def get_subscription_count(self) -> int:
         """Number of subscriptions this publisher is connected to."""

@@ -72,6 +72,8 @@ class Subscription:
         self.callback_group = callback_group
         self.qos_profile = qos_profile
         self.raw = raw
+        # CDR bytes in the queue are decoded for the callback unless it asked for them.
+        self._decode_bytes = not raw
         self.event_handlers: list[Any] = []
         self._with_info = False
         self._event_callbacks = event_callbacks
@@ -88,7 +90,7 @@ class Subscription:
         self._gid: tuple[int, ...] = ()
         self._alive = True
         self._received = 0
-        _, self._decode = cdr_codec()
+        self._codec = cdr_codec(self._typename)
 
     @property
     def handle(self) -> Subscription:
@@ -129,8 +131,8 @@ class Subscription:
         )
 
     def _update_plain(self) -> None:
-        """Whether a delivered message object goes straight to ``callback(msg)``."""
-        self._plain = not self._with_info and not getattr(self, 'raw', False)
+        """Whether the executor hands a message straight to ``callback(msg)`` (no MessageInfo)."""
+        self._plain = not self._with_info
 
     def _set_effective_qos(self, qos: QoSProfile) -> None:
         self._effective_qos = qos
@@ -152,7 +154,7 @@ class Subscription:
         """Run the callback with one queued message (decoding CDR bytes unless raw)."""
         data = entry[1]
         if not self.raw and type(data) is bytes:
-            data = self._decode(data, self._typename)
+            data = self._codec.deserialize(data)
         self._received += 1
         if self._with_info:
             now_ns = SYSTEM_EPOCH_NS + self._context._elapsed_ns

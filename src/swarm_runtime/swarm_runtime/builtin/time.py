@@ -14,11 +14,13 @@ __all__ = ['Time']
 
 
 @cache
-def _time_msg_class() -> type:
+def _time_msg_class() -> Any:
     return interface_class('builtin_interfaces', 'Time')
 
 
 _LIMIT = 2**63
+_INT32_MIN = -(2**31)
+_INT32_MAX = 2**31 - 1
 
 
 class Time:
@@ -142,7 +144,14 @@ class Time:
     def to_msg(self) -> Any:
         """Return the time as a ``builtin_interfaces.msg.Time``."""
         sec, nanosec = divmod(self._nanoseconds, S_TO_NS)
-        return _time_msg_class()(sec=sec, nanosec=nanosec)
+        cls = _time_msg_class()
+        if _INT32_MIN <= sec <= _INT32_MAX:
+            # What the constructor would build, without its checks (the values pass them).
+            msg = cls._new_default()
+            msg._sec = sec
+            msg._nanosec = nanosec
+            return msg
+        return cls(sec=sec, nanosec=nanosec)
 
     @classmethod
     def from_msg(cls, msg: Any, clock_type: ClockType = ClockType.ROS_TIME) -> Time:

@@ -7,10 +7,11 @@ clock reports the last received time, 0 before the first message.
 
 from __future__ import annotations
 
+import struct
 import weakref
 from typing import TYPE_CHECKING, Any
 
-from ._messages import interface_class, interface_module
+from ._messages import cdr_codec, cdr_roundtrip_enabled, interface_class, interface_module
 from .clock import ROSClock
 from .clock_type import ClockType
 from .parameter import Parameter
@@ -24,8 +25,13 @@ if TYPE_CHECKING:
 __all__ = ['CLOCK_TOPIC', 'USE_SIM_TIME_NAME', 'TimeSource']
 
 CLOCK_TOPIC = '/clock'
+CLOCK_TYPE = 'rosgraph_msgs/msg/Clock'
 USE_SIM_TIME_NAME = 'use_sim_time'
 _CLOCK_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.BEST_EFFORT)
+# A rosgraph_msgs/Clock in CDR: the encapsulation header (byte 1: 1 little-endian, 0 big-endian),
+# then builtin_interfaces/Time as int32 sec and uint32 nanosec.
+_CLOCK_CDR = {1: struct.Struct('<iI'), 0: struct.Struct('>iI')}
+_CLOCK_CDR_SIZE = 12
 
 
 class TimeSource:
@@ -64,13 +70,20 @@ class TimeSource:
         return None if self._node_weak_ref is None else self._node_weak_ref()
 
     def _subscribe_to_clock_topic(self) -> None:
+        """Subscribe to /clock; with the CDR round trip on, take the bytes and read the time.
+
+        Decoding a whole Clock message per node and step would be the costliest part of a
+        simulation's clock ticks, and nothing but the time is used.
+        """
         node = self._get_node()
         if self._clock_sub is None and node is not None:
+            raw = cdr_roundtrip_enabled()
             self._clock_sub = node.create_subscription(
                 interface_class('rosgraph_msgs', 'Clock'),
                 CLOCK_TOPIC,
-                self.clock_callback,
+                self._clock_cdr_callback if raw else self.clock_callback,
                 _CLOCK_QOS,
+                raw=raw,
             )
 
     def attach_node(self, node: Node) -> None:
@@ -115,7 +128,25 @@ class TimeSource:
     def clock_callback(self, msg: Any) -> None:
         """Take a rosgraph_msgs/Clock message as the new ROS time."""
         stamp = msg.clock
-        nanoseconds = stamp.sec * 1_000_000_000 + stamp.nanosec
+        self._set_time_ns(stamp.sec * 1_000_000_000 + stamp.nanosec)
+
+    def _clock_cdr_callback(self, data: bytes) -> None:
+        """Take a rosgraph_msgs/Clock in CDR as the new ROS time.
+
+        Raises:
+            swarm_runtime.messages.DeserializationError: the bytes are not a Clock message.
+        """
+        layout = _CLOCK_CDR.get(data[1]) if len(data) >= _CLOCK_CDR_SIZE else None
+        if layout is None:
+            self.clock_callback(cdr_codec(CLOCK_TYPE).deserialize(data))
+            return
+        sec, nanosec = layout.unpack_from(data, 4)
+        nanoseconds = sec * 1_000_000_000 + nanosec
+        self._last_ns = nanoseconds
+        for clock in self._associated_clocks:
+            clock._set_ros_ns(nanoseconds)
+
+    def _set_time_ns(self, nanoseconds: int) -> None:
         self._last_ns = nanoseconds
         for clock in self._associated_clocks:
             clock._set_ros_ns(nanoseconds)

@@ -54,6 +54,7 @@ __all__ = [
     'cdr_roundtrip',
     'default_registry',
     'deserialize_cdr',
+    'get_cdr_codec',
     'get_message_class',
     'get_message_module',
     'get_typestore',
@@ -116,6 +117,18 @@ def deserialize_cdr(data: bytes | bytearray | memoryview, typename: str) -> Any:
         UnknownMessageTypeError: the type is not known.
     """
     return _cdr.deserialize_cdr(data, typename, default_registry())
+
+
+def get_cdr_codec(typename: str) -> _cdr.TypeCodec:
+    """Return the CDR codec of one type: ``codec.serialize(msg)``, ``codec.deserialize(data)``.
+
+    Same results and errors as :func:`serialize_cdr` / :func:`deserialize_cdr`, without their
+    per-call type lookups (what the built-in runtime's publishers and subscriptions use).
+
+    Raises:
+        UnknownMessageTypeError: the type is not known.
+    """
+    return default_registry().codec(typename)
 
 
 def cdr_roundtrip(message: Any) -> Any:

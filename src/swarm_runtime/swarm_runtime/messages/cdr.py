@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import struct
 import sys
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -22,7 +23,7 @@ from .errors import DeserializationError, SerializationError, UnknownMessageType
 from .fields import FieldSpec
 from .registry import MessageRegistry
 
-__all__ = ['cdr_roundtrip', 'deserialize_cdr', 'message_typename', 'serialize_cdr']
+__all__ = ['TypeCodec', 'cdr_roundtrip', 'deserialize_cdr', 'message_typename', 'serialize_cdr']
 
 # Exceptions the generated encoders and rosbags raise on values they cannot encode.
 _VALUE_ERRORS = (struct.error, TypeError, ValueError, AttributeError, OverflowError, IndexError)
@@ -132,6 +133,70 @@ def cdr_roundtrip(message: Any, registry: MessageRegistry) -> Any:
     except _VALUE_ERRORS as err:
         raise _describe_failure(message, typename, registry, err) from err
     return functions.deserialize(data)
+
+
+class TypeCodec:
+    """The CDR encoder and decoder of one message type, with the type looked up once.
+
+    ``serialize(message) -> bytes`` and ``deserialize(data) -> message`` behave exactly like
+    :func:`serialize_cdr` and ``deserialize_cdr(data, typename)`` (same bytes, same errors),
+    without their per-call type-name and registry lookups: publishers and subscriptions keep
+    one per type. The generated functions are compiled at the first call, not at creation.
+    """
+
+    __slots__ = ('_registry', '_typename', 'deserialize', 'serialize')
+
+    def __init__(self, typename: str, registry: MessageRegistry) -> None:
+        self._typename = registry.get_class(typename).__msgtype__
+        self._registry = registry
+        self.serialize: Callable[[Any], bytes] = self._serialize_first
+        self.deserialize: Callable[[bytes | bytearray | memoryview], Any] = self._deserialize_first
+
+    @property
+    def typename(self) -> str:
+        """The full type name, e.g. 'sensor_msgs/msg/LaserScan'."""
+        return self._typename
+
+    def _serialize_first(self, message: Any) -> bytes:
+        self._bind()
+        return self.serialize(message)
+
+    def _deserialize_first(self, data: bytes | bytearray | memoryview) -> Any:
+        self._bind()
+        return self.deserialize(data)
+
+    def _bind(self) -> None:
+        """Replace the first-call stand-ins by closures over the generated functions."""
+        typename = self._typename
+        registry = self._registry
+        if not _NATIVE_LITTLE_ENDIAN:
+            self.serialize = lambda message: serialize_cdr(message, registry)
+            self.deserialize = lambda data: deserialize_cdr(data, typename, registry)
+            return
+        functions = registry.cdr_functions(typename)
+        encode = functions.serialize
+        decode = functions.deserialize
+
+        def serialize(message: Any) -> bytes:
+            try:
+                return encode(message)
+            except _VALUE_ERRORS as err:
+                raise _describe_failure(message, typename, registry, err) from err
+
+        def deserialize(data: bytes | bytearray | memoryview) -> Any:
+            if type(data) is not bytes:
+                data = bytes(data)
+            # Anything but a little-endian header takes the general path (and its errors).
+            if len(data) < 4 or data[1] != 1 or data[0] != 0:
+                return deserialize_cdr(data, typename, registry)
+            try:
+                return decode(data)
+            except _DECODE_ERRORS as err:
+                msg = f'cannot decode {len(data)} bytes as {typename}: {err}'
+                raise DeserializationError(msg) from err
+
+        self.serialize = serialize
+        self.deserialize = deserialize
 
 
 # --------------------------------------------------------------------------- diagnosis

@@ -175,12 +175,16 @@ class _Writer:
     align: _Alignment = field(default_factory=_Alignment)
     run_codes: list[str] = field(default_factory=list)
     run_values: list[str] = field(default_factory=list)
+    # Lines computing values of the pending run (encoded strings), emitted before it.
+    pre_lines: list[str] = field(default_factory=list)
 
     def flush(self) -> None:
         if not self.run_codes:
             return
         codes = ''.join(self.run_codes)
         name = self.structs.setdefault(codes, f'_S{len(self.structs)}')
+        self.lines.extend(self.pre_lines)
+        self.pre_lines = []
         if self.run_values:
             self.lines.append(f'buf += {name}.pack({", ".join(self.run_values)})')
         else:
@@ -210,6 +214,19 @@ class _Writer:
         self.run_codes.append(f'{length}{code}')
         self.run_values.append(f'*_as_list({expr})')
         self.align.advance(size * length)
+
+    def string(self, expr: str) -> None:
+        """A string: its length joins the pending run, the bytes and NUL follow."""
+        encoded = self.names('t')
+        self.pad(4)
+        self.pre_lines.append(f'{encoded} = {expr}.encode()')
+        self.run_codes.append('I')
+        self.run_values.append(f'len({encoded}) + 1')
+        self.align.advance(4)
+        self.flush()
+        self.lines.append(f'buf += {encoded}')
+        self.lines.append('buf.append(0)')
+        self.align.reset(1)
 
     def statement(self, line: str, modulus_after: int) -> None:
         self.flush()
@@ -274,6 +291,25 @@ class _Reader:
         self.run_size += size
         self.align.advance(size)
 
+    def string(self, target: str) -> None:
+        """A string: its length joins the pending run, then the checked bytes are decoded."""
+        size = self.names('n')
+        end = self.names('e')
+        self.pad(4)
+        self.run_codes.append('I')
+        self.run_targets.append((size, 'uint32'))
+        self.run_size += 4
+        self.align.advance(4)
+        self.flush()
+        self.lines.append(f'{end} = pos + {size}')
+        self.lines.append(
+            f'if {size} < 1 or {end} > len(data) or data[{end} - 1] != 0: '
+            f"raise _CdrDecodeError(f'invalid string of {{{size}}} bytes at offset {{pos - 4}}')"
+        )
+        self.lines.append(f'{target} = data[pos:{end} - 1].decode()')
+        self.lines.append(f'pos = {end}')
+        self.align.reset(1)
+
     def fixed_array(self, base: str, dtype: str, target: str, length: int) -> None:
         _, size = _PRIMITIVES[base]
         self.pad(size)
@@ -327,7 +363,7 @@ class _Generator:
                 out.lines.append(f'{local} = {expr}')
                 self.write_message(out, self._specs(element.nested), local)
             elif element.is_string:
-                out.statement(f'_write_string(buf, {expr})', 1)
+                out.string(expr)
             else:
                 out.primitive(element.base, expr)
             return
@@ -399,7 +435,7 @@ class _Generator:
                 self.read_message(out, self._specs(element.nested), local)
                 out.lines.append(f'{target} = {local}')
             elif element.is_string:
-                out.statement(f'{target}, pos = _read_string(data, pos)', 1)
+                out.string(target)
             else:
                 out.primitive(element.base, target)
             return

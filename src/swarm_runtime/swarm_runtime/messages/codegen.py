@@ -12,6 +12,8 @@ assertions when field checks are on, ``__eq__``, ``__repr__``, ``get_fields_and_
 
 from __future__ import annotations
 
+import builtins
+import keyword
 import math
 import re
 from array import array
@@ -45,6 +47,18 @@ def _camel_to_snake(name: str) -> str:
 def module_name_for(spec: MessageSpec) -> str:
     """The ``__module__`` rosidl gives the class, e.g. 'sensor_msgs.msg._laser_scan'."""
     return f'{spec.package}.{spec.interface}._{_camel_to_snake(spec.name)}'
+
+
+class _Missing:
+    """The default of constructor parameters: the field was not given."""
+
+    __slots__ = ()
+
+    def __repr__(self) -> str:
+        return '<not given>'
+
+
+_MISSING = _Missing()
 
 
 class GeneratedMessage:
@@ -233,22 +247,27 @@ def _unchecked_store(field: FieldSpec) -> str:
     return 'value'
 
 
-def _constructor_checked(field: FieldSpec, nested: Mapping[str, str]) -> list[str]:
-    """Constructor lines for ``field`` when checks are on."""
-    key = repr(field.name)
+def _constructor_checked_given(field: FieldSpec, nested: Mapping[str, str]) -> list[str]:
+    """Constructor lines that check and store a given ``value`` of ``field`` (checks on)."""
     element = field.element
+    if not (field.is_sequence and element.is_numeric):
+        return _checked_store(field, nested)
+    # rosidl's constructor wraps the value in array.array before the setter sees it.
+    lines = [f'value = _numeric_array({element.typecode!r}, value)']
+    if field.length:
+        lines.append(
+            f'assert len(value) <= {field.length}, '
+            + repr(f"The '{field.name}' array.array() must have a size <= {field.length}")
+        )
+    lines.append(f'self._{field.name} = value')
+    return lines
+
+
+def _constructor_checked(field: FieldSpec, nested: Mapping[str, str]) -> list[str]:
+    """Constructor lines for ``field`` when checks are on (``**kwargs`` constructor)."""
+    key = repr(field.name)
     lines = [f'if {key} in kwargs:', f'    value = kwargs[{key}]']
-    if field.is_sequence and element.is_numeric:
-        # rosidl's constructor wraps the value in array.array before the setter sees it.
-        lines.append(f'    value = _numeric_array({element.typecode!r}, value)')
-        if field.length:
-            lines.append(
-                f'    assert len(value) <= {field.length}, '
-                + repr(f"The '{field.name}' array.array() must have a size <= {field.length}")
-            )
-        lines.append(f'    self._{field.name} = value')
-    else:
-        lines.extend(f'    {line}' for line in _checked_store(field, nested))
+    lines.extend(f'    {line}' for line in _constructor_checked_given(field, nested))
     lines += ['else:', f'    self._{field.name} = {_default_expr(field, nested)}']
     return lines
 
@@ -261,6 +280,96 @@ def _constructor_unchecked(field: FieldSpec, nested: Mapping[str, str]) -> str:
         return f'self._{field.name} = kwargs.get({key}, {default})'
     given = _unchecked_store(field).replace('value', f'kwargs[{key}]')
     return f'self._{field.name} = {given} if {key} in kwargs else {default}'
+
+
+# Names the generated __init__ uses besides its parameters; fields could be named like them
+# ('range', 'type', 'str' ...), so the keyword-parameter constructor reaches them as aliases.
+_INIT_BUILTINS = (
+    'all',
+    'bool',
+    'bytearray',
+    'bytes',
+    'float',
+    'int',
+    'isinstance',
+    'len',
+    'sorted',
+    'str',
+)
+_IDENTIFIER_OR_STRING = re.compile(r"""'(?:[^'\\]|\\.)*'|"(?:[^"\\]|\\.)*"|\b[A-Za-z_]\w*\b""")
+
+
+def _rename_identifiers(line: str, names: Mapping[str, str]) -> str:
+    """Rename identifiers in a line of generated code, leaving string literals alone."""
+
+    def replace(match: re.Match[str]) -> str:
+        text = match.group(0)
+        return names.get(text, text)
+
+    return _IDENTIFIER_OR_STRING.sub(replace, line)
+
+
+def _keyword_constructor_possible(spec: MessageSpec) -> bool:
+    """Fields can be keyword parameters unless one is a Python keyword or ``self``."""
+    return not any(keyword.iskeyword(f.name) or f.name == 'self' for f in spec.fields)
+
+
+def _init_source(spec: MessageSpec, nested: Mapping[str, str]) -> list[str]:
+    """The constructor: one keyword parameter per field (no kwargs dict to build and search,
+    which makes construction much cheaper), or ``**kwargs`` if a field name cannot be one.
+
+    Both behave like rosidl's ``__init__(self, **kwargs)``: keyword arguments only; unknown
+    names fail the checks (AssertionError) and are ignored without them; a field that is not
+    given gets a fresh default.
+    """
+    if not _keyword_constructor_possible(spec):
+        return _kwargs_init_source(spec, nested)
+    aliases = {name: f'_b_{name}' for name in _INIT_BUILTINS}
+    aliases['value'] = '_v'
+    params = ''.join(f'{f.name}=_MISSING, ' for f in spec.fields)
+    out = [f'def __init__(self, *, {params}check_fields=_MISSING, **_unknown):']
+    out.append('    check = _CHECK_FIELDS if check_fields is _MISSING else check_fields')
+    out.append('    self._check_fields = check')
+    out.append('    if check:')
+    out.append(
+        "        assert not _unknown, 'Invalid arguments passed to constructor: %s' % "
+        "', '.join(_b_sorted(_unknown))"
+    )
+    for field in spec.fields:
+        name = field.name
+        out.append(f'        if {name} is _MISSING:')
+        out.append(f'            self._{name} = {_default_expr(field, nested)}')
+        out.append('        else:')
+        out.append(f'            _v = {name}')
+        for line in _constructor_checked_given(field, nested):
+            out.append('            ' + _rename_identifiers(line, aliases))
+    if spec.fields:
+        out.append('    else:')
+        for field in spec.fields:
+            name = field.name
+            given = _rename_identifiers(_unchecked_store(field), {'value': name})
+            default = _default_expr(field, nested)
+            out.append(f'        self._{name} = {default} if {name} is _MISSING else {given}')
+    return out
+
+
+def _kwargs_init_source(spec: MessageSpec, nested: Mapping[str, str]) -> list[str]:
+    """The constructor as rosidl writes it, ``__init__(self, **kwargs)``."""
+    out = ['def __init__(self, **kwargs):']
+    out.append("    check = kwargs['check_fields'] if 'check_fields' in kwargs else _CHECK_FIELDS")
+    out.append('    self._check_fields = check')
+    out.append('    if check:')
+    out.append(
+        '        assert _VALID_KEYS.issuperset(kwargs), '
+        "'Invalid arguments passed to constructor: %s' % "
+        "', '.join(sorted(k for k in kwargs if k not in _VALID_KEYS))"
+    )
+    for field in spec.fields:
+        out.extend(f'        {line}' for line in _constructor_checked(field, nested))
+    if spec.fields:
+        out.append('    else:')
+        out.extend(f'        {_constructor_unchecked(field, nested)}' for field in spec.fields)
+    return out
 
 
 def class_source(spec: MessageSpec) -> str:
@@ -276,20 +385,7 @@ def class_source(spec: MessageSpec) -> str:
         out.append(f'        self._{field.name} = {_unchecked_store(field)}')
         out.append('')
 
-    out.append('def __init__(self, **kwargs):')
-    out.append("    check = kwargs['check_fields'] if 'check_fields' in kwargs else _CHECK_FIELDS")
-    out.append('    self._check_fields = check')
-    out.append('    if check:')
-    out.append(
-        '        assert _VALID_KEYS.issuperset(kwargs), '
-        "'Invalid arguments passed to constructor: %s' % "
-        "', '.join(sorted(k for k in kwargs if k not in _VALID_KEYS))"
-    )
-    for field in spec.fields:
-        out.extend(f'        {line}' for line in _constructor_checked(field, nested))
-    if spec.fields:
-        out.append('    else:')
-        out.extend(f'        {_constructor_unchecked(field, nested)}' for field in spec.fields)
+    out.extend(_init_source(spec, nested))
     out.append('')
 
     out.append('def _new_default():')
@@ -362,6 +458,8 @@ def build_message_class(
         '_integers_in_range': checks.integers_in_range,
         '_sequence_repr': checks.sequence_repr,
         '_arrays_equal': checks.arrays_equal,
+        '_MISSING': _MISSING,
+        **{f'_b_{name}': getattr(builtins, name) for name in _INIT_BUILTINS},
     }
     for typename, alias in nested.items():
         namespace[alias] = nested_classes[typename]

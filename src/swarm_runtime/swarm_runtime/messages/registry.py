@@ -6,7 +6,7 @@ import os
 import threading
 import types
 from collections.abc import Callable
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from rosbags.typesys.store import Typestore
 
@@ -21,6 +21,9 @@ from .errors import (
 from .fields import MessageSpec, message_spec, split_typename
 from .interface_paths import INTERFACES_PACKAGE, find_interface_msg_dir
 from .typestore import jazzy_typestore, load_msg_directory
+
+if TYPE_CHECKING:
+    from .cdr import TypeCodec
 
 __all__ = [
     'CHECK_FIELDS_ENV_VAR',
@@ -104,6 +107,7 @@ class MessageRegistry:
         self._specs: dict[str, MessageSpec] = {}
         self._converters: dict[str, tuple[Converter, Converter]] = {}
         self._cdr: dict[str, CdrFunctions] = {}
+        self._codecs: dict[str, TypeCodec] = {}
 
     @property
     def typestore(self) -> Typestore:
@@ -213,6 +217,20 @@ class MessageRegistry:
                 )
                 self._cdr[typename] = functions
             return functions
+
+    def codec(self, typename: str) -> TypeCodec:
+        """Return the :class:`~.cdr.TypeCodec` of a type (one per type and registry)."""
+        codec = self._codecs.get(typename)
+        if codec is not None:
+            return codec
+        from .cdr import TypeCodec
+
+        with self._lock:
+            codec = self._codecs.get(typename)
+            if codec is None:
+                codec = TypeCodec(typename, self)
+                self._codecs[typename] = codec
+            return codec
 
     def _package_check_fields(self, typename: str) -> bool:
         return self.get_module(split_typename(typename)[0]).check_fields
