@@ -203,46 +203,45 @@ class Executor:
             ExecutorStalledError: ``limit_ns`` is None and nothing can ever run.
         """
         inbox = self._inbox
+        popleft = inbox.popleft
         ready = self._ready
         context = self._context
         heappop = heapq.heappop
         graph = context._graph
         count = 0
         while True:
-            ran = False
-            while inbox:
-                seq, subscription = inbox.popleft()
+            if inbox:
+                seq, subscription = popleft()
                 queue = subscription._queue
-                if queue and queue[0][0] == seq and subscription._owner is self:
-                    entry = queue.popleft()
-                    if subscription._plain:
-                        data = entry[1]
-                        if type(data) is bytes and subscription._decode_bytes:
-                            data = subscription._codec.deserialize(data)
-                        subscription._callback(data)
-                    else:
-                        subscription._deliver(entry)
-                    ran = True
-                    break
-            if not ran:
-                while ready:
-                    _, _, gen, timer = heappop(ready)
-                    if gen == timer._gen and timer._owner is self:
-                        timer._call()
-                        ran = True
-                        break
-            if ran:
-                count += 1
-                if count == max_callbacks or not context._ok or self._is_shutdown:
-                    return count
-                if stop is not None and stop():
-                    return count
-                if until_clock_ns is not None:
-                    clock_ns = graph.clock_ns
-                    if clock_ns is not None and clock_ns >= until_clock_ns:
-                        return count
-            elif not self._advance_wall_clock(limit_ns):
+                # Stale notifications (message dropped or taken, node moved) are skipped.
+                if not queue or queue[0][0] != seq or subscription._owner is not self:
+                    continue
+                entry = queue.popleft()
+                if subscription._plain:
+                    data = entry[1]
+                    if type(data) is bytes and subscription._decode_bytes:
+                        data = subscription._codec.deserialize(data)
+                    subscription._callback(data)
+                else:
+                    subscription._deliver(entry)
+            elif ready:
+                _, _, gen, timer = heappop(ready)
+                if gen != timer._gen or timer._owner is not self:
+                    continue
+                timer._call()
+            elif self._advance_wall_clock(limit_ns):
+                continue
+            else:
                 return count
+            count += 1
+            if count == max_callbacks or not context._ok or self._is_shutdown:
+                return count
+            if stop is not None and stop():
+                return count
+            if until_clock_ns is not None:
+                clock_ns = graph.clock_ns
+                if clock_ns is not None and clock_ns >= until_clock_ns:
+                    return count
 
     def _advance_wall_clock(self, limit_ns: int | None) -> bool:
         """Jump to the next wall-timer deadline (not past ``limit_ns``); False if none."""

@@ -75,11 +75,6 @@ class CdrFunctions:
 # --------------------------------------------------------------------------- runtime helpers
 
 
-def _as_list(value: Any) -> list[Any]:
-    """Elements of a fixed-size numeric array as Python numbers (struct packs them)."""
-    return value.tolist() if type(value) is np.ndarray else list(value)
-
-
 def _sequence_bytes(value: Any, typecode: str, dtype: str) -> bytes:
     """Bytes of a numeric sequence (array.array fast path)."""
     if type(value) is array and value.typecode == typecode:
@@ -212,7 +207,10 @@ class _Writer:
         code, size = _PRIMITIVES[base]
         self.pad(size)
         self.run_codes.append(f'{length}{code}')
-        self.run_values.append(f'*_as_list({expr})')
+        local = self.names('a')
+        self.pre_lines.append(f'{local} = {expr}')
+        # Elements as Python numbers for struct (numpy arrays via tolist(), others as they are).
+        self.run_values.append(f'*({local}.tolist() if type({local}) is _ndarray else {local})')
         self.align.advance(size * length)
 
     def string(self, expr: str) -> None:
@@ -408,8 +406,15 @@ class _Generator:
         elif element.is_string:
             out.statement(f'{check}[_write_string(buf, item) for item in {expr}]', 1)
         else:
-            writer = f'{self.external(element.nested)}w'
-            out.statement(f'{check}[{writer}(item, buf) for item in {expr}]', 1)
+            # The element's encoder inlined in a loop: no function call per element.
+            item = out.names('i')
+            body = _Writer(self.structs, self.name, align=_Alignment(1, 0))
+            self.write_message(body, self._specs(element.nested), item)
+            body.flush()
+            if check:
+                out.statement(check.rstrip('; '), 1)
+            out.statement(f'for {item} in {expr}:', 1)
+            out.lines.extend(_indent(body.lines or ['pass']))
 
     # ----------------------------------------------------------------- decoder
 
@@ -488,12 +493,15 @@ class _Generator:
             out.lines.append(f'    {items}.append(text)')
             out.lines.append(f'{target} = {items}')
         else:
-            reader = f'{self.external(element.nested)}r'
+            # The element's decoder inlined in a loop: no function call per element.
             items = out.names('l')
+            item = out.names('i')
+            body = _Reader(self.structs, self.name, align=_Alignment(1, 0))
+            self.read_message(body, self._specs(element.nested), item)
+            body.flush()
             out.statement(f'{items} = []', 1)
             out.lines.append(f'for _ in range({length}):')
-            out.lines.append(f'    item, pos = {reader}(data, pos)')
-            out.lines.append(f'    {items}.append(item)')
+            out.lines.extend(_indent([*body.lines, f'{items}.append({item})']))
             out.lines.append(f'{target} = {items}')
         if not counted:
             out.lines.append(f'_check_decoded_length({target}, {length})')
@@ -578,6 +586,7 @@ def build_cdr_functions(
     source, generator = cdr_source(spec, specs)
     namespace: dict[str, Any] = {
         '_np': np,
+        '_ndarray': np.ndarray,
         '_new': object.__new__,
         '_ZEROS': _ZEROS,
         '_CdrDecodeError': CdrDecodeError,
@@ -585,7 +594,6 @@ def build_cdr_functions(
         '_read_string': _read_string,
         '_read_count': _read_count,
         '_read_array': _read_array,
-        '_as_list': _as_list,
         '_sequence_bytes': _sequence_bytes,
         '_octets': _octets,
         '_check_length': _check_length,
