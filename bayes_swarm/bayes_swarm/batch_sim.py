@@ -15,6 +15,7 @@ Decisions take no simulated time; their wall-clock duration is recorded per robo
 from __future__ import annotations
 
 import math
+from abc import ABC, abstractmethod
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from typing import Literal
@@ -238,7 +239,7 @@ def run_mission(
 
 
 # --------------------------------------------------------------------------- agents
-class _Agent:
+class _Agent(ABC):
     """What the event loop needs from a robot's decision maker."""
 
     planner: BayesSwarmPlanner | None = None
@@ -246,8 +247,9 @@ class _Agent:
     def observe(self, point: np.ndarray, value: float) -> None:
         return None
 
+    @abstractmethod
     def decide(self, position: np.ndarray, time_s: float) -> Decision:
-        raise ConfigError('abstract agent')  # pragma: no cover
+        """Next waypoint on arrival at ``position``."""
 
     def broadcast(self, position: np.ndarray) -> PeerUpdate | None:
         return None
