@@ -97,9 +97,17 @@ PARAMETERS: tuple[tuple[str, Any, str], ...] = (
         _DEFAULTS.robot_hit_repeat_s,
         'a robot hit this soon after the previous one turns to a random heading [s]',
     ),
-    ('sound_turn_rule', _DEFAULTS.sound_turn_rule.value, 'away (paper) or toward'),
+    (
+        'sound_turn_rule',
+        _DEFAULTS.sound_turn_rule.value,
+        "toward (authors' simulator) or away (authors' robot)",
+    ),
     ('sound_weighting', _DEFAULTS.sound_weighting.value, 'distance (paper) or unit'),
-    ('sound_memory', _DEFAULTS.sound_memory.value, 'stored (paper) or once'),
+    (
+        'sound_memory',
+        _DEFAULTS.sound_memory.value,
+        "once (authors' simulator) or stored (paper wording)",
+    ),
     (
         'sound_updates_at_corner',
         _DEFAULTS.sound_updates_at_corner,

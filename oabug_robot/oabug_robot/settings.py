@@ -86,7 +86,7 @@ class TurnDirection(Enum):
 class SoundTurnRule(Enum):
     """How the sound variants pick the wall-following side at a first wall contact."""
 
-    AWAY = 'away'  # paper ("spread out") and the authors' robot: turn away from the peers
+    AWAY = 'away'  # the authors' robot: turn away from the peers
     TOWARD = 'toward'  # the authors' simulator: turn toward the peers' resultant
 
 
@@ -100,8 +100,8 @@ class SoundWeighting(Enum):
 class SoundMemory(Enum):
     """Whether the sound direction theta_opp becomes the stored preferred direction."""
 
-    STORED = 'stored'  # paper: phi'_i = theta_opp is the new preferred direction
-    ONCE = 'once'  # the authors' simulator: used for one turn, only 180 deg flips are stored
+    STORED = 'stored'  # paper's wording: phi'_i = theta_opp is the new preferred direction
+    ONCE = 'once'  # the authors' simulator: used for one turn; flips apply to phi_i
 
 
 def _require(condition: bool, message: str) -> None:
@@ -257,9 +257,12 @@ class OABugConfig:
             another robot (paper: "all turn right").
         robot_hit_repeat_s: a robot hit this soon after the previous one turns to a random
             heading instead of right, to break jams of two robots (0 disables) [s].
-        sound_turn_rule: see SoundTurnRule (paper: away).
+        sound_turn_rule: see SoundTurnRule; the paper does not say which (default: toward,
+            as in the authors' simulator that produced the paper's figures).
         sound_weighting: see SoundWeighting (paper: distance).
-        sound_memory: see SoundMemory (paper: stored).
+        sound_memory: see SoundMemory; the paper's text says stored, its 180 deg flip
+            ("an area symmetrical ... with respect to the departure point") only makes sense
+            for the original phi_i (default: once, as in the authors' simulator).
         sound_updates_at_corner: the Sound variant updates phi' from the bearings at outer
             corners (paper, Table I); False leaves it at phi_i (the authors' simulator).
         pump_on_s: pump burst length (paper: 0.5 s).
@@ -283,9 +286,9 @@ class OABugConfig:
     visit_count_resets_on_fresh_corner: bool = True
     fixed_turn: TurnDirection = TurnDirection.RIGHT
     robot_hit_repeat_s: float = 4.0
-    sound_turn_rule: SoundTurnRule = SoundTurnRule.AWAY
+    sound_turn_rule: SoundTurnRule = SoundTurnRule.TOWARD
     sound_weighting: SoundWeighting = SoundWeighting.DISTANCE
-    sound_memory: SoundMemory = SoundMemory.STORED
+    sound_memory: SoundMemory = SoundMemory.ONCE
     sound_updates_at_corner: bool = True
     pump_on_s: float = 0.5
     pump_period_s: float = 5.0

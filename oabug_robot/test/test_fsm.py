@@ -400,7 +400,7 @@ def test_revisit_count_can_accumulate_across_fresh_corners() -> None:
 
 
 def test_sound_direction_is_opposite_to_the_resultant_of_the_bearings() -> None:
-    fsm = make(Variant.SOUND, robot_count=3)
+    fsm = make(Variant.SOUND, robot_count=3, sound_memory=SoundMemory.STORED)
     script = Script(fsm, yaw_rad=0.0)
     script.step(free(), yaw_rad=fsm.memory.preferred_direction_rad)
     script.step(free(), yaw_rad=0.0)
@@ -429,7 +429,7 @@ def test_sound_variants_choose_the_wall_side_from_the_peers(
 
 
 def test_sound_turn_side_uses_bearings_rotated_into_the_current_heading() -> None:
-    fsm = make(Variant.SOUND, robot_count=2)
+    fsm = make(Variant.SOUND, robot_count=2, sound_turn_rule=SoundTurnRule.AWAY)
     script = Script(fsm, yaw_rad=0.0)
     script.step(free())
     script.hear([-90.0])  # heard at yaw 0: theta_opp points to yaw +90 deg
@@ -459,7 +459,7 @@ def test_stale_bearings_are_not_used() -> None:
 
 
 def test_sound_variant_updates_the_preferred_direction_at_outer_corners() -> None:
-    fsm = make(Variant.SOUND, robot_count=2)
+    fsm = make(Variant.SOUND, robot_count=2, sound_memory=SoundMemory.STORED)
     script = Script(fsm, yaw_rad=0.0)
     reach_wall(script)
     script.follow_straight(1)
@@ -468,6 +468,18 @@ def test_sound_variant_updates_the_preferred_direction_at_outer_corners() -> Non
     assert fsm.memory.event is Event.LEAVE_WALL
     assert abs(fsm.memory.target_yaw_rad) == pytest.approx(math.pi)
     assert abs(fsm.memory.preferred_direction_rad) == pytest.approx(math.pi)
+
+
+def test_sound_variant_with_theta_used_once_turns_to_it_but_keeps_phi() -> None:
+    fsm = make(Variant.SOUND, robot_count=2, sound_memory=SoundMemory.ONCE)
+    phi = fsm.memory.preferred_direction_rad
+    script = Script(fsm, yaw_rad=0.0)
+    reach_wall(script)
+    script.follow_straight(1)
+    script.hear([0.0], [3.0])
+    script.pass_outer_corner(1)
+    assert abs(fsm.memory.target_yaw_rad) == pytest.approx(math.pi)
+    assert fsm.memory.preferred_direction_rad == pytest.approx(phi)
 
 
 def test_sound_variant_as_in_the_authors_simulator_keeps_its_initial_direction() -> None:
