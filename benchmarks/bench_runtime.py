@@ -6,6 +6,11 @@ Each simulated robot has a sensor node publishing the contract's streams at real
 publishes ``/clock`` at 100 Hz from a wall timer, as the sim bridge does. The real-time
 factor is simulated seconds per real second of spinning (setup excluded).
 
+The goal (the foundation issue): at least 100x real time without the CDR round trip and 50x
+with it. On a machine shared with other work the wall-clock factor depends on the load, so the
+factor per CPU second of the benchmark process is the primary figure; both are printed, with
+the command line that produced them.
+
 Field checks (``ROS_PYTHON_CHECK_FIELDS``) are fixed when message classes are generated, so
 each configuration runs in its own process, one after the other::
 
@@ -23,11 +28,16 @@ import json
 import math
 import os
 import pstats
+import shlex
 import subprocess
 import sys
 import time
 from dataclasses import asdict, dataclass
 from typing import Any
+
+#: Real-time factor goals (per CPU second) without and with the CDR round trip.
+GOAL_WITHOUT_CDR = 100.0
+GOAL_WITH_CDR = 50.0
 
 CONFIGURATIONS = (
     (
@@ -315,12 +325,15 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument(
         '--repeat',
         type=int,
-        default=3,
+        default=5,
         help='runs per configuration (with all); the fastest is reported, as with timeit',
     )
     parser.add_argument('--profile', metavar='PATH', help='write cProfile stats (with current)')
     parser.add_argument('--json', action='store_true', help='print the result as JSON')
     args = parser.parse_args(argv)
+    command = shlex.join(
+        ['python', 'benchmarks/bench_runtime.py', *(sys.argv[1:] if argv is None else argv)]
+    )
 
     if args.configs == 'current':
         result = run(
@@ -338,6 +351,7 @@ def main(argv: list[str] | None = None) -> None:
         if args.json:
             print(json.dumps(summary))
             return
+        print(f'$ {command}')
         print(
             f'CDR round trip {"on" if result.cdr_roundtrip else "off"}, field checks '
             f'{"on" if result.field_checks else "off"}: {_describe(summary)}'
@@ -346,14 +360,22 @@ def main(argv: list[str] | None = None) -> None:
             pstats.Stats(args.profile).sort_stats('tottime').print_stats(25)
         return
 
+    print(f'$ {command}')
     print(
         f'{args.robots} robots, {args.sim_seconds:g} s of sim time, /clock at {args.clock_hz:g} Hz'
         + (', prebuilt messages' if args.prebuilt else '')
+        + f'; best of {max(args.repeat, 1)} runs per configuration (by CPU factor)'
     )
     for label, env_overrides in CONFIGURATIONS:
         runs = [_run_configuration(args, env_overrides) for _ in range(max(args.repeat, 1))]
         best = max(runs, key=lambda result: result['cpu_real_time_factor'])
-        print(f'  {label:<37} {_describe(best)}')
+        goal = GOAL_WITH_CDR if best['cdr_roundtrip'] else GOAL_WITHOUT_CDR
+        verdict = 'meets' if best['cpu_real_time_factor'] >= goal else 'misses'
+        print(f'  {label:<37} {_describe(best)}; {verdict} the {goal:g}x goal')
+    print(
+        'The factor per CPU second is the primary figure: the wall-clock factor also counts '
+        'the time other processes hold the CPU.'
+    )
 
 
 if __name__ == '__main__':
