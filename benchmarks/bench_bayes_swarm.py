@@ -12,6 +12,7 @@ Experiments (``--experiments``, default all):
 
 * main: Case 1 with 5 robots and Case 2 with 10 robots (Bayes-Swarm-P);
 * penalty: Bayes-Swarm-P against -O (Table 5);
+* comm: limited communication ranges (Experiment 5, Table 6);
 * authors: the authors' code options (inert penalty, origin paths, floor downsampling,
   alpha on 0.1 T_max, COBYLA) for comparison;
 * baselines: Glowworm, Levy walk and exhaustive search (Table 3);
@@ -46,7 +47,16 @@ from bayes_swarm.messages import DecisionKind  # noqa: E402
 from bayes_swarm.settings import Arena, BayesSwarmConfig, ExhaustiveConfig  # noqa: E402
 from sim_bridge.signal_fields import get_case  # noqa: E402
 
-EXPERIMENTS = ('main', 'penalty', 'authors', 'baselines', 'scaling', 'case3', 'avalanche')
+EXPERIMENTS = (
+    'main',
+    'penalty',
+    'authors',
+    'comm',
+    'baselines',
+    'scaling',
+    'case3',
+    'avalanche',
+)
 AUTHORS_OPTIONS = {
     'authors_negated_m': True,
     'authors_origin_paths': True,
@@ -70,6 +80,7 @@ class Job:
     noise_std: float = 0.0
     max_mission_time_s: float | None = None
     partition: str = 'strips'
+    comm_range_m: float | None = None
 
 
 @dataclass(frozen=True)
@@ -109,6 +120,7 @@ def mission_spec(job: Job) -> MissionSpec:
         planner=planner,
         depot_direction_offsets_deg=case.depot_direction_offsets_deg,
         noise_std=job.noise_std,
+        comm_range_m=job.comm_range_m,
         exhaustive=ExhaustiveConfig(partition=job.partition),
     )
 
@@ -164,6 +176,20 @@ def plan_jobs(experiments: list[str], runs: int, baseline_runs: int, large_runs:
                     dict(AUTHORS_OPTIONS),
                 )
             )
+    if 'comm' in experiments:
+        for case, m, ranges in (('case1', 5, (0.1, 0.5, 1.0)), ('case2', 10, (5.0, 10.0, 20.0))):
+            for comm in ranges:
+                jobs.append(
+                    Job(
+                        'comm',
+                        f'Case {case[-1]}, {m} robots, comm range {comm:g} m',
+                        case,
+                        'bayes_swarm_p',
+                        m,
+                        runs,
+                        comm_range_m=comm,
+                    )
+                )
     if 'baselines' in experiments:
         for case, m in (('case1', 5), ('case2', 10)):
             name = f'Case {case[-1]}, {m} robots'
