@@ -242,8 +242,38 @@ class _Reader:
     align: _Alignment = field(default_factory=_Alignment)
     run_codes: list[str] = field(default_factory=list)
     run_targets: list[tuple[str, str]] = field(default_factory=list)  # (target, base)
-    run_arrays: list[str] = field(default_factory=list)  # lines reading arrays of the run
+    # Fixed numeric arrays of the run: (target, dtype, item size, length, offset in the run).
+    run_arrays: list[tuple[str, str, int, int, int]] = field(default_factory=list)
     run_size: int = 0
+
+    def _array_lines(self) -> list[str]:
+        """Read the run's fixed arrays, each into its own new array.
+
+        Arrays of one dtype share a view of the data (one ``frombuffer``) that each copies its
+        slice from, which is cheaper than a ``frombuffer`` per array.
+        """
+        lines = []
+        by_dtype: dict[str, list[tuple[str, str, int, int, int]]] = {}
+        for spec in self.run_arrays:
+            by_dtype.setdefault(spec[1], []).append(spec)
+        for dtype, specs in by_dtype.items():
+            first = specs[0][4]
+            size = specs[0][2]
+            shared = len(specs) > 1 and all((spec[4] - first) % size == 0 for spec in specs)
+            if not shared:
+                lines.extend(
+                    f'{target} = _np.frombuffer(data, _np.{dtype}, {length}, pos + {offset}).copy()'
+                    for target, _, _, length, offset in specs
+                )
+                continue
+            last = specs[-1]
+            count = (last[4] - first) // size + last[3]
+            view = self.names('b')
+            lines.append(f'{view} = _np.frombuffer(data, _np.{dtype}, {count}, pos + {first})')
+            for target, _, _, length, offset in specs:
+                start = (offset - first) // size
+                lines.append(f'{target} = {view}[{start}:{start + length}].copy()')
+        return lines
 
     def flush(self) -> None:
         if not self.run_codes:
@@ -266,7 +296,7 @@ class _Reader:
         elif self.run_arrays:
             # Nothing to unpack, but the struct call checks that the bytes are there.
             self.lines.append(f'{name}.unpack_from(data, pos)')
-        self.lines.extend(self.run_arrays)
+        self.lines.extend(self._array_lines())
         self.lines.append(f'pos += {self.run_size}')
         self.run_codes, self.run_targets, self.run_arrays, self.run_size = [], [], [], 0
 
@@ -312,9 +342,7 @@ class _Reader:
         _, size = _PRIMITIVES[base]
         self.pad(size)
         self.run_codes.append(f'{size * length}x')
-        self.run_arrays.append(
-            f'{target} = _np.frombuffer(data, _np.{dtype}, {length}, pos + {self.run_size}).copy()'
-        )
+        self.run_arrays.append((target, dtype, size, length, self.run_size))
         self.run_size += size * length
         self.align.advance(size * length)
 
