@@ -128,7 +128,10 @@ class TimeSource:
     def clock_callback(self, msg: Any) -> None:
         """Take a rosgraph_msgs/Clock message as the new ROS time."""
         stamp = msg.clock
-        self._set_time_ns(stamp.sec * 1_000_000_000 + stamp.nanosec)
+        nanoseconds = stamp.sec * 1_000_000_000 + stamp.nanosec
+        self._last_ns = nanoseconds
+        for clock in self._associated_clocks:
+            clock._set_ros_ns(nanoseconds)
 
     def _clock_cdr_callback(self, data: bytes) -> None:
         """Take a rosgraph_msgs/Clock in CDR as the new ROS time.
@@ -142,11 +145,6 @@ class TimeSource:
             return
         sec, nanosec = layout.unpack_from(data, 4)
         nanoseconds = sec * 1_000_000_000 + nanosec
-        self._last_ns = nanoseconds
-        for clock in self._associated_clocks:
-            clock._set_ros_ns(nanoseconds)
-
-    def _set_time_ns(self, nanoseconds: int) -> None:
         self._last_ns = nanoseconds
         for clock in self._associated_clocks:
             clock._set_ros_ns(nanoseconds)
