@@ -126,3 +126,17 @@ def test_fields_named_like_python_keywords_fall_back_to_a_kwargs_constructor() -
     assert 'def __init__(self, **kwargs):' in class_source(registry.spec('probe_msgs/msg/Odd'))
     with pytest.raises(AssertionError, match='Invalid arguments passed to constructor: x'):
         registry.get_class('probe_msgs/msg/Odd')(x=1)
+
+
+def test_default_fixed_arrays_are_fresh_zero_arrays_of_their_dtype() -> None:
+    registry = MessageRegistry(check_fields=True)
+    imu_class = registry.get_class('sensor_msgs/msg/Imu')
+    first = imu_class()
+    first.orientation_covariance[0] = 5.0
+    first.angular_velocity_covariance[:] = 1.0
+    for imu in (imu_class(), imu_class._new_default(), imu_class(check_fields=False)):
+        assert imu.orientation_covariance.dtype == 'float64'
+        assert imu.orientation_covariance.shape == (9,)
+        assert not imu.orientation_covariance.any()
+        assert not imu.angular_velocity_covariance.any()
+        assert imu.orientation_covariance is not first.orientation_covariance

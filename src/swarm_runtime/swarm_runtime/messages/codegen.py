@@ -113,12 +113,27 @@ def _element_default(field: FieldSpec, nested: Mapping[str, str]) -> str:
     return '0'
 
 
+def _zeros_name(field: FieldSpec) -> str:
+    """Namespace name of the ``copy`` method of a fixed numeric array's zero template."""
+    return f'_zeros_{field.length}_{field.element.dtype}'
+
+
+def _zero_templates(spec: MessageSpec) -> dict[str, Any]:
+    """``copy`` methods of zero arrays, one per fixed numeric array shape of ``spec``."""
+    return {
+        _zeros_name(field): np.zeros(field.length, dtype=field.element.dtype).copy
+        for field in spec.fields
+        if field.is_array and field.element.is_numeric
+    }
+
+
 def _default_expr(field: FieldSpec, nested: Mapping[str, str]) -> str:
     """Expression of a fresh default value of ``field``."""
     element = field.element
     if field.is_array:
         if element.is_numeric:
-            return f'_np.zeros({field.length}, dtype=_np.{element.dtype})'
+            # A copy of a zero template (never handed out): cheaper than numpy.zeros().
+            return f'{_zeros_name(field)}()'
         return f'[{_element_default(field, nested)} for _ in range({field.length})]'
     if field.is_sequence:
         return f'_array({element.typecode!r})' if element.is_numeric else '[]'
@@ -460,6 +475,7 @@ def build_message_class(
         '_arrays_equal': checks.arrays_equal,
         '_MISSING': _MISSING,
         **{f'_b_{name}': getattr(builtins, name) for name in _INIT_BUILTINS},
+        **_zero_templates(spec),
     }
     for typename, alias in nested.items():
         namespace[alias] = nested_classes[typename]
