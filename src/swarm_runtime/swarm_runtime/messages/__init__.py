@@ -106,6 +106,9 @@ def serialize_cdr(message: Any) -> bytes:
     Raises:
         SerializationError: a field holds a value that cannot be encoded (names the field).
     """
+    typename = getattr(type(message), '__msgtype__', None)
+    if type(typename) is str:
+        return default_registry().codec(typename).serialize(message)
     return _cdr.serialize_cdr(message, default_registry())
 
 
@@ -116,7 +119,7 @@ def deserialize_cdr(data: bytes | bytearray | memoryview, typename: str) -> Any:
         DeserializationError: the bytes are not a valid encoding of the type.
         UnknownMessageTypeError: the type is not known.
     """
-    return _cdr.deserialize_cdr(data, typename, default_registry())
+    return default_registry().codec(typename).deserialize(data)
 
 
 def get_cdr_codec(typename: str) -> _cdr.TypeCodec:
