@@ -142,6 +142,7 @@ class RobotController:
         self._far_since_s: float | None = None
         self._swarm_changes: tuple[str, ...] = ()
         self._with_estimates = True
+        self._events: list[str] = []
 
     # ------------------------------------------------------------------ memory
     @property
@@ -229,6 +230,7 @@ class RobotController:
         if self._start_s is None:
             self._start_s = now_s
         events: list[str] = []
+        self._events = events
 
         fresh = self._merge_peers(now_s, peers)
         newly_captured = self._merge_captured(captured_ids)
@@ -399,6 +401,15 @@ class RobotController:
             self._committed = choice
             events.append(f'target {captured} captured: re-targets {choice} from its estimate')
 
+    def _abandon(self, target: int) -> None:
+        """Forget ``target``'s filter and stop pursuing it (it is re-tracked if heard again)."""
+        assert self._bank is not None
+        self._bank.forget(target)
+        self._events.append(f'target {target} not heard at its estimate: estimate dropped')
+        if self._committed == target:
+            self._committed = NO_TARGET
+        self.target_id = NO_TARGET
+
     def _update_work(self, now_s: float, own_target: int) -> None:
         """(c-1): stop when the own target is louder than gamma3; give up after a timeout."""
         phases = self.config.phases
@@ -430,7 +441,12 @@ class RobotController:
         if scheme.uses_direct_approach and bank is not None and bank.is_converged(target):
             goal = bank.estimate(target).position_m
             near = float(np.hypot(*(goal - position))) < phases.task_area_m
-            if not (near and mean is not None):
+            if near and mean is None:
+                # Nothing heard at the estimate: the target was captured by robots out of
+                # range, or the estimate is far off. Drop it instead of hovering there.
+                self._abandon(target)
+                return Phase.SEARCH
+            if not near:
                 self._goal = goal
                 return Phase.DIRECT_APPROACH
         if scheme.uses_far_formation and bank is not None and bank.is_tracked(target):

@@ -128,3 +128,19 @@ def test_msc_pf_robot_does_not_use_stored_estimates_after_a_capture():
     _, out = run_capture_scenario('msc_pf')
     assert out.status.target_id == NO_TARGET
     assert out.status.phase is Phase.SEARCH
+
+
+def test_robot_drops_an_estimate_where_nothing_is_heard_and_searches_again():
+    robot, out = run_capture_scenario('proposed')
+    position = HOME.copy()
+    t = 40.0
+    for _ in range(400):
+        if out.status.phase is not Phase.DIRECT_APPROACH:
+            break
+        position = position + out.displacement_m
+        t += 1.0
+        out = robot.step(t, position, {})
+    assert out.status.phase is Phase.SEARCH
+    assert out.status.target_id == NO_TARGET
+    assert not robot.filters.is_tracked(2)
+    assert any('not heard at its estimate' in e for e in out.events)
