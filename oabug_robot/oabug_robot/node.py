@@ -4,7 +4,7 @@ Subscribes (relative names, so the robot's namespace applies): ``scan``
 (sensor_msgs/LaserScan), ``imu`` (sensor_msgs/Imu), ``gas`` (swarm_interfaces/GasReading),
 ``bearings`` (swarm_interfaces/PeerBearingArray). Publishes ``cmd_vel``
 (geometry_msgs/Twist), ``pump`` (std_msgs/Bool) and ``state`` (swarm_interfaces/OABugState)
-at ``control_rate_hz``.
+at ``control_rate_hz`` (the state at ``state_rate_hz``, and at every event).
 
 The node only translates; every decision is in :class:`oabug_robot.fsm.OABugFsm`. If the scan
 or the IMU (and, for the gas variants, the gas sensor) has not been heard for
@@ -40,7 +40,7 @@ from oabug_robot.conversions import (
     yaw_from_imu,
 )
 from oabug_robot.errors import ConfigError, ScanError
-from oabug_robot.fsm import OABugFsm, SensorSnapshot
+from oabug_robot.fsm import Event, OABugFsm, SensorSnapshot
 from oabug_robot.scan_features import ScanFeatureExtractor, ScanFeatures
 from oabug_robot.settings import (
     Departure,
@@ -82,6 +82,11 @@ PARAMETERS: tuple[tuple[str, Any, str], ...] = (
         'the direction into the building minus 90',
     ),
     ('control_rate_hz', 10.0, 'control loop rate [Hz]'),
+    (
+        'state_rate_hz',
+        2.0,
+        'state topic rate [Hz]; a step with an event or a change of staleness is always published',
+    ),
     ('stale_timeout_s', 1.0, 'stop when scan, imu (or gas, gas variants) is older [s]'),
     ('gas_threshold', _DEFAULTS.gas_threshold, 'raw 10-bit gas reading that means scent'),
     ('scent_window_s', _DEFAULTS.scent_window_s, 'scent counts at a corner for this long [s]'),
@@ -210,6 +215,10 @@ class OABugNode(Node):
                 raise ConfigError(f'control_rate_hz must be > 0, got {rate_hz}')
             if not (math.isfinite(self._stale_timeout_s) and self._stale_timeout_s > 0.0):
                 raise ConfigError(f'stale_timeout_s must be > 0, got {self._stale_timeout_s}')
+            state_rate_hz = float(values['state_rate_hz'])
+            if not (math.isfinite(state_rate_hz) and state_rate_hz > 0.0):
+                raise ConfigError(f'state_rate_hz must be > 0, got {state_rate_hz}')
+            self._state_period_s = 1.0 / state_rate_hz
         except ConfigError as err:
             self.get_logger().fatal(f'invalid configuration: {err}')
             raise
@@ -227,6 +236,8 @@ class OABugNode(Node):
         self._gas_time_s: float | None = None
         self._bearings: PeerBearings | None = None
         self._last_warning_s: dict[str, float] = {}
+        self._last_state_s = -math.inf
+        self._last_state_stale: bool | None = None
         self._heard: set[str] = set()
 
         self._cmd_pub = self.create_publisher(geometry_msgs.Twist, 'cmd_vel', 10)
@@ -364,6 +375,14 @@ class OABugNode(Node):
             )
 
     def _publish_state(self, now_s: float, *, pump_on: bool, stale: bool) -> None:
+        """Publish the state at ``state_rate_hz``, and at once on an event or a stale change."""
+        due = not 0.0 <= now_s - self._last_state_s < self._state_period_s
+        changed = stale != self._last_state_stale
+        event = not stale and self._fsm.memory.event is not Event.NONE
+        if not (due or changed or event):
+            return
+        self._last_state_s = now_s
+        self._last_state_stale = stale
         self._state_pub.publish(
             state_to_ros(
                 self._fsm.memory,

@@ -249,3 +249,17 @@ def test_the_parameter_file_starts_a_node_and_command_line_overrides_win() -> No
         node.destroy_node()
     finally:
         rclpy.try_shutdown()
+
+
+def test_state_is_published_at_its_own_rate_and_at_every_event(make_harness) -> None:
+    h = make_harness(variant='gas', robot_count=1, state_rate_hz=2.0)
+    h.play(**all_sensors(front_m=5.0))
+    h.spin_for(0.5)
+    h.states.clear()
+    h.spin_for(2.0)
+    assert 3 <= len(h.states) <= 5, 'about 2 Hz while nothing happens'
+    assert len(h.commands) >= 19, 'while cmd_vel goes out every control step'
+    h.states.clear()
+    h.play(scan=scan_msg(front_m=0.22))
+    h.spin_for(0.15)
+    assert [s.event for s in h.states] == ['hit_wall']
