@@ -18,7 +18,8 @@ Random is the blank control: straight legs, a new uniform heading on every hit a
 each ``random_step_m`` driven, with probability ``random_turn_probability``.
 
 Besides the paper's state the controller keeps a motion mode (turning in place to a
-heading, going straight, following a wall) that turns its decisions into velocities.
+heading, going straight, following a wall, wrapping round a wall end) that turns its
+decisions into velocities.
 :meth:`OABugFsm.step` is the only entry point: one sensor snapshot in, one command out.
 """
 
@@ -183,8 +184,6 @@ class OABugFsm:
         )
         return Command(float(twist.linear_mps), float(twist.angular_radps), bool(pump))
 
-    # Bug variants ---------------------------------------------------------------------------
-
     def _step_bug(self, snap: SensorSnapshot) -> Twist2D:
         mem = self._memory
         cfg = self._config
@@ -345,8 +344,6 @@ class OABugFsm:
             bearings.azimuths_rad, bearings.distances_m, self._config.sound_weighting
         )
         return None if theta is None else wrap_angle(theta + bearings.yaw_at_stamp_rad)
-
-    # Random (blank control) -----------------------------------------------------------------
 
     def _step_random(self, snap: SensorSnapshot, dt_s: float) -> Twist2D:
         mem = self._memory
