@@ -271,6 +271,12 @@ class ROSClock(Clock):
             return self._ros_ns
         return self._offset_ns + self._time_context()._elapsed_ns
 
+    def now(self) -> Time:
+        """Return the current time: ``/clock`` time while ROS time is active, else wall time."""
+        if self._ros_active:
+            return Time._from_ns(self._ros_ns, ClockType.ROS_TIME)
+        return Time._from_ns(self._offset_ns + self._time_context()._elapsed_ns, ClockType.ROS_TIME)
+
     def _schedule_timer(self, timer: Timer) -> None:
         if not self._ros_active:
             super()._schedule_timer(timer)
@@ -310,9 +316,13 @@ class ROSClock(Clock):
         self._ros_ns = nanoseconds
         heap = self._timer_heap
         while heap and heap[0][0] <= nanoseconds:
-            _, _, gen, timer = heapq.heappop(heap)
-            if gen == timer._gen:
-                timer._notify_ready()
+            entry = heapq.heappop(heap)
+            timer = entry[3]
+            if entry[2] == timer._gen:
+                # Timer._notify_ready() inlined: queue it in its executor's ready heap.
+                owner = timer._owner
+                if owner is not None:
+                    heapq.heappush(owner._ready, entry)
 
     def _set_ros_ns_with_jumps(self, nanoseconds: int) -> None:
         """The general case: jump callbacks, backward jumps, inactive ROS time."""

@@ -18,6 +18,16 @@ def _time_msg_class() -> Any:
     return interface_class('builtin_interfaces', 'Time')
 
 
+@cache
+def _time_msg_layout() -> tuple[Any, bool]:
+    """The Time message class and the field-check default its new messages get."""
+    cls = _time_msg_class()
+    return cls, cls()._check_fields
+
+
+_new = object.__new__
+
+
 _LIMIT = 2**63
 _INT32_MIN = -(2**31)
 _INT32_MAX = 2**31 - 1
@@ -144,10 +154,11 @@ class Time:
     def to_msg(self) -> Any:
         """Return the time as a ``builtin_interfaces.msg.Time``."""
         sec, nanosec = divmod(self._nanoseconds, S_TO_NS)
-        cls = _time_msg_class()
+        cls, check_fields = _time_msg_layout()
         if _INT32_MIN <= sec <= _INT32_MAX:
             # What the constructor would build, without its checks (the values pass them).
-            msg = cls._new_default()
+            msg = _new(cls)
+            msg._check_fields = check_fields
             msg._sec = sec
             msg._nanosec = nanosec
             return msg
