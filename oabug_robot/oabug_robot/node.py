@@ -330,7 +330,12 @@ class OABugNode(Node):
         scan_time, msg = self._scan_time_s, self._scan_msg
         self._scan_msg = None
         try:
-            self._features = self._extractor.extract(scan_from_ros(msg), *self._near_peers(now_s))
+            # Only the wall being followed matters for the next step (a wall taken up in
+            # that step is first turned to, which needs no side wall).
+            side = self._fsm.memory.wall_side
+            self._features = self._extractor.extract(
+                scan_from_ros(msg), *self._near_peers(now_s), sides=(side,) if side else ()
+            )
         except ScanError as err:
             self._log_once_per_period('scan', f'ignoring laser scan: {err}')
             return

@@ -139,6 +139,7 @@ class ScanFeatureExtractor:
         scan: LaserScanData,
         peer_azimuths_rad: np.ndarray = _NO_ANGLES,
         peer_distances_m: np.ndarray | None = None,
+        sides: tuple[int, ...] = (1, -1),
     ) -> ScanFeatures:
         """Return the features of ``scan``.
 
@@ -147,6 +148,8 @@ class ScanFeatureExtractor:
             peer_azimuths_rad: (B,) bearings of the peers heard, robot frame [rad].
             peer_distances_m: (B,) their coarse distances [m], NaN where unknown; None when
                 no distance is known at all.
+            sides: the sides whose wall is wanted (+1 left, -1 right); a side left out
+                reads as "no wall". A robot that follows no wall needs none.
 
         Raises:
             ScanError: the scan has no rays or its angles are not finite.
@@ -196,9 +199,12 @@ class ScanFeatureExtractor:
                 captured &= is_wall
         front_wall = float(x[front].min()) if front.any() else math.inf
         beside = captured & (x <= cfg.side_lookahead_m) & (x >= -cfg.side_window_behind_m)
-        left = self._side_wall(x, y, beside & (y > 0.0))
-        right = self._side_wall(x, -y, beside & (y < 0.0))
-        right = SideWall(right.distance_m, -right.angle_rad, right.abeam)
+        left = right = SideWall()
+        if 1 in sides:
+            left = self._side_wall(x, y, beside & (y > 0.0))
+        if -1 in sides:
+            right = self._side_wall(x, -y, beside & (y < 0.0))
+            right = SideWall(right.distance_m, -right.angle_rad, right.abeam)
         return ScanFeatures(
             front_wall_m=front_wall,
             front_robot_m=front_robot,

@@ -213,3 +213,14 @@ def test_a_perpendicular_wall_behind_is_not_part_of_the_wall_beside(extractor) -
     wall = extractor.extract(scan_of(ranges)).left
     assert wall.distance_m == pytest.approx(0.25, abs=0.01)
     assert wall.angle_rad == pytest.approx(0.0, abs=math.radians(2.0))
+
+
+def test_only_the_requested_side_walls_are_fitted(extractor) -> None:
+    scan = scan_of(box_ranges(5.0, 0.3, 5.0, 0.4))
+    left_only = extractor.extract(scan, sides=(1,))
+    assert left_only.left.distance_m == pytest.approx(0.3, abs=1e-3)
+    assert not left_only.right.found
+    neither = extractor.extract(scan, sides=())
+    assert not neither.left.found
+    assert not neither.right.found
+    assert neither.front_wall_m == math.inf
