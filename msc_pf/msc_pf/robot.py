@@ -401,13 +401,19 @@ class RobotController:
             self._committed = choice
             events.append(f'target {captured} captured: re-targets {choice} from its estimate')
 
-    def _abandon(self, target: int) -> None:
-        """Forget ``target``'s filter and stop pursuing it (it is re-tracked if heard again)."""
+    def _abandon(self, target: int, *, heard: bool) -> None:
+        """Forget ``target``'s filter (it restarts from the next sample of the target).
+
+        When the target is not heard at all the robot also stops pursuing it.
+        """
         assert self._bank is not None
         self._bank.forget(target)
-        self._events.append(f'target {target} not heard at its estimate: estimate dropped')
         if self._committed == target:
             self._committed = NO_TARGET
+        if heard:
+            self._events.append(f'target {target} is weak at its estimate: filter restarted')
+            return
+        self._events.append(f'target {target} not heard at its estimate: estimate dropped')
         self.target_id = NO_TARGET
 
     def _update_work(self, now_s: float, own_target: int) -> None:
@@ -441,14 +447,16 @@ class RobotController:
         if scheme.uses_direct_approach and bank is not None and bank.is_converged(target):
             goal = bank.estimate(target).position_m
             near = float(np.hypot(*(goal - position))) < phases.task_area_m
-            if near and mean is None:
-                # Nothing heard at the estimate: the target was captured by robots out of
-                # range, or the estimate is far off. Drop it instead of hovering there.
-                self._abandon(target)
-                return Phase.SEARCH
             if not near:
                 self._goal = goal
                 return Phase.DIRECT_APPROACH
+            # At the estimate but the target is not louder than gamma2: the estimate is wrong
+            # (or the target was captured by robots out of range). A converged flag never
+            # clears by itself, so drop the filter instead of circling the wrong point; it
+            # restarts from the next sample of the target.
+            self._abandon(target, heard=mean is not None)
+            if mean is None:
+                return Phase.SEARCH
         if scheme.uses_far_formation and bank is not None and bank.is_tracked(target):
             far_below = phases.gamma1_dbm - (
                 0.0 if previous == Phase.FAR_LOCALISATION else hysteresis

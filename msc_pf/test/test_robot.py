@@ -144,3 +144,14 @@ def test_robot_drops_an_estimate_where_nothing_is_heard_and_searches_again():
     assert out.status.target_id == NO_TARGET
     assert not robot.filters.is_tracked(2)
     assert any('not heard at its estimate' in e for e in out.events)
+
+
+def test_robot_does_not_keep_a_converged_estimate_that_contradicts_what_it_hears():
+    # Standing on the converged estimate of target 2, the robot hears it at -89 dBm (the
+    # target is really ~120 m away): the estimate must not survive as "converged".
+    robot, _ = run_capture_scenario('proposed')
+    goal = robot.filters.estimate(2).position_m
+    out = robot.step(41.0, goal, {2: RADIO.mean_rssi_dbm(120.0)})
+    assert not robot.filters.is_converged(2)
+    assert out.status.phase is not Phase.DIRECT_APPROACH
+    assert any('re-initialised' in e or 'restarted' in e for e in out.events)
