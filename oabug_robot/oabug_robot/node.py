@@ -325,7 +325,7 @@ class OABugNode(Node):
         )
 
     def _update_features(self, now_s: float) -> None:
-        if self._scan_msg is None or self._scan_time_s == self._features_time_s:
+        if self._scan_msg is None:
             return
         scan_time, msg = self._scan_time_s, self._scan_msg
         self._scan_msg = None
@@ -347,14 +347,14 @@ class OABugNode(Node):
         if math.isfinite(self._yaw_rad):
             self._update_features(now_s)
         stale = self._stale_inputs(now_s)
-        if stale:
-            self._hold_stopped(now_s, stale)
+        features = self._features
+        if stale or features is None:
+            self._hold_stopped(now_s, stale or ['scan'])
             return
-        assert self._features is not None
         snapshot = SensorSnapshot(
             time_s=now_s,
             yaw_rad=self._yaw_rad,
-            scan=self._features,
+            scan=features,
             gas_raw=self._gas_raw,
             bearings=self._bearings,
         )
