@@ -38,7 +38,7 @@ from msc_pf.settings import ParticleFilterConfig, RadioConfig  # noqa: E402
 from sim_bridge.msc_pf_batch import BatchScenario, run_batch  # noqa: E402
 
 SCHEMES = ('proposed', 'msc_pf', 'msc')
-CSV_HEADER = 'scheme,targets,robots,seed,cct_s,finished,wall_s\n'
+CSV_HEADER = 'scheme,targets,robots,seed,cct_s,finished,wall_s,mean_capture_s\n'
 EXPERIMENTS = ('main', 'robots', 'pf')
 
 
@@ -53,6 +53,7 @@ class RunOutcome:
     cct_s: float
     finished: bool
     wall_time_s: float
+    mean_capture_s: float = math.nan
 
 
 def _run_one(job: tuple[str, int, int, int, float]) -> RunOutcome:
@@ -68,7 +69,11 @@ def _run_one(job: tuple[str, int, int, int, float]) -> RunOutcome:
     )
     finished = not math.isnan(result.cct_s)
     cct = result.cct_s if finished else max_time_s
-    return RunOutcome(scheme, n_targets, n_robots, seed, cct, finished, result.wall_time_s)
+    times = np.where(np.isnan(result.capture_times_s), max_time_s, result.capture_times_s)
+    mean_capture = float(times.mean()) if times.size else math.nan
+    return RunOutcome(
+        scheme, n_targets, n_robots, seed, cct, finished, result.wall_time_s, mean_capture
+    )
 
 
 def _log(outcome: RunOutcome, csv_path: Path | None) -> RunOutcome:
@@ -90,7 +95,7 @@ def _log(outcome: RunOutcome, csv_path: Path | None) -> RunOutcome:
 def _csv_row(o: RunOutcome) -> str:
     return (
         f'{o.scheme},{o.n_targets},{o.n_robots},{o.seed},{o.cct_s:.0f},{o.finished:d},'
-        f'{o.wall_time_s:.1f}\n'
+        f'{o.wall_time_s:.1f},{o.mean_capture_s:.0f}\n'
     )
 
 
@@ -182,6 +187,27 @@ def main_table(outcomes: list[RunOutcome], robots: int, schemes: tuple[str, ...]
             + f' | {ratio("proposed", "msc_pf")} | {" ".join(unfinished)}'
             + f' | {" ".join(walls)} |'
         )
+    lines += [
+        '',
+        '### Mean per-target capture time [s] (uncaptured targets count as T_max)',
+        '',
+        '| targets | ' + ' | '.join(schemes) + ' |',
+        '|---' * (len(schemes) + 1) + '|',
+    ]
+    for n in sorted({o.n_targets for o in rows}):
+        cells = []
+        for scheme in schemes:
+            values = [
+                o.mean_capture_s
+                for o in rows
+                if o.n_targets == n and o.scheme == scheme and not math.isnan(o.mean_capture_s)
+            ]
+            cells.append(
+                f'{np.mean(values):.0f} +- {np.std(values):.0f} (n={len(values)})'
+                if values
+                else '-'
+            )
+        lines.append(f'| {n} | ' + ' | '.join(cells) + ' |')
     return [*lines, '']
 
 
