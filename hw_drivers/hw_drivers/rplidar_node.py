@@ -54,7 +54,7 @@ PARAMETERS: list[ParamSpec] = [
     ('bins', 360, 'LaserScan bins over [-pi, pi)'),
     ('angle_direction', -1, 'ROS angle = offset + direction * device angle; -1: device is CW'),
     ('zero_offset_rad', math.pi, 'ROS angle of the device 0 deg mark [rad]; pi = Slamtec mapping'),
-    ('range_min_m', 0.15, 'shortest valid range [m]; shorter readings become NaN'),
+    ('range_min_m', 0.15, 'shortest valid range [m]; shorter readings become -inf (REP 117)'),
     ('range_max_m', 12.0, 'longest valid range [m]; longer readings become +inf'),
     ('stall_timeout_s', 1.0, 'no revolution for this long restarts the motor and scan [s]'),
     ('stale_timeout_s', 1.0, 'no scan published for this long is reported stale [s]'),

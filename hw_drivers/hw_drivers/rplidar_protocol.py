@@ -402,7 +402,7 @@ class ScanBinning:
         bins: number of bins over [-pi, pi).
         angle_direction: +1 or -1 (the device measures clockwise).
         zero_offset_rad: ROS angle of the device's 0° mark [rad].
-        range_min_m: shortest valid range [m]; shorter readings become NaN.
+        range_min_m: shortest valid range [m]; shorter readings become -inf (REP 117).
         range_max_m: longest valid range [m]; longer readings become +inf.
     """
 
@@ -442,7 +442,7 @@ def bin_revolution(
 
     Each sample goes to its nearest bin; when several fall into one bin the shortest finite
     range wins. Per REP 117: no return (distance 0 or beyond range_max) is +inf, a reading
-    shorter than range_min is NaN, and a bin that got no sample at all is NaN.
+    shorter than range_min is -inf, and a bin that got no sample at all is NaN.
 
     Returns:
         ranges [m] and intensities (quality 0..63), both float32 of shape (bins,).
@@ -454,7 +454,7 @@ def bin_revolution(
     range_m = np.where(
         (revolution.distance_mm <= 0.0) | (range_m > binning.range_max_m), np.inf, range_m
     )
-    range_m = np.where(range_m < binning.range_min_m, np.nan, range_m)
+    range_m = np.where(range_m < binning.range_min_m, -np.inf, range_m)
     order = np.lexsort((range_m, index))
     sorted_index = index[order]
     first = np.flatnonzero(np.r_[True, sorted_index[1:] != sorted_index[:-1]])

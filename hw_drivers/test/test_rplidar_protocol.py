@@ -217,7 +217,7 @@ def test_invalid_samples_follow_rep_117():
     ranges, _ = bin_revolution(revolution, binning)
     assert math.isinf(ranges[4])
     assert ranges[4] > 0
-    assert math.isnan(ranges[5])  # closer than range_min
+    assert ranges[5] == -math.inf  # closer than range_min
     assert math.isinf(ranges[6])  # beyond range_max
     assert math.isnan(ranges[0])  # no sample at all
 

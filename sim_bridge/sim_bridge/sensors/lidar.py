@@ -2,8 +2,8 @@
 
 Figures from the A1 datasheet and HARDWARE.md §2.7: range 0.15-12 m, angular resolution about
 1 degree, 5.5 Hz rotation in standard mode, distance resolution better than 1 % of the range.
-Readings outside [range_min_m, range_max_m] and dropped samples are ``inf``, as the driver
-publishes invalid samples (REP 117 allows inf for "no return").
+Following REP 117 as the RPLidar driver does: no return within range_max_m and dropped
+samples are ``+inf``, returns closer than range_min_m are ``-inf``.
 """
 
 from __future__ import annotations
@@ -25,7 +25,7 @@ class LidarConfig:
 
     Attributes:
         num_bins: samples per revolution (360 = one per degree).
-        range_min_m: shortest measurable range [m]; closer returns read ``inf``.
+        range_min_m: shortest measurable range [m]; closer returns read ``-inf``.
         range_max_m: longest measurable range [m]; no return beyond reads ``inf``.
         rate_hz: revolutions per second (A1 standard mode: 5.5 Hz).
         range_noise_fraction: standard deviation of the range noise as a fraction of the range.
@@ -91,5 +91,6 @@ class LidarModel:
         noisy[finite] += self._rng.normal(0.0, 1.0, int(finite.sum())) * noise_std[finite]
         if cfg.dropout_probability > 0.0:
             noisy[self._rng.random(noisy.shape) < cfg.dropout_probability] = np.inf
-        noisy[(noisy < cfg.range_min_m) | (noisy > cfg.range_max_m)] = np.inf
+        noisy[noisy > cfg.range_max_m] = np.inf
+        noisy[noisy < cfg.range_min_m] = -np.inf
         return noisy
