@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy.linalg import LinAlgError, cho_solve, cholesky, solve_triangular
-from scipy.linalg.lapack import dpotri, dtrtri
+from scipy.linalg.lapack import dpotrf, dpotri, dpotrs, dtrtri
 from scipy.optimize import minimize
 from scipy.spatial.distance import cdist
 
@@ -49,7 +49,13 @@ def se_kernel(a: np.ndarray, b: np.ndarray, hyper: Hyperparameters) -> np.ndarra
 
     Returns an (n, m) array.
     """
-    return hyper.signal_variance * np.exp(-0.5 * _squared_distances(a, b) / hyper.length_scale_m**2)
+    # In place, in the order of s2 * exp(-0.5 * d2 / l^2): same values without four temporaries.
+    k = _squared_distances(a, b)
+    np.multiply(k, -0.5, out=k)
+    np.divide(k, hyper.length_scale_m**2, out=k)
+    np.exp(k, out=k)
+    np.multiply(k, hyper.signal_variance, out=k)
+    return k
 
 
 def _squared_distances(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -335,22 +341,27 @@ def _inverse_factor(chol: np.ndarray) -> np.ndarray:
 def _negative_log_likelihood(
     log_params: np.ndarray, sq: np.ndarray, y: np.ndarray, noise_variance: float
 ) -> tuple[float, np.ndarray]:
-    """Negative log marginal likelihood and its gradient w.r.t. (log s2, log l)."""
+    """Negative log marginal likelihood and its gradient w.r.t. (log s2, log l).
+
+    ``sq`` is the (n, n) matrix of squared distances [m^2]. LAPACK is called directly
+    (potrf/potrs/potri, as scipy's wrappers do) because at n <= 100 the wrappers' argument
+    checks cost more than the factorisation.
+    """
     s2 = math.exp(log_params[0])
     ell2 = math.exp(2.0 * log_params[1])
     r = np.exp(-0.5 * sq / ell2)
     k = s2 * r
-    k[np.diag_indices_from(k)] += noise_variance
-    try:
-        chol = cholesky(k, lower=True, check_finite=False)
-    except LinAlgError:
-        k[np.diag_indices_from(k)] += 1e-8 * s2
-        try:
-            chol = cholesky(k, lower=True, check_finite=False)
-        except LinAlgError:
-            return 1e25, np.zeros(2)
-    alpha = cho_solve((chol, True), y, check_finite=False)
     n = y.shape[0]
+    k.flat[:: n + 1] += noise_variance
+    chol, info = dpotrf(k, lower=1, clean=1)
+    if info != 0:
+        k.flat[:: n + 1] += 1e-8 * s2
+        chol, info = dpotrf(k, lower=1, clean=1)
+        if info != 0:
+            return 1e25, np.zeros(2)
+    alpha, info = dpotrs(chol, y, lower=1)
+    if info != 0:
+        return 1e25, np.zeros(2)
     nll = (
         0.5 * float(y @ alpha)
         + float(np.log(np.diag(chol)).sum())
@@ -359,7 +370,10 @@ def _negative_log_likelihood(
     k_inv, info = dpotri(chol, lower=1)
     if info != 0:
         return 1e25, np.zeros(2)
-    k_inv = np.tril(k_inv) + np.tril(k_inv, -1).T
+    # potri fills the lower triangle and leaves the (clean, zero) upper one alone: adding the
+    # transpose and halving the doubled diagonal gives the full symmetric inverse exactly.
+    k_inv += k_inv.T
+    k_inv.flat[:: n + 1] *= 0.5
     inner = np.outer(alpha, alpha) - k_inv
     dk_ds = s2 * r
     dk_dl = dk_ds * (sq / ell2)
