@@ -20,7 +20,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.linalg import LinAlgError, cho_solve, cholesky, solve_triangular
+from scipy.linalg import LinAlgError, cholesky, solve_triangular
 from scipy.linalg.lapack import dpotrf, dpotri, dpotrs, dtrtri
 from scipy.optimize import minimize
 from scipy.spatial.distance import cdist
@@ -168,7 +168,7 @@ class GaussianProcess:
             self._fitted_hyper = self._hyper
             self._n_at_last_fit = x.shape[0]
             self._chol, self._jitter = self._factor(x, self._hyper)
-        self._weights = cho_solve((self._chol, True), y, check_finite=False)
+        self._weights, _ = dpotrs(self._chol, y, lower=1)
         self._chol_inv = None
 
     def _factor(self, x: np.ndarray, hyper: Hyperparameters) -> tuple[np.ndarray, float]:
@@ -178,7 +178,7 @@ class GaussianProcess:
         jitter = 0.0
         while True:
             k_eps = k.copy()
-            k_eps[np.diag_indices_from(k_eps)] += base + jitter
+            k_eps.flat[:: k.shape[0] + 1] += base + jitter
             try:
                 return cholesky(k_eps, lower=True, check_finite=False), jitter
             except LinAlgError:
@@ -293,13 +293,13 @@ class ExtendedVariance:
         k_xe = se_kernel(x, extra_m, hyper)
         b = solve_triangular(chol, k_xe, lower=True, check_finite=False)
         schur = se_kernel(extra_m, extra_m, hyper) - b.T @ b
-        schur[np.diag_indices_from(schur)] += noise
+        schur.flat[:: schur.shape[0] + 1] += noise
         jitter = 0.0
         while True:
             try:
-                c = cholesky(
-                    schur + jitter * np.eye(schur.shape[0]), lower=True, check_finite=False
-                )
+                shifted = schur.copy()
+                shifted.flat[:: schur.shape[0] + 1] += jitter
+                c = cholesky(shifted, lower=True, check_finite=False)
                 break
             except LinAlgError:
                 jitter = max(10.0 * jitter, 1e-10 * hyper.signal_variance)

@@ -44,6 +44,8 @@ __all__ = ['BayesSwarmPlanner', 'ascend_mean', 'first_waypoint']
 _MEAN_GRID_SIZE = 16
 _MAX_RAY_STEPS = 25
 _REFINE_LEVELS = 2
+# (radius, heading) multiples of the pattern search's 3 x 3 stencil, centre excluded.
+_POLAR_STENCIL = np.array([(a, b) for a in (-1, 0, 1) for b in (-1, 0, 1) if a or b], float)
 
 
 def first_waypoint(
@@ -400,33 +402,53 @@ def ascend_mean(
     gradient steps elsewhere, each step limited by a per-seed trust radius (initially half a
     length scale) and projected into the arena; a step is kept only if the mean rises.
     Returns the (2,) best point found.
+
+    The GP derivatives of all seeds come from one vectorised call per iteration; the 2 x 2
+    step algebra of the few seeds is plain float arithmetic, which costs less than a dozen
+    numpy calls on arrays of length s.
     """
     x = arena.clip(np.asarray(seeds_m, dtype=float).reshape(-1, 2))
     ell = gp.hyperparameters.length_scale_m
-    radius = np.full(x.shape[0], 0.5 * ell)
+    n_seeds = x.shape[0]
+    radius = [0.5 * ell] * n_seeds
     mean, grad, hess = gp.mean_derivatives(x)
     tolerance = 1e-7 * max(ell, 1e-9)
+    (x_min, x_max), (y_min, y_max) = (arena.x_min_m, arena.x_max_m), (arena.y_min_m, arena.y_max_m)
+    candidate = np.empty_like(x)
     for _ in range(max_iterations):
-        step = grad * (ell * ell / np.maximum(np.abs(mean), 1e-12))[:, None]
-        h00, h01, h11 = hess[:, 0, 0], hess[:, 0, 1], hess[:, 1, 1]
-        det = h00 * h11 - h01 * h01
-        concave = (h00 < 0.0) & (det > 0.0)
-        safe_det = np.where(concave, det, 1.0)
-        newton_x = -(h11 * grad[:, 0] - h01 * grad[:, 1]) / safe_det
-        newton_y = -(h00 * grad[:, 1] - h01 * grad[:, 0]) / safe_det
-        step = np.where(concave[:, None], np.column_stack([newton_x, newton_y]), step)
-        norm = np.hypot(step[:, 0], step[:, 1])
-        scale = np.minimum(1.0, radius / np.maximum(norm, 1e-300))
-        candidate = arena.clip(x + step * scale[:, None])
-        moved = np.hypot(*(candidate - x).T)
-        if np.all(moved < tolerance):
+        converged = True
+        for i in range(n_seeds):
+            step_x, step_y = _ascent_step(float(mean[i]), grad[i], hess[i], ell)
+            norm = float(np.hypot(step_x, step_y))
+            scale = min(1.0, radius[i] / max(norm, 1e-300))
+            cx = min(max(x[i, 0] + step_x * scale, x_min), x_max)
+            cy = min(max(x[i, 1] + step_y * scale, y_min), y_max)
+            candidate[i, 0], candidate[i, 1] = cx, cy
+            if np.hypot(cx - x[i, 0], cy - x[i, 1]) >= tolerance:
+                converged = False
+        if converged:
             break
         c_mean, c_grad, c_hess = gp.mean_derivatives(candidate)
-        better = c_mean > mean
-        x[better], mean[better] = candidate[better], c_mean[better]
-        grad[better], hess[better] = c_grad[better], c_hess[better]
-        radius = np.where(better, np.minimum(2.0 * radius, 2.0 * ell), 0.25 * radius)
+        for i in range(n_seeds):
+            if c_mean[i] > mean[i]:
+                x[i], mean[i], grad[i], hess[i] = candidate[i], c_mean[i], c_grad[i], c_hess[i]
+                radius[i] = min(2.0 * radius[i], 2.0 * ell)
+            else:
+                radius[i] = 0.25 * radius[i]
     return x[int(np.argmax(mean))].copy()
+
+
+def _ascent_step(
+    mean: float, grad: np.ndarray, hess: np.ndarray, ell: float
+) -> tuple[float, float]:
+    """Newton step where the (2, 2) Hessian is negative definite, else a scaled gradient step."""
+    g0, g1 = float(grad[0]), float(grad[1])
+    h00, h01, h11 = float(hess[0, 0]), float(hess[0, 1]), float(hess[1, 1])
+    det = h00 * h11 - h01 * h01
+    if h00 < 0.0 and det > 0.0:
+        return -(h11 * g0 - h01 * g1) / det, -(h00 * g1 - h01 * g0) / det
+    gain = ell * ell / max(abs(mean), 1e-12)
+    return g0 * gain, g1 * gain
 
 
 class _OuterProblem:
@@ -555,17 +577,22 @@ class _OuterProblem:
         offset = x0 - self.position
         radius = float(np.hypot(*offset))
         heading = math.atan2(offset[1], offset[0])
-        best_value = float(self.values(x0)[0])
+        best_value = -math.inf
         best = x0
         d_r = 0.5 * self.ray_step_m
         d_theta = math.pi / cfg.n_candidate_headings
-        stencil = np.array([(a, b) for a in (-1, 0, 1) for b in (-1, 0, 1) if a or b], float)
-        for _ in range(_REFINE_LEVELS):
+        stencil = _POLAR_STENCIL
+        for level in range(_REFINE_LEVELS):
             radii = np.clip(radius + d_r * stencil[:, 0], 0.0, cfg.max_leg_m)
             headings = heading + d_theta * stencil[:, 1]
             pts = self.position + radii[:, None] * np.c_[np.cos(headings), np.sin(headings)]
             pts = cfg.arena.clip(pts)
-            vals = self.values(pts)
+            if level == 0:
+                # The start point's value comes with the first stencil, in the same call.
+                vals = self.values(np.vstack([x0, pts]))
+                best_value, vals = float(vals[0]), vals[1:]
+            else:
+                vals = self.values(pts)
             i = int(np.argmax(vals))
             if vals[i] > best_value:
                 best_value, best = float(vals[i]), pts[i]
