@@ -101,6 +101,11 @@ class BayesSwarmPlanner:
         self._fan_index = config.robot_index + 1 if fan_index is None else fan_index
         self._fan_size = config.n_robots if fan_size is None else fan_size
         self._direction_offset_deg = direction_offset_deg
+        arena = config.arena
+        gx = np.linspace(arena.x_min_m, arena.x_max_m, _MEAN_GRID_SIZE)
+        gy = np.linspace(arena.y_min_m, arena.y_max_m, _MEAN_GRID_SIZE)
+        # Fixed start candidates of Eq. 5: a (g * g, 2) grid over the arena [m].
+        self._mean_grid = np.stack(np.meshgrid(gx, gy), axis=-1).reshape(-1, 2)
 
     # ----------------------------------------------------------------- inputs
     @property
@@ -354,13 +359,10 @@ class BayesSwarmPlanner:
         )
 
     def _expected_source(self) -> np.ndarray:
-        """Eq. 5: argmax of the GP mean in the arena (multi-start L-BFGS-B)."""
+        """Eq. 5: argmax of the GP mean in the arena, from several starts (``inner_optimizer``)."""
         cfg = self._cfg
         arena = cfg.arena
-        gx = np.linspace(arena.x_min_m, arena.x_max_m, _MEAN_GRID_SIZE)
-        gy = np.linspace(arena.y_min_m, arena.y_max_m, _MEAN_GRID_SIZE)
-        grid = np.stack(np.meshgrid(gx, gy), axis=-1).reshape(-1, 2)
-        candidates = np.vstack([grid, self._gp.training_inputs])
+        candidates = np.vstack([self._mean_grid, self._gp.training_inputs])
         means = self._gp.predict_mean(candidates)
         order = np.argsort(-means)
         seeds = [candidates[order[0]]]
@@ -477,6 +479,8 @@ class _OuterProblem:
         self.max_signal = max_signal
         self.n_steps = max(1, min(_MAX_RAY_STEPS, math.ceil(cfg.max_leg_m / cfg.step_m)))
         self.ray_step_m = cfg.max_leg_m / self.n_steps
+        # Path parameter u in [0, 1] (n_steps + 1,) of the paths sampled by values().
+        self.path_u = np.linspace(0.0, 1.0, self.n_steps + 1)
 
     def gamma(self, points: np.ndarray) -> np.ndarray:
         return local_penalty(
@@ -492,7 +496,7 @@ class _OuterProblem:
     def values(self, points: np.ndarray) -> np.ndarray:
         """Acquisition (q,) at arbitrary (q, 2) reachable points (paths sampled uniformly)."""
         pts = np.asarray(points, dtype=float).reshape(-1, 2)
-        u = np.linspace(0.0, 1.0, self.n_steps + 1)
+        u = self.path_u
         base = np.zeros(2) if self.cfg.authors_origin_paths else self.position
         offsets = pts - self.position
         samples = base + u[None, :, None] * offsets[:, None, :]
