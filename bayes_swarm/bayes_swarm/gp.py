@@ -352,8 +352,8 @@ def _negative_log_likelihood(
     """
     s2 = math.exp(log_params[0])
     ell2 = math.exp(2.0 * log_params[1])
-    r = np.exp(-0.5 * sq / ell2)
-    k = s2 * r
+    dk_ds = s2 * np.exp(-0.5 * sq / ell2)  # dK / d log s2 = K without the noise
+    k = dk_ds.copy()
     n = y.shape[0]
     k.flat[:: n + 1] += noise_variance
     chol, info = dpotrf(k, lower=1, clean=1)
@@ -370,15 +370,19 @@ def _negative_log_likelihood(
         + float(np.log(np.diag(chol)).sum())
         + 0.5 * n * math.log(2 * math.pi)
     )
-    k_inv, info = dpotri(chol, lower=1)
+    k_inv, info = dpotri(chol, lower=1, overwrite_c=1)
     if info != 0:
         return 1e25, np.zeros(2)
     # potri fills the lower triangle and leaves the (clean, zero) upper one alone: adding the
     # transpose and halving the doubled diagonal gives the full symmetric inverse exactly.
     k_inv += k_inv.T
     k_inv.flat[:: n + 1] *= 0.5
-    inner = np.outer(alpha, alpha) - k_inv
-    dk_ds = s2 * r
-    dk_dl = dk_ds * (sq / ell2)
-    grad = -0.5 * np.array([np.sum(inner * dk_ds), np.sum(inner * dk_dl)])
+    inner = np.outer(alpha, alpha)
+    inner -= k_inv
+    # The products below are formed in place: dK / d log l = dK / d log s2 * sq / l^2.
+    weighted_dl = sq / ell2
+    weighted_dl *= dk_ds
+    weighted_dl *= inner
+    dk_ds *= inner
+    grad = -0.5 * np.array([dk_ds.sum(), weighted_dl.sum()])
     return nll, grad
