@@ -426,7 +426,7 @@ def ascend_mean(
             cx = min(max(x[i, 0] + step_x * scale, x_min), x_max)
             cy = min(max(x[i, 1] + step_y * scale, y_min), y_max)
             candidate[i, 0], candidate[i, 1] = cx, cy
-            if np.hypot(cx - x[i, 0], cy - x[i, 1]) >= tolerance:
+            if not np.hypot(cx - x[i, 0], cy - x[i, 1]) < tolerance:  # NaN: not converged
                 converged = False
         if converged:
             break

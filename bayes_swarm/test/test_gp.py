@@ -12,6 +12,7 @@ from bayes_swarm.gp import (
 )
 from bayes_swarm.settings import GpConfig
 from scipy.optimize import approx_fprime
+from scipy.stats import multivariate_normal
 
 HYPER = Hyperparameters(signal_variance=0.7, length_scale_m=0.4)
 NOISE_STD = 0.05
@@ -78,6 +79,30 @@ def test_likelihood_gradient_matches_finite_differences(data):
     _, grad = _negative_log_likelihood(theta, sq, y, 1e-3)
     numeric = approx_fprime(theta, lambda t: _negative_log_likelihood(t, sq, y, 1e-3)[0], 1e-7)
     np.testing.assert_allclose(grad, numeric, rtol=1e-4, atol=1e-5)
+
+
+def test_likelihood_value_is_the_negative_gaussian_log_density_of_the_data(data):
+    x, y, _ = data
+    s2, ell, noise_var = 0.8, 0.6, 1e-3
+    d2 = ((x[:, None, :] - x[None, :, :]) ** 2).sum(-1)
+    cov = s2 * np.exp(-0.5 * d2 / ell**2) + noise_var * np.eye(len(x))
+    expected = multivariate_normal(mean=np.zeros(len(x)), cov=cov).logpdf(y)
+    nll, _ = _negative_log_likelihood(np.log([s2, ell]), _squared_distances(x, x), y, noise_var)
+    assert nll == pytest.approx(-expected, rel=1e-9)
+
+
+def test_mean_derivatives_agree_with_the_mean_its_gradient_and_finite_differences(data):
+    x, y, q = data
+    gp = GaussianProcess(GpConfig(noise_std=NOISE_STD))
+    gp.fit(x, y, hyperparameters=HYPER)
+    mean, grad, hess = gp.mean_derivatives(q)
+    np.testing.assert_allclose(mean, gp.predict_mean(q), rtol=1e-12, atol=1e-12)
+    for point, g, h in zip(q, grad, hess, strict=True):
+        np.testing.assert_allclose(g, gp.mean_and_gradient(point)[1], rtol=1e-12, atol=1e-12)
+        for axis in range(2):
+            numeric = approx_fprime(point, lambda p, a=axis: gp.mean_and_gradient(p)[1][a], 1e-7)
+            np.testing.assert_allclose(h[axis], numeric, rtol=1e-4, atol=1e-5)
+        assert h[0, 1] == pytest.approx(h[1, 0], rel=1e-12)
 
 
 def test_fit_recovers_the_length_scale_of_a_smooth_field():
