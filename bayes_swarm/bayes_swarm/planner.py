@@ -589,7 +589,9 @@ class _OuterProblem:
         for level in range(_REFINE_LEVELS):
             radii = np.clip(radius + d_r * stencil[:, 0], 0.0, cfg.max_leg_m)
             headings = heading + d_theta * stencil[:, 1]
-            pts = self.position + radii[:, None] * np.c_[np.cos(headings), np.sin(headings)]
+            pts = self.position + radii[:, None] * np.column_stack(
+                [np.cos(headings), np.sin(headings)]
+            )
             pts = cfg.arena.clip(pts)
             if level == 0:
                 # The start point's value comes with the first stencil, in the same call.
