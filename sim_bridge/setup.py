@@ -33,6 +33,10 @@ setup(
         'PyYAML',
         'swarm_runtime',
         'swarm_analysis',
+        # The spawners start these algorithm nodes.
+        'oabug_robot',
+        'bayes_swarm',
+        'msc_pf',
     ],
     zip_safe=True,
     maintainer='Swarm search maintainers',
