@@ -129,7 +129,7 @@ def test_binning_yields_valid_ranges_or_rep117_markers(samples, bins, direction,
     finite = ranges[np.isfinite(ranges)]
     assert np.all((finite >= binning.range_min_m - 1e-6) & (finite <= binning.range_max_m + 1e-3))
     # -inf (REP 117: closer than range_min) only where such a sample exists.
-    too_close = [d for _, d in samples if 0.0 < d / 1000.0 < binning.range_min_m]
+    too_close = [d for _, d in samples if d > 0.0 and d / 1000.0 < binning.range_min_m]
     assert np.count_nonzero(np.isneginf(ranges)) <= len(too_close)
     assert np.count_nonzero(~np.isnan(ranges)) <= len(samples)
 
