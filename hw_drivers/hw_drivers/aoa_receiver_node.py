@@ -18,11 +18,9 @@ from collections.abc import Callable
 from typing import Any
 
 from swarm_runtime.ros import (
-    ExternalShutdownException,
     Node,
     message_module,
     qos_profile_sensor_data,
-    rclpy,
 )
 
 from hw_drivers.aoa_bearings import BearingCollector
@@ -38,6 +36,7 @@ from hw_drivers.node_common import (
     ParamSpec,
     declare_parameter_table,
     publish_diagnostics,
+    run_driver_node,
     seconds_clock,
 )
 from hw_drivers.worker import DeviceWorker, DiagnosticLevel
@@ -188,20 +187,7 @@ def _is_loopback(host: str) -> bool:
 
 def main(args: list[str] | None = None) -> None:
     """Entry point of ``ros2 run hw_drivers aoa_receiver_node``."""
-    rclpy.init(args=args)
-    node = None
-    try:
-        node = AoaReceiverNode()
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    except ConfigurationError as err:
-        rclpy.logging.get_logger('aoa_receiver_node').fatal(f'invalid parameters: {err}')
-        raise SystemExit(2) from err
-    finally:
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
+    run_driver_node(AoaReceiverNode, 'aoa_receiver_node', args)
 
 
 if __name__ == '__main__':

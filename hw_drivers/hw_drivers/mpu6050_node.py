@@ -20,11 +20,9 @@ from collections.abc import Callable
 from typing import Any
 
 from swarm_runtime.ros import (
-    ExternalShutdownException,
     Node,
     message_module,
     qos_profile_sensor_data,
-    rclpy,
 )
 
 from hw_drivers.backoff import BackoffConfig
@@ -42,6 +40,7 @@ from hw_drivers.node_common import (
     ParamSpec,
     declare_parameter_table,
     publish_diagnostics,
+    run_driver_node,
     seconds_clock,
 )
 from hw_drivers.worker import DeviceWorker
@@ -215,20 +214,7 @@ def _no_sleep(_duration_s: float) -> None:
 
 def main(args: list[str] | None = None) -> None:
     """Entry point of ``ros2 run hw_drivers mpu6050_node``."""
-    rclpy.init(args=args)
-    node = None
-    try:
-        node = Mpu6050Node()
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    except ConfigurationError as err:
-        rclpy.logging.get_logger('mpu6050_node').fatal(f'invalid parameters: {err}')
-        raise SystemExit(2) from err
-    finally:
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
+    run_driver_node(Mpu6050Node, 'mpu6050_node', args)
 
 
 if __name__ == '__main__':

@@ -14,9 +14,10 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
-from swarm_runtime.ros import message_module
+from swarm_runtime.ros import ExternalShutdownException, message_module, rclpy
 
 from hw_drivers.conversions import DiagnosticEntry, diagnostics_to_ros
+from hw_drivers.errors import ConfigurationError
 from hw_drivers.worker import DeviceWorker, DiagnosticLevel
 
 __all__ = [
@@ -26,6 +27,7 @@ __all__ = [
     'ParamSpec',
     'declare_parameter_table',
     'publish_diagnostics',
+    'run_driver_node',
     'seconds_clock',
 ]
 
@@ -160,3 +162,25 @@ def publish_diagnostics(publisher: Any, entries: Sequence[DiagnosticEntry], now_
 def seconds_clock(node: Any) -> Callable[[], float]:
     """The node clock in seconds, as a device clock for fakes polled from timers."""
     return lambda: node.get_clock().now().nanoseconds * 1e-9
+
+
+def run_driver_node(node_factory: Callable[[], Any], name: str, args: list[str] | None) -> None:
+    """The body of a sensor driver's ``main()``: init, spin until shutdown, clean up.
+
+    Invalid parameters end the process with exit code 2 and a fatal log line naming them;
+    Ctrl-C and an external shutdown end it normally. The node is destroyed in every case.
+    """
+    rclpy.init(args=args)
+    node = None
+    try:
+        node = node_factory()
+        rclpy.spin(node)
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    except ConfigurationError as err:
+        rclpy.logging.get_logger(name).fatal(f'invalid parameters: {err}')
+        raise SystemExit(2) from err
+    finally:
+        if node is not None:
+            node.destroy_node()
+        rclpy.try_shutdown()
