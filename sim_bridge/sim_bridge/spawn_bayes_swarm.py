@@ -26,6 +26,7 @@ from typing import Any
 
 import numpy as np
 
+from sim_bridge.cli_args import points_argument
 from sim_bridge.engine import EngineConfig, SiteGeometry
 from sim_bridge.errors import SimBridgeError
 from sim_bridge.mission import MissionSpec, RecordingSpec, RobotNodeSpec, run_mission
@@ -357,25 +358,14 @@ def write_plots(result: BayesSwarmRun, out_dir: Path) -> list[Path]:
     return paths
 
 
-def _parse_depots(text: str) -> np.ndarray:
-    try:
-        pts = [[float(v) for v in item.split(',')] for item in text.split(';') if item.strip()]
-        arr = np.array(pts, dtype=float)
-    except ValueError as err:
-        msg = f"--depots must look like 'x,y;x,y', got {text!r}"
-        raise argparse.ArgumentTypeError(msg) from err
-    if arr.ndim != 2 or arr.shape[1] != 2:
-        msg = f"--depots must look like 'x,y;x,y', got {text!r}"
-        raise argparse.ArgumentTypeError(msg)
-    return arr
-
-
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     parser.add_argument('--algorithm', choices=ALGORITHMS, default='bayes_swarm_p')
     parser.add_argument('--case', choices=CASE_NAMES, default='case1')
     parser.add_argument('--robots', type=int, default=None, help='swarm size (paper default)')
-    parser.add_argument('--depots', type=_parse_depots, default=None, help="'x,y;x,y' [m]")
+    parser.add_argument(
+        '--depots', type=points_argument('--depots'), default=None, help="'x,y;x,y' [m]"
+    )
     parser.add_argument('--seed', type=int, default=0)
     parser.add_argument('--comm-range', type=float, default=math.inf, help='[m], default inf')
     parser.add_argument('--loss', type=float, default=0.0, help='peer message loss probability')

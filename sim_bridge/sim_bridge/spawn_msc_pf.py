@@ -27,6 +27,7 @@ from typing import Any
 
 import numpy as np
 
+from sim_bridge.cli_args import points_argument
 from sim_bridge.engine import EngineConfig, SiteGeometry
 from sim_bridge.errors import SimBridgeError
 from sim_bridge.mission import (
@@ -312,26 +313,18 @@ def write_plots(result: MscPfRun, out_dir: Path) -> list[Path]:
     return paths
 
 
-def _parse_targets(text: str) -> np.ndarray:
-    try:
-        pts = [[float(v) for v in item.split(',')] for item in text.split(';') if item.strip()]
-        arr = np.array(pts, dtype=float)
-    except ValueError as err:
-        msg = f"--target-positions must look like 'x,y;x,y', got {text!r}"
-        raise argparse.ArgumentTypeError(msg) from err
-    if arr.ndim != 2 or arr.shape[1] != 2:
-        msg = f"--target-positions must look like 'x,y;x,y', got {text!r}"
-        raise argparse.ArgumentTypeError(msg)
-    return arr
-
-
 def build_parser() -> argparse.ArgumentParser:
     """Command-line options of ``spawn_msc_pf``."""
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     parser.add_argument('--scheme', choices=SCHEMES, default='proposed')
     parser.add_argument('--robots', type=int, default=15)
     parser.add_argument('--targets', type=int, default=10)
-    parser.add_argument('--target-positions', type=_parse_targets, default=None, help="'x,y;x,y'")
+    parser.add_argument(
+        '--target-positions',
+        type=points_argument('--target-positions'),
+        default=None,
+        help="'x,y;x,y' [m]",
+    )
     parser.add_argument('--seed', type=int, default=0)
     parser.add_argument('--comm-range', type=float, default=150.0, help='[m]')
     parser.add_argument('--loss', type=float, default=0.0, help='peer message loss probability')
