@@ -43,6 +43,7 @@ from hw_drivers.node_common import (
     DevicePoller,
     ParamSpec,
     declare_parameter_table,
+    no_sleep,
     publish_diagnostics,
     run_driver_node,
     seconds_clock,
@@ -94,7 +95,7 @@ class GasNode(Node):
         self._device_clock: Callable[[], float] = (
             time.monotonic if self._threaded else seconds_clock(self)
         )
-        self._sleep: Callable[[float], None] = time.sleep if self._threaded else _no_sleep
+        self._sleep: Callable[[float], None] = time.sleep if self._threaded else no_sleep
         self._fake = bool(values['fake_device'])
         self._ads_config: AdsConfig | None = None
         if backend.startswith('ads'):
@@ -219,10 +220,6 @@ class GasNode(Node):
         """Stop the device loop and close the ADC before the node goes."""
         self._poller.stop()
         super().destroy_node()
-
-
-def _no_sleep(_duration_s: float) -> None:
-    """Fakes polled from a timer must not block the executor."""
 
 
 def main(args: list[str] | None = None) -> None:

@@ -39,6 +39,7 @@ from hw_drivers.node_common import (
     DevicePoller,
     ParamSpec,
     declare_parameter_table,
+    no_sleep,
     publish_diagnostics,
     run_driver_node,
     seconds_clock,
@@ -112,7 +113,7 @@ class Mpu6050Node(Node):
         self._device_clock: Callable[[], float] = (
             time.monotonic if self._threaded else seconds_clock(self)
         )
-        self._sleep: Callable[[float], None] = time.sleep if self._threaded else _no_sleep
+        self._sleep: Callable[[float], None] = time.sleep if self._threaded else no_sleep
         self._fake_chip = (
             FakeMpu6050(self._device_clock, noise_dps=0.02, seed=1)
             if values['fake_device']
@@ -206,10 +207,6 @@ class Mpu6050Node(Node):
         """Stop the device loop and close the bus before the node goes."""
         self._poller.stop()
         super().destroy_node()
-
-
-def _no_sleep(_duration_s: float) -> None:
-    """Fakes polled from a timer must not block the executor."""
 
 
 def main(args: list[str] | None = None) -> None:

@@ -26,6 +26,7 @@ __all__ = [
     'DevicePoller',
     'ParamSpec',
     'declare_parameter_table',
+    'no_sleep',
     'publish_diagnostics',
     'run_driver_node',
     'seconds_clock',
@@ -157,6 +158,10 @@ class DeviceMonitor:
 def publish_diagnostics(publisher: Any, entries: Sequence[DiagnosticEntry], now_ns: int) -> None:
     """Publish one DiagnosticArray."""
     publisher.publish(diagnostics_to_ros(entries, stamp_ns=now_ns))
+
+
+def no_sleep(_duration_s: float) -> None:
+    """A sleep that returns at once: fakes polled from a timer must not block the executor."""
 
 
 def seconds_clock(node: Any) -> Callable[[], float]:

@@ -32,6 +32,7 @@ from hw_drivers.node_common import (
     DevicePoller,
     ParamSpec,
     declare_parameter_table,
+    no_sleep,
     publish_diagnostics,
     run_driver_node,
     seconds_clock,
@@ -134,7 +135,7 @@ class RPLidarNode(Node):
                 return FakeRPLidarPort(fake, clock=self._device_clock)
 
             if not self._threaded:
-                sleep = _no_sleep
+                sleep = no_sleep
         self._session = connect_rplidar(
             self._device_config,
             self._revolutions.append,
@@ -189,10 +190,6 @@ class RPLidarNode(Node):
         """Stop the device loop (STOP, motor off, close) before the node goes."""
         self._poller.stop()
         super().destroy_node()
-
-
-def _no_sleep(_duration_s: float) -> None:
-    """Fakes polled from a timer must not block the executor."""
 
 
 def main(args: list[str] | None = None) -> None:
