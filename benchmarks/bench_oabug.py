@@ -1,10 +1,13 @@
 """OA-Bug benchmark: coverage of the five Table I variants on generated sites, and throughput.
 
-Runs every (site, variant, departure) combination through the full simulation (sim bridge +
-OA-Bug nodes on the built-in runtime), one run per worker process at a time, and prints the
-mean +- std coverage beside the authors' simulator measured on this project's machines
-(REFERENCE_OABUG_SIM.md §5), plus wall seconds per run and robot-metres simulated per wall
-second. Example (the Small sweep of the closing note, 20 sites, both cores)::
+Runs every (site, variant, departure) combination, one run per worker process at a time, and
+prints the mean +- std coverage beside the authors' simulator measured on this project's
+machines (REFERENCE_OABUG_SIM.md §5), plus CPU and wall seconds per run, robot-metres
+simulated per wall second and the projected time of the 1000-run Small sweep. ``--path
+batch`` (the default) runs each mission on the batch path (:mod:`sim_bridge.oabug_batch`:
+the same engine and OA-Bug controller without the runtime, equal trajectories); ``--path
+ros`` runs the full simulation (sim bridge + OA-Bug nodes on the built-in runtime). Example
+(the Small sweep of the closing note, 20 sites, both cores)::
 
     python benchmarks/bench_oabug.py --config small --sites 20 --workers 2 --out small.md
 """
@@ -23,6 +26,8 @@ from pathlib import Path
 
 VARIANTS = ('random', 'minimum', 'sound', 'gas', 'gas_sound')
 DEPARTURES = ('center', 'edge')
+PATHS = ('batch', 'ros')
+SWEEP_RUNS = 1000
 
 # Authors' simulator, 100 Small / 20 Medium sites, 10 robots: mean +- std coverage [%].
 REFERENCE = {
@@ -64,6 +69,7 @@ class Job:
     robots: int
     actions: int | None
     speed_mps: float
+    path: str = 'batch'
 
 
 @dataclass(frozen=True)
@@ -74,11 +80,13 @@ class Outcome:
     coverage: float
     sim_time_s: float
     wall_time_s: float
+    cpu_time_s: float
     robot_metres: float
 
 
 def run_job(job: Job) -> Outcome:
     """Run one job headless (called in a worker process)."""
+    from sim_bridge.oabug_batch import run_spawn_batch
     from sim_bridge.spawn import SpawnConfig, run
 
     config = SpawnConfig(
@@ -92,13 +100,16 @@ def run_job(job: Job) -> Outcome:
         speed_mps=job.speed_mps,
     )
     start = time.perf_counter()
-    result = run(config)
+    start_cpu = time.process_time()
+    result = run_spawn_batch(config) if job.path == 'batch' else run(config)
+    cpu = time.process_time() - start_cpu
     wall = time.perf_counter() - start
     return Outcome(
         job=job,
         coverage=result.coverage,
         sim_time_s=result.mission.sim_time_s,
         wall_time_s=wall,
+        cpu_time_s=cpu,
         robot_metres=float(result.mission.distance_travelled_m.sum()),
     )
 
@@ -117,8 +128,8 @@ def format_table(outcomes: Sequence[Outcome], config: str) -> str:
     reference = REFERENCE.get(config, {})
     lines = [
         "| departure | variant | runs | coverage % (this suite) | authors' simulator % "
-        '| full coverage runs | wall s/run | robot-m per wall s |',
-        '|---|---|---|---|---|---|---|---|',
+        '| full coverage runs | CPU s/run | wall s/run | robot-m per wall s |',
+        '|---|---|---|---|---|---|---|---|---|',
     ]
     for departure in DEPARTURES:
         for variant in VARIANTS:
@@ -130,12 +141,30 @@ def format_table(outcomes: Sequence[Outcome], config: str) -> str:
             ref_text = f'{ref[0]:.1f} +- {ref[1]:.1f}' if ref else 'n/a'
             full = sum(o.coverage >= 1.0 for o in runs)
             wall = sum(o.wall_time_s for o in runs) / len(runs)
+            cpu = sum(o.cpu_time_s for o in runs) / len(runs)
             metres = sum(o.robot_metres for o in runs) / sum(o.wall_time_s for o in runs)
             lines.append(
                 f'| {departure} | {variant} | {len(runs)} | {mean:.1f} +- {std:.1f} | {ref_text} '
-                f'| {full} | {wall:.1f} | {metres:.0f} |'
+                f'| {full} | {cpu:.1f} | {wall:.1f} | {metres:.0f} |'
             )
     return '\n'.join(lines)
+
+
+def format_footer(outcomes: Sequence[Outcome], total_s: float, args: argparse.Namespace) -> str:
+    """Throughput: CPU and wall time per run, robot-metres per wall second, sweep projection."""
+    n = len(outcomes)
+    cpu = sum(o.cpu_time_s for o in outcomes) / n
+    metres = sum(o.robot_metres for o in outcomes)
+    sim_s = sum(o.sim_time_s for o in outcomes)
+    workers = max(args.workers, 1)
+    return (
+        f'{n} runs ({args.config}, {args.robots} robots, {args.sites} sites, {args.path} path) '
+        f'in {total_s:.0f} s wall with {workers} workers: {cpu:.2f} CPU s per run, '
+        f'{total_s / n:.2f} wall s per run overall, {metres / total_s:.0f} robot-m and '
+        f'{sim_s / total_s:.1f} sim s per wall s. A {SWEEP_RUNS}-run sweep: '
+        f'{SWEEP_RUNS * total_s / n / 60:.0f} min at this wall rate, '
+        f'{SWEEP_RUNS * cpu / workers / 60:.0f} min from the CPU time on {workers} idle cores.'
+    )
 
 
 def run(
@@ -149,10 +178,11 @@ def run(
     actions: int | None = None,
     speed_mps: float = 0.3,
     workers: int = 2,
+    path: str = 'batch',
 ) -> tuple[list[Outcome], float]:
     """Run the sweep; return the outcomes and the total wall time [s]."""
     jobs = [
-        Job(config, seed, variant, departure, robots, actions, speed_mps)
+        Job(config, seed, variant, departure, robots, actions, speed_mps, path)
         for seed in range(first_site_seed, first_site_seed + sites)
         for departure in departures
         for variant in variants
@@ -189,6 +219,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument('--actions', type=int, default=None, help='default: Table II budget')
     parser.add_argument('--speed', type=float, default=0.3, help='robot speed [m/s]')
     parser.add_argument('--workers', type=int, default=2, help='worker processes')
+    parser.add_argument(
+        '--path',
+        choices=PATHS,
+        default='batch',
+        help='batch: engine + controllers without the runtime (sweeps); ros: the node path',
+    )
     parser.add_argument('--out', type=Path, default=None, help='also write the table here')
     args = parser.parse_args(argv)
     outcomes, total_s = run(
@@ -201,15 +237,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         actions=args.actions,
         speed_mps=args.speed,
         workers=args.workers,
+        path=args.path,
     )
     table = format_table(outcomes, args.config)
-    sim_s = sum(o.sim_time_s for o in outcomes)
-    footer = (
-        f'\n{len(outcomes)} runs ({args.config}, {args.robots} robots, {args.sites} sites) in '
-        f'{total_s:.0f} s wall with {args.workers} workers: {total_s / len(outcomes):.2f} s per '
-        f'run overall, {sim_s / total_s:.1f} sim s per wall s; a 1000-run sweep would take '
-        f'{1000 * total_s / len(outcomes) / 60:.0f} min.'
-    )
+    footer = '\n' + format_footer(outcomes, total_s, args)
     print(table + footer)
     if args.out is not None:
         args.out.write_text(table + '\n' + footer + '\n', encoding='utf-8')

@@ -37,7 +37,7 @@ from swarm_runtime.ros import (
 )
 
 from sim_bridge.bridge_node import SimBridgeNode
-from sim_bridge.engine import EngineConfig, StepOutput
+from sim_bridge.engine import EngineConfig, SimEngine, StepOutput
 from sim_bridge.errors import ConfigurationError, MissionError
 from sim_bridge.extensions import SimExtension
 from sim_bridge.ground_truth import RoomEntry
@@ -164,6 +164,17 @@ class MissionProgress:
     def coverage(self) -> float:
         """Covered fraction of the rooms."""
         return self.rooms_covered / self.rooms_total if self.rooms_total else 1.0
+
+    @classmethod
+    def of_engine(cls, engine: SimEngine, wall_start_s: float) -> MissionProgress:
+        """The progress of ``engine`` now, for a run that started at ``wall_start_s``
+        (a :func:`time.perf_counter` reading)."""
+        return cls(
+            sim_time_s=engine.time_s,
+            wall_time_s=time.perf_counter() - wall_start_s,
+            rooms_covered=engine.coverage.rooms_covered,
+            rooms_total=engine.coverage.rooms_total,
+        )
 
 
 @dataclass(frozen=True)
@@ -318,12 +329,7 @@ def run_mission(
         }
 
         def snapshot() -> MissionProgress:
-            return MissionProgress(
-                sim_time_s=engine.time_s,
-                wall_time_s=time.perf_counter() - wall_start,
-                rooms_covered=engine.coverage.rooms_covered,
-                rooms_total=engine.coverage.rooms_total,
-            )
+            return MissionProgress.of_engine(engine, wall_start)
 
         def finished() -> bool:
             # The state only changes at physics steps; skip the checks between them.

@@ -248,11 +248,18 @@ def format_summary(result: SpawnResult) -> str:
 
 
 def run(
-    config: SpawnConfig, *, progress: Callable[[MissionProgress], None] | None = None
+    config: SpawnConfig,
+    *,
+    progress: Callable[[MissionProgress], None] | None = None,
+    runner: Callable[..., MissionResult] = run_mission,
 ) -> SpawnResult:
-    """Run one OA-Bug mission headless and return its result (no printing)."""
+    """Run one OA-Bug mission headless and return its result (no printing).
+
+    ``runner`` runs the mission spec: the node path :func:`sim_bridge.mission.run_mission`,
+    or the batch path :func:`sim_bridge.oabug_batch.run_oabug_batch` for sweeps.
+    """
     spec, bias = build_mission(config)
-    mission = run_mission(spec, progress=progress)
+    mission = runner(spec, progress=progress)
     figures: tuple[Path, ...] = ()
     if config.out_dir is not None:
         stem = f'oabug_{config.variant}_{config.departure}_{mission.site.name}_seed{config.seed}'

@@ -1,0 +1,348 @@
+"""OA-Bug missions without the runtime: the sweep path of the benchmarks.
+
+The ROS path (:func:`sim_bridge.mission.run_mission`) runs the sim bridge node and one
+:class:`oabug_robot.node.OABugNode` per robot on the built-in runtime, and every reading
+travels as a message. This module drives the very same parts directly: the
+:class:`sim_bridge.engine.SimEngine` and, per robot, the node's own controller
+(:class:`oabug_robot.fsm.OABugFsm`) and scan feature extractor, built from the same node
+parameters by :func:`oabug_robot.node.config_from_parameters`. It reproduces what the
+messages and the executor do to the data, so a batch run's trajectories and first room
+entries equal the ROS path's (tested):
+
+* per physics step the engine steps, then every reading due is handed over in the bridge's
+  publish order (scan, gas, bearings, IMU): the bearings are stamped with the yaw of the
+  *previous* IMU reading, as the node receives them before this step's IMU message;
+* a robot keeps the newest reading of each sensor (sample and hold), stamped with the sim
+  time the node's clock reads (the ``/clock`` stamp, rounded to the nanosecond);
+* the control step runs on the node's timer grid (``control_rate_hz`` on sim time), after
+  every reading of that step, and reads the scan features, the staleness and the near peers
+  exactly as :class:`~oabug_robot.node.OABugNode` does; a robot with stale inputs gets a zero
+  command and the pump off;
+* scan ranges pass through float32 as in ``LaserScan.ranges``, the IMU yaw through the
+  quaternion of ``sensor_msgs/Imu``. The other float32 fields (scan angles and limits,
+  bearing azimuths and distances) are rounded to float32 when messages are serialized: by
+  DDS on a robot, and in the built-in runtime with its CDR round trip
+  (``SWARM_RUNTIME_CDR_ROUNDTRIP=1``, which the test suite sets). The batch path follows
+  that setting unless told otherwise (``float32_fields``), since the rounding changes
+  trajectories after a few seconds.
+
+It does not record bags, publish state messages, or support bridge extensions or the peer
+relay (OA-Bug uses neither): it is for sweeps. The ROS path stays the product.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from oabug_robot.errors import ScanError
+from oabug_robot.fsm import Command, OABugFsm, SensorSnapshot
+from oabug_robot.heading import yaw_from_quaternion
+from oabug_robot.node import PARAMETERS, config_from_parameters
+from oabug_robot.scan_features import LaserScanData, ScanFeatureExtractor, ScanFeatures
+from oabug_robot.sound import PeerBearings
+from swarm_runtime.builtin._messages import cdr_roundtrip_enabled
+
+from sim_bridge.conversions import yaw_to_quaternion
+from sim_bridge.engine import SimEngine, SiteGeometry
+from sim_bridge.errors import ConfigurationError
+from sim_bridge.mission import MissionProgress, MissionResult, MissionSpec, StopReason
+from sim_bridge.sensors.bearings import PeerBearings as BearingReport
+from sim_bridge.sensors.lidar import LidarConfig
+from sim_bridge.site_geometry import geometry_from_site
+from sim_bridge.spawn import SpawnConfig, SpawnResult, run
+
+__all__ = ['BatchRobot', 'run_oabug_batch', 'run_spawn_batch']
+
+_NS_PER_S = 1_000_000_000
+_STOP = Command(linear_mps=0.0, angular_radps=0.0, pump_on=False)
+
+
+def _to_float32(value: float) -> float:
+    """``value`` as a float32 message field carries it after serialization."""
+    return float(np.float32(value))
+
+
+def _stamp_ns(time_s: float) -> int:
+    """Sim time as the nodes' clock holds it: the ``/clock`` stamp in nanoseconds."""
+    return round(time_s * 1e9)
+
+
+@dataclass
+class _Held:
+    """The newest reading of one sensor and the node-clock time it arrived [s]."""
+
+    value: Any = None
+    time_s: float | None = None
+
+
+class BatchRobot:
+    """One OA-Bug robot as its node runs it, fed with readings instead of messages."""
+
+    def __init__(
+        self, parameters: Mapping[str, Any], lidar: LidarConfig, *, float32_fields: bool = False
+    ) -> None:
+        """Build the robot from OA-Bug node parameters (missing ones take their defaults).
+
+        Args:
+            parameters: node parameter overrides, as the spawner passes them.
+            lidar: the simulated lidar (the scan message's angles and limits).
+            float32_fields: round the float32 scalar message fields as serialization does.
+
+        Raises:
+            oabug_robot.errors.ConfigError: a parameter value is invalid.
+        """
+        values = {name: default for name, default, _ in PARAMETERS}
+        unknown = set(parameters) - set(values) - {'use_sim_time'}
+        if unknown:
+            msg = f'unknown OA-Bug parameters: {", ".join(sorted(unknown))}'
+            raise ConfigurationError(msg)
+        values.update({k: v for k, v in parameters.items() if k != 'use_sim_time'})
+        self.config = config_from_parameters(values)
+        rate_hz = float(values['control_rate_hz'])
+        self.stale_timeout_s = float(values['stale_timeout_s'])
+        if not (math.isfinite(rate_hz) and rate_hz > 0.0):
+            msg = f'control_rate_hz must be > 0, got {rate_hz}'
+            raise ConfigurationError(msg)
+        # The node's timer: period in whole nanoseconds, first deadline one period in.
+        self.control_period_ns = int(1.0 / rate_hz * _NS_PER_S)
+        self.next_control_ns = self.control_period_ns
+        self.own_tag = str(values['own_tag_id']).strip().upper()
+        self.fsm = OABugFsm(self.config)
+        self._extractor = ScanFeatureExtractor(self.config.perception)
+        self._float = _to_float32 if float32_fields else float
+        self._scan_frame = (
+            self._float(-math.pi),
+            self._float(lidar.angle_increment_rad),
+            self._float(lidar.range_min_m),
+            self._float(lidar.range_max_m),
+        )
+        self._needs_gas = self.config.variant.uses_scent
+        self._scan = _Held()
+        self._features: ScanFeatures | None = None
+        self._features_time_s: float | None = None
+        self._yaw = _Held(math.nan)
+        self._gas = _Held()
+        self._bearings: PeerBearings | None = None
+
+    # Readings, in the order the bridge publishes them within a step.
+
+    def receive_scan(self, ranges_m: np.ndarray, now_s: float) -> None:
+        """A lidar revolution ([m], REP 117) arrives; kept as the float32 of the message."""
+        self._scan.value = LaserScanData(np.asarray(ranges_m, dtype=np.float32), *self._scan_frame)
+        self._scan.time_s = now_s
+
+    def receive_gas(self, raw: int, now_s: float) -> None:
+        """A gas reading on the 10-bit scale arrives."""
+        self._gas.value = int(raw)
+        self._gas.time_s = now_s
+
+    def receive_bearings(
+        self, report: BearingReport, tag_ids: tuple[str, ...], now_s: float
+    ) -> None:
+        """A locator cycle arrives; stamped with the yaw held now (the previous IMU)."""
+        keep = [
+            k
+            for k, tag in enumerate(report.tags.tolist())
+            if not self.own_tag or tag_ids[tag] != self.own_tag
+        ]
+        yaw = self._yaw.value if math.isfinite(self._yaw.value) else 0.0
+        field_type = np.float32 if self._float is _to_float32 else float
+        self._bearings = PeerBearings(
+            azimuths_rad=np.asarray(report.azimuth_rad, dtype=field_type)[keep].astype(float),
+            distances_m=np.asarray(report.distance_m, dtype=field_type)[keep].astype(float),
+            stamp_s=now_s,
+            yaw_at_stamp_rad=yaw,
+        )
+
+    def receive_imu(self, yaw_rad: float, now_s: float) -> None:
+        """An IMU reading arrives; its yaw goes through the message's quaternion."""
+        self._yaw.value = yaw_from_quaternion(*yaw_to_quaternion(yaw_rad))
+        self._yaw.time_s = now_s
+
+    # The control step.
+
+    def _near_peers(self, now_s: float) -> tuple[np.ndarray, np.ndarray]:
+        bearings = self._bearings
+        if bearings is None or now_s - bearings.stamp_s > self.config.bearing_timeout_s:
+            return np.zeros(0), np.zeros(0)
+        return bearings.near_peers_now(
+            self._yaw.value, self.config.perception.peer_bearing_max_distance_m
+        )
+
+    def _update_features(self, now_s: float) -> None:
+        scan, scan_time = self._scan.value, self._scan.time_s
+        if scan is None:
+            return
+        self._scan.value = None
+        side = self.fsm.memory.wall_side
+        try:
+            self._features = self._extractor.extract(
+                scan, *self._near_peers(now_s), sides=(side,) if side else ()
+            )
+        except ScanError:
+            return
+        self._features_time_s = scan_time
+
+    def _fresh(self, stamp_s: float | None, now_s: float) -> bool:
+        return stamp_s is not None and 0.0 <= now_s - stamp_s <= self.stale_timeout_s
+
+    def control(self, now_s: float) -> Command:
+        """One control step at node time ``now_s``: the command the node would publish."""
+        if math.isfinite(self._yaw.value):
+            self._update_features(now_s)
+        fresh = self._fresh(self._features_time_s, now_s) and self._fresh(self._yaw.time_s, now_s)
+        if self._needs_gas:
+            fresh = fresh and self._fresh(self._gas.time_s, now_s)
+        if not fresh or self._features is None:
+            return _STOP
+        snapshot = SensorSnapshot(
+            time_s=now_s,
+            yaw_rad=self._yaw.value,
+            scan=self._features,
+            gas_raw=self._gas.value,
+            bearings=self._bearings,
+        )
+        return self.fsm.step(snapshot)
+
+
+def _check_spec(spec: MissionSpec) -> None:
+    if spec.recording is not None:
+        raise ConfigurationError('the batch path records no bags: use the ROS path')
+    if spec.extensions or spec.bridge_parameters:
+        raise ConfigurationError(
+            'the batch path runs OA-Bug only: no bridge extensions or bridge parameters'
+        )
+
+
+def run_oabug_batch(
+    spec: MissionSpec,
+    *,
+    progress: Callable[[MissionProgress], None] | None = None,
+    stop: Callable[[MissionProgress], bool] | None = None,
+    float32_fields: bool | None = None,
+) -> MissionResult:
+    """Run an OA-Bug mission (one node parameter set per robot) without the runtime.
+
+    ``spec`` is what :func:`sim_bridge.spawn.build_mission` builds for the ROS path; the
+    robots' node factories are not called, their parameters configure the controllers. The
+    stop conditions, progress reports and trajectory samples are those of
+    :func:`sim_bridge.mission.run_mission`. ``float32_fields`` rounds the float32 scalar
+    fields of the messages as serialization does; None follows the built-in runtime's CDR
+    round-trip setting, so the result equals the ROS path's in the same process.
+
+    Raises:
+        ConfigurationError: the spec asks for a bag, extensions or bridge parameters, or a
+            robot parameter is unknown.
+        oabug_robot.errors.ConfigError: a robot parameter value is invalid.
+    """
+    _check_spec(spec)
+    wall_start = time.perf_counter()
+    site = spec.site
+    geometry = site if isinstance(site, SiteGeometry) else geometry_from_site(site)
+    engine = SimEngine(geometry, np.asarray(spec.initial_poses, dtype=float), spec.engine_config)
+    n = engine.num_robots
+    names = tuple(f'r{i}' for i in range(n))
+    tag_ids = tuple(name.upper() for name in names)
+    lidar = engine.config.lidar
+    if float32_fields is None:
+        float32_fields = cdr_roundtrip_enabled()
+    robots = [
+        BatchRobot(robot.parameters, lidar, float32_fields=float32_fields) for robot in spec.robots
+    ]
+    times = [0.0]
+    poses = [engine.world.poses]
+    next_sample_s = spec.trajectory_period_s
+    next_report_s = 0.0
+    reason = StopReason.BUDGET
+
+    def snapshot() -> MissionProgress:
+        return MissionProgress.of_engine(engine, wall_start)
+
+    while True:
+        out = engine.step()
+        if out.time_s + 1e-9 >= next_sample_s:
+            times.append(out.time_s)
+            poses.append(out.poses)
+            next_sample_s += spec.trajectory_period_s
+        if spec.stop_when_all_rooms_covered and engine.coverage.complete:
+            reason = StopReason.ALL_ROOMS_COVERED
+            break
+        if engine.time_s + 1e-9 >= spec.max_sim_time_s:
+            reason = StopReason.BUDGET
+            break
+        if engine.time_s + 1e-9 >= next_report_s:
+            next_report_s += spec.progress_period_s
+            report = snapshot()
+            if progress is not None:
+                progress(report)
+            if stop is not None and stop(report):
+                reason = StopReason.PREDICATE
+                break
+        _deliver(engine, out, robots, tag_ids)
+
+    final = snapshot()
+    if progress is not None:
+        progress(final)
+    if times[-1] < engine.time_s:
+        times.append(engine.time_s)
+        poses.append(engine.world.poses)
+    return MissionResult(
+        robot_names=names,
+        site=site,
+        stop_reason=reason,
+        sim_time_s=engine.time_s,
+        wall_time_s=final.wall_time_s,
+        rooms_total=engine.coverage.rooms_total,
+        room_entries=engine.coverage.entries,
+        trajectory_times_s=np.array(times),
+        trajectories=np.stack(poses),
+        distance_travelled_m=engine.distance_travelled_m.copy(),
+    )
+
+
+def _deliver(
+    engine: SimEngine, out: Any, robots: list[BatchRobot], tag_ids: tuple[str, ...]
+) -> None:
+    """Hand one step's readings to the robots and apply the commands of those whose
+    control timer is due (what the executor does between two bridge ticks)."""
+    now_ns = _stamp_ns(out.time_s)
+    now_s = now_ns * 1e-9
+    if out.scans is not None:
+        for robot, ranges in zip(robots, out.scans, strict=True):
+            robot.receive_scan(ranges, now_s)
+    if out.gas_raw is not None:
+        for robot, raw in zip(robots, out.gas_raw.tolist(), strict=True):
+            robot.receive_gas(raw, now_s)
+    if out.bearings is not None:
+        for robot, report in zip(robots, out.bearings, strict=True):
+            robot.receive_bearings(report, tag_ids, now_s)
+    if out.imu is not None:
+        for robot, yaw in zip(robots, out.imu[0].tolist(), strict=True):
+            robot.receive_imu(yaw, now_s)
+    for i, robot in enumerate(robots):
+        if now_ns < robot.next_control_ns:
+            continue
+        period = robot.control_period_ns
+        robot.next_control_ns += period
+        if robot.next_control_ns < now_ns:
+            behind = now_ns - robot.next_control_ns
+            robot.next_control_ns += (1 + (behind - 1) // period) * period
+        command = robot.control(now_s)
+        engine.set_velocity_command(i, float(command.linear_mps), float(command.angular_radps))
+        engine.set_pump(i, bool(command.pump_on))
+
+
+def run_spawn_batch(
+    config: SpawnConfig, *, progress: Callable[[MissionProgress], None] | None = None
+) -> SpawnResult:
+    """:func:`sim_bridge.spawn.run` on the batch path: the same run, figures included.
+
+    Raises:
+        ConfigurationError: ``config.record`` is set (the batch path records no bags).
+    """
+    return run(config, progress=progress, runner=run_oabug_batch)

@@ -1,0 +1,78 @@
+"""The batch path reproduces the ROS path's OA-Bug missions exactly."""
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+from oabug_robot.fsm import Command
+from sim_bridge.errors import ConfigurationError
+from sim_bridge.mission import RecordingSpec, StopReason, run_mission
+from sim_bridge.oabug_batch import BatchRobot, run_oabug_batch, run_spawn_batch
+from sim_bridge.sensors.lidar import LidarConfig
+from sim_bridge.spawn import SpawnConfig, build_mission
+
+FIVE_ROOMS = Path(__file__).parent / 'data' / 'five_rooms.lay'
+
+
+@pytest.mark.parametrize(
+    ('site', 'robots', 'variant', 'departure', 'actions'),
+    [
+        ('small', 10, 'gas_sound', 'center', 120),
+        (str(FIVE_ROOMS), 4, 'gas', 'edge', 300),
+    ],
+    ids=['small-10-robots', 'five-rooms-all-covered'],
+)
+def test_batch_and_ros_paths_give_the_same_poses_and_first_entries(
+    site, robots, variant, departure, actions
+):
+    config = SpawnConfig(
+        site=site, robots=robots, variant=variant, departure=departure, actions=actions
+    )
+    spec, _ = build_mission(config)
+    ros = run_mission(spec)
+    batch = run_oabug_batch(spec)
+    # The robots did something worth comparing: they drove and entered rooms.
+    assert ros.distance_travelled_m.min() > 2.0
+    assert ros.rooms_covered >= 2
+    assert batch.stop_reason == ros.stop_reason
+    if site == str(FIVE_ROOMS):
+        assert ros.stop_reason == StopReason.ALL_ROOMS_COVERED
+    assert batch.sim_time_s == ros.sim_time_s
+    np.testing.assert_array_equal(batch.trajectory_times_s, ros.trajectory_times_s)
+    np.testing.assert_array_equal(batch.trajectories, ros.trajectories)
+    assert batch.room_entries == ros.room_entries
+    np.testing.assert_array_equal(batch.distance_travelled_m, ros.distance_travelled_m)
+
+
+def test_batch_spawn_run_matches_its_config():
+    config = SpawnConfig(site=str(FIVE_ROOMS), robots=3, departure='edge', actions=60)
+    result = run_spawn_batch(config)
+    assert result.mission.sim_time_s == pytest.approx(config.budget_s, abs=0.11)
+    assert result.mission.trajectories.shape[1:] == (3, 3)
+    assert result.figures == ()
+
+
+def test_batch_path_refuses_what_it_cannot_do(tmp_path):
+    spec, _ = build_mission(SpawnConfig(site=str(FIVE_ROOMS), robots=2, departure='edge'))
+    recorded = type(spec)(**{**spec.__dict__, 'recording': RecordingSpec(tmp_path / 'bag')})
+    with pytest.raises(ConfigurationError, match='bag'):
+        run_oabug_batch(recorded)
+    relayed = type(spec)(**{**spec.__dict__, 'bridge_parameters': {'comm_range_m': 5.0}})
+    with pytest.raises(ConfigurationError, match='bridge'):
+        run_oabug_batch(relayed)
+    with pytest.raises(ConfigurationError, match='no_such_parameter'):
+        BatchRobot({'no_such_parameter': 1}, LidarConfig())
+
+
+def test_a_robot_holds_still_until_scan_and_imu_arrive_and_when_they_go_stale():
+    robot = BatchRobot({'variant': 'minimum'}, LidarConfig())
+    stop = Command(0.0, 0.0, False)
+    assert robot.control(0.1) == stop
+    robot.receive_imu(0.5, 0.1)
+    assert robot.control(0.1) == stop
+    robot.receive_scan(np.full(360, math.inf), 0.2)
+    moving = robot.control(0.2)
+    assert moving != stop
+    # Nothing new for longer than stale_timeout_s: the node's fail safe.
+    assert robot.control(0.2 + robot.stale_timeout_s + 0.1) == stop
