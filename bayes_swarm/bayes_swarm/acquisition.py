@@ -87,7 +87,8 @@ def ray_integrals(
 
     Candidates lie on rays at ``headings_rad`` (h,) and distances ``k * step_m``,
     k = 0..n_steps. Paths to all candidates of one ray share their points, so the cumulative
-    trapezoid along the ray gives every candidate's integral.
+    trapezoid along the ray gives every candidate's integral; the common start point is
+    evaluated once.
 
     Returns:
         candidates: (h, n_steps + 1, 2) array of candidate points [m].
@@ -99,7 +100,11 @@ def ray_integrals(
     offsets = radii[None, :, None] * directions[:, None, :]
     candidates = start + offsets
     samples = offsets if from_origin else candidates
-    std = std_fn(samples.reshape(-1, 2)).reshape(len(headings_rad), n_steps + 1)
+    n_rays = len(headings_rad)
+    values = std_fn(np.vstack([samples[0, :1], samples[:, 1:].reshape(-1, 2)]))
+    std = np.empty((n_rays, n_steps + 1))
+    std[:, 0] = values[0]
+    std[:, 1:] = values[1:].reshape(n_rays, n_steps)
     cumulative = np.zeros_like(std)
     cumulative[:, 1:] = np.cumsum(0.5 * step_m * (std[:, 1:] + std[:, :-1]), axis=1)
     return candidates, cumulative

@@ -101,7 +101,8 @@ class GpConfig:
     The kernel is ``signal_variance * exp(-|x - x'|^2 / (2 length_scale^2))`` plus
     ``noise_std^2`` on the diagonal. Hyperparameters are fitted by maximum marginal likelihood
     within the bounds; to keep decisions fast they are refitted only when the data set has grown
-    by ``refit_growth_factor`` since the last fit, on at most ``max_fit_points`` samples.
+    by ``refit_growth_factor`` since the last fit, on at most ``max_fit_points`` samples, with at
+    most ``max_fit_iterations`` likelihood evaluations.
     """
 
     noise_std: float = 1e-3
@@ -110,6 +111,7 @@ class GpConfig:
     initial_length_scale_m: float = 1.0
     initial_signal_variance: float = 1.0
     max_fit_points: int = 80
+    max_fit_iterations: int = 30
     refit_growth_factor: float = 2.0
     max_jitter: float = 1e-2
 
@@ -122,6 +124,7 @@ class GpConfig:
         _positive('initial_length_scale_m', self.initial_length_scale_m)
         _positive('initial_signal_variance', self.initial_signal_variance)
         _require(self.max_fit_points >= 2, 'max_fit_points must be >= 2')
+        _require(self.max_fit_iterations >= 1, 'max_fit_iterations must be >= 1')
         _require(self.refit_growth_factor >= 1.0, 'refit_growth_factor must be >= 1')
         _positive('max_jitter', self.max_jitter)
 

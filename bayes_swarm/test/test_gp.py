@@ -6,12 +6,13 @@ from bayes_swarm.errors import ObservationError
 from bayes_swarm.gp import (
     GaussianProcess,
     Hyperparameters,
-    _negative_log_likelihood,
+    _likelihood_derivatives,
+    _minimise_likelihood,
     _squared_distances,
     downsample_indices,
 )
 from bayes_swarm.settings import GpConfig
-from scipy.optimize import approx_fprime
+from scipy.optimize import approx_fprime, minimize
 from scipy.stats import multivariate_normal
 
 HYPER = Hyperparameters(signal_variance=0.7, length_scale_m=0.4)
@@ -72,13 +73,24 @@ def test_mean_gradient_matches_finite_differences(data):
     np.testing.assert_allclose(grad, numeric, rtol=1e-4, atol=1e-6)
 
 
-def test_likelihood_gradient_matches_finite_differences(data):
+@pytest.mark.parametrize('noise_var', [1e-6, 1e-2])
+def test_likelihood_gradient_and_hessian_match_finite_differences(data, noise_var):
     x, y, _ = data
     sq = _squared_distances(x, x)
     theta = np.log([0.8, 0.6])
-    _, grad = _negative_log_likelihood(theta, sq, y, 1e-3)
-    numeric = approx_fprime(theta, lambda t: _negative_log_likelihood(t, sq, y, 1e-3)[0], 1e-7)
-    np.testing.assert_allclose(grad, numeric, rtol=1e-4, atol=1e-5)
+
+    def nll(t):
+        return _likelihood_derivatives(t, sq, y, noise_var)[0]
+
+    def grad(t, axis):
+        return _likelihood_derivatives(t, sq, y, noise_var)[1][axis]
+
+    _, g, h = _likelihood_derivatives(theta, sq, y, noise_var)
+    np.testing.assert_allclose(g, approx_fprime(theta, nll, 1e-7), rtol=1e-4, atol=1e-5)
+    for axis in range(2):
+        numeric = approx_fprime(theta, grad, 1e-6, axis)
+        np.testing.assert_allclose(h[axis], numeric, rtol=1e-4, atol=1e-4)
+    assert h[0, 1] == h[1, 0]
 
 
 def test_likelihood_value_is_the_negative_gaussian_log_density_of_the_data(data):
@@ -87,8 +99,38 @@ def test_likelihood_value_is_the_negative_gaussian_log_density_of_the_data(data)
     d2 = ((x[:, None, :] - x[None, :, :]) ** 2).sum(-1)
     cov = s2 * np.exp(-0.5 * d2 / ell**2) + noise_var * np.eye(len(x))
     expected = multivariate_normal(mean=np.zeros(len(x)), cov=cov).logpdf(y)
-    nll, _ = _negative_log_likelihood(np.log([s2, ell]), _squared_distances(x, x), y, noise_var)
+    nll, _, _ = _likelihood_derivatives(np.log([s2, ell]), _squared_distances(x, x), y, noise_var)
     assert nll == pytest.approx(-expected, rel=1e-9)
+
+
+@pytest.mark.parametrize('start', [(0.0, 0.0), (3.0, -4.0), (-8.0, 4.0)])
+def test_newton_likelihood_fit_reaches_the_optimum_a_general_solver_finds(data, start):
+    x, y, _ = data
+    sq = _squared_distances(x, x)
+    lower, upper = (np.log(1e-5), np.log(1e-3)), (np.log(1e5), np.log(500.0))
+
+    def nll(t):
+        return _likelihood_derivatives(t, sq, y, 1e-6)[:2]
+
+    bounds = list(zip(lower, upper, strict=True))
+    reference = minimize(nll, start, jac=True, method='L-BFGS-B', bounds=bounds)
+    found = _minimise_likelihood(sq, y, 1e-6, start, lower, upper, max_iterations=50)
+    assert found is not None
+    # As good as the general solver (which may stop in a worse local optimum from a far
+    # start), and a stationary point.
+    assert nll(found)[0] <= reference.fun + 1e-6
+    assert np.hypot(*nll(found)[1]) < 1e-3
+
+
+def test_newton_likelihood_fit_stops_at_a_bound_when_the_optimum_lies_beyond(data):
+    x, y, _ = data
+    sq = _squared_distances(x, x)
+    # The fitted length scale of this field is about 0.5 m: an upper bound of 0.2 m binds.
+    lower, upper = (np.log(1e-5), np.log(1e-3)), (np.log(1e5), np.log(0.2))
+    found = _minimise_likelihood(sq, y, 1e-6, (0.0, -2.0), lower, upper, max_iterations=50)
+    assert found is not None
+    assert found[1] == pytest.approx(upper[1])
+    assert _likelihood_derivatives(found, sq, y, 1e-6)[1][1] < 0.0  # would grow further
 
 
 def test_mean_derivatives_agree_with_the_mean_its_gradient_and_finite_differences(data):
