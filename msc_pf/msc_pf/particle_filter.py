@@ -160,7 +160,7 @@ class ParticleFilterBank:
             radio: path-loss model of eq. (4) (P0, K) and the detection range.
             field_size_m: the field is [0, field_size_m]^2; particles are kept inside.
             rng: the bank's own random generator (resampling offsets, roughening).
-            capacity: initial number of target slots (grows as needed).
+            capacity: initial number of target slots (at least 8; grows as needed).
         """
         self._cfg = config
         self._radio = radio
@@ -180,8 +180,9 @@ class ParticleFilterBank:
             else np.empty(0, np.float32)
         )
         self._ids: list[int] = []
+        self._any_updated = False
         self._slot_of: dict[int, int] = {}
-        self._allocate(max(1, capacity))
+        self._allocate(max(8, capacity))
 
     # ----------------------------------------------------------------- bookkeeping
     def _allocate(self, capacity: int) -> None:
@@ -350,32 +351,40 @@ class ParticleFilterBank:
             ObservationError: as :meth:`update`, for any observation (nothing is updated).
         """
         checked = [(self._validate(o, ids, v), ids) for o, ids, v in observations]
-        rounds: list[list[tuple[int, np.ndarray, float]]] = []
-        depth: dict[int, int] = {}
+        # The samples of each filter, in observation order: (observer x, observer y, RSSI).
+        samples: dict[int, list[tuple[float, float, float]]] = {}
+        skip_converged = not self._cfg.update_after_convergence
         for (obs, values), ids in checked:
-            for tid, value in zip(ids, values, strict=True):
+            ox, oy = obs.tolist()
+            for tid, value in zip(ids, values.tolist(), strict=True):
                 tid = int(tid)
                 self.track(tid, obs)
                 slot = self._slot_of[tid]
-                if not self._cfg.update_after_convergence and self._converged[slot]:
+                if skip_converged and self._converged[slot]:
                     continue
-                level = depth.get(slot, 0)
-                depth[slot] = level + 1
-                if level == len(rounds):
-                    rounds.append([])
-                rounds[level].append((slot, obs, float(value)))
-        if not rounds:
+                samples.setdefault(slot, []).append((ox, oy, value))
+        if not samples:
             return []
-        first = sorted(rounds[0], key=lambda item: item[0])
-        slots = np.array([item[0] for item in first], dtype=np.int64)
-        row_of = {int(slot): row for row, slot in enumerate(slots)}
-        observers = np.array([item[1] for item in first])
-        values = np.array([item[2] for item in first])
-        extra = []
-        for level in rounds[1:]:
-            rows = np.array([row_of[item[0]] for item in level], dtype=np.int64)
-            extra.append((rows, np.array([item[1] for item in level]), [i[2] for i in level]))
-        return self._update_slots(slots, observers, values, extra)
+        slots = sorted(samples)
+        first = np.array([samples[slot][0] for slot in slots])
+        # Later samples, level by level (a filter's second samples, then its third...), each
+        # level in row order: the log-likelihoods add up in observation order.
+        extra: list[tuple[int, float, float, float]] = []
+        level = 1
+        while True:
+            start = len(extra)
+            for row, slot in enumerate(slots):
+                if len(samples[slot]) > level:
+                    extra.append((row, *samples[slot][level]))
+            if len(extra) == start:
+                break
+            level += 1
+        return self._update_slots(
+            np.array(slots, dtype=np.int64),
+            first[:, :2],
+            first[:, 2],
+            np.array(extra).reshape(-1, 4),
+        )
 
     def _log_likelihood(self, d2: np.ndarray, values: np.ndarray, out: np.ndarray) -> np.ndarray:
         """Eqs. (3)-(4) in log form, -((P - P0) + 5 K log10 d^2)^2 / sigma^2, into ``out``."""
@@ -387,15 +396,51 @@ class ParticleFilterBank:
         out *= np.float32(-1.0 / self._denominator)
         return out
 
+    def _add_extra_samples(self, a: np.ndarray, x: np.ndarray, y: np.ndarray, extra: np.ndarray):
+        """Add the log-likelihoods of the later samples to ``a`` (rows of the first samples).
+
+        ``extra`` holds (row, observer x, observer y, RSSI) per sample, level by level; the
+        samples are evaluated in blocks as large as the work buffers.
+        """
+        k = a.shape[0]
+        block = self._capacity
+        rows_all = extra[:, 0].astype(np.int64)
+        for start in range(0, len(extra), block):
+            rows = rows_all[start : start + block]
+            chunk = extra[start : start + block]
+            m = len(rows)
+            ex, ey, ll = self._buf_nx[:m], self._buf_ny[:m], self._buf_cum[:m]
+            ox = chunk[:, 1:2].astype(np.float32)
+            oy = chunk[:, 2:3].astype(np.float32)
+            if k == 1:
+                np.subtract(x[0], ox, out=ex)
+                np.subtract(y[0], oy, out=ey)
+            else:
+                np.subtract(np.take(x, rows, axis=0, out=ex), ox, out=ex)
+                np.subtract(np.take(y, rows, axis=0, out=ey), oy, out=ey)
+            ex *= ex
+            ey *= ey
+            ex += ey
+            self._log_likelihood(ex, chunk[:, 3], out=ll)
+            # One level has each row at most once and in order; a row's levels come in order.
+            i = 0
+            while i < m:
+                j = i + 1
+                while j < m and rows[j] > rows[j - 1]:
+                    j += 1
+                if j - i == k:
+                    a += ll[i:j]
+                elif j - i == 1:
+                    a[rows[i]] += ll[i]
+                else:
+                    a[rows[i:j]] += ll[i:j]
+                i = j
+
     def _update_slots(
-        self,
-        slots: np.ndarray,
-        observers: np.ndarray,
-        values: np.ndarray,
-        extra: list[tuple[np.ndarray, np.ndarray, list[float]]],
+        self, slots: np.ndarray, observers: np.ndarray, values: np.ndarray, extra: np.ndarray
     ) -> list[int]:
         k = slots.size
-        contiguous = bool(np.array_equal(slots, np.arange(k)))
+        contiguous = bool(slots[-1] == k - 1)  # slots are sorted and distinct
         if contiguous:
             x, y = self._x[:k], self._y[:k]
         else:
@@ -412,13 +457,8 @@ class ParticleFilterBank:
         np.multiply(dy, dy, out=a)
         d2 += a
         self._log_likelihood(d2, values, out=a)
-        for rows, where, more in extra:
-            ex_ = x[rows] - where[:, :1].astype(np.float32)
-            ey_ = y[rows] - where[:, 1:].astype(np.float32)
-            ex_ *= ex_
-            ey_ *= ey_
-            ex_ += ey_
-            a[rows] += self._log_likelihood(ex_, np.asarray(more), out=ey_)
+        if len(extra):
+            self._add_extra_samples(a, x, y, extra)
         peak = a.max(axis=1)
         degenerate = ~(peak >= _LOG_TINY)  # also catches NaN
         # Eq. (2): normalised weights exp(l - max) / sum; degenerate rows are handled below.
@@ -437,10 +477,17 @@ class ParticleFilterBank:
         rows = np.arange(k)
         best_xy = np.stack([x[rows, best], y[rows, best]], axis=1).astype(np.float64)
 
+        if degenerate.any():
+            # Re-initialised below; uniform weights keep the resampling well defined.
+            a[degenerate] = np.float32(1.0 / self._n)
         new_x, new_y = self._resample(a, x, y, k)
         self._roughen(new_x, new_y, k)
 
-        if contiguous:
+        if contiguous and k == len(self._ids):
+            # Every filter was updated: the new particles become the storage (no copy).
+            self._x, self._buf_nx = self._buf_nx, self._x
+            self._y, self._buf_ny = self._buf_ny, self._y
+        elif contiguous:
             self._x[:k] = new_x
             self._y[:k] = new_y
         else:
@@ -451,9 +498,10 @@ class ParticleFilterBank:
         self._spread[slots] = np.sqrt(np.maximum(spread2, 0.0))
         self._best[slots] = best_xy
         self._updated[slots] = True
-        self._n_updates[slots] += 1 + np.bincount(
-            np.concatenate([r for r, _, _ in extra] or [np.empty(0, np.int64)]), minlength=k
-        )
+        self._any_updated = True
+        self._n_updates[slots] += 1
+        if len(extra):
+            self._n_updates[slots] += np.bincount(extra[:, 0].astype(np.int64), minlength=k)
 
         reinitialised: list[int] = []
         for row in np.flatnonzero(degenerate):
@@ -505,6 +553,9 @@ class ParticleFilterBank:
     # ----------------------------------------------------------------- convergence
     def end_step(self) -> None:
         """Record this control step's estimate of every updated filter and test eqs. (6)-(7)."""
+        if not self._any_updated:
+            return
+        self._any_updated = False
         cfg = self._cfg
         for slot in np.flatnonzero(self._updated[: len(self._ids)]):
             window = self._window[slot]

@@ -180,3 +180,68 @@ def test_batched_update_gives_each_target_the_same_estimate_as_a_lone_update():
     a, b = together.estimate(1), alone.estimate(1)
     np.testing.assert_allclose(a.position_m, b.position_m, atol=1e-3)
     assert a.spread_m == pytest.approx(b.spread_m, abs=1e-3)
+
+
+def lattice_posterior_mean(center, samples, gaussian=False):
+    """Eq. (5) on the initial lattice in float64: the weights multiply over ``samples``."""
+    x, y = (
+        v.astype(np.float64)
+        for v in lattice(
+            np.array(center), RADIO.detection_range_m, FIELD_M, ParticleFilterConfig().n_particles
+        )
+    )
+    log_w = np.zeros_like(x)
+    denominator = 2.0 if gaussian else 1.0
+    for (ox, oy), rssi in samples:
+        d = np.maximum(np.hypot(x - ox, y - oy), 1.0)
+        log_w -= (rssi - (RADIO.rssi_at_1m_dbm - 30.0 * np.log10(d))) ** 2 / denominator
+    w = np.exp(log_w - log_w.max())
+    w /= w.sum()
+    return np.array([w @ x, w @ y])
+
+
+# Which of ten observers hear target 1, 2, 3, 4: uneven (10, 5, 1 and 3 samples), or all.
+UNEVEN_HEARING = {1: range(10), 2: range(0, 10, 2), 3: (4,), 4: (2, 5, 9)}
+FULL_HEARING = dict.fromkeys((1, 2, 3, 4), range(10))
+
+
+@pytest.mark.parametrize('hearing', [UNEVEN_HEARING, FULL_HEARING])
+def test_joint_update_multiplies_every_sample_of_each_target(hearing):
+    # Ten observers: more than one block of work rows. Filter 7 is tracked first but not
+    # heard, so the updated filters are not the first rows of the bank, and target 1 (the
+    # one with most samples) is the last of them.
+    bank = make_bank(3)
+    centers = {1: (1000.0, 1000.0), 2: (1100.0, 900.0), 3: (900.0, 1100.0), 4: (1000.0, 950.0)}
+    bank.track(7, (400.0, 400.0))
+    for tid in (2, 4, 3, 1):
+        bank.track(tid, centers[tid])
+    truth = {1: (1050.0, 1040.0), 2: (1150.0, 850.0), 3: (800.0, 1150.0), 4: (1000.0, 800.0)}
+    rng = np.random.default_rng(9)
+    observations, samples = [], {tid: [] for tid in truth}
+    for i in range(10):
+        observer = np.array([950.0 + 12.0 * i, 1000.0 - 7.0 * i])
+        heard = [tid for tid in (1, 2, 3, 4) if i in hearing[tid]]
+        rssi = [noisy_rssi(observer, np.array(truth[tid]), rng) for tid in heard]
+        observations.append((observer, heard, rssi))
+        for tid, value in zip(heard, rssi, strict=True):
+            samples[tid].append((observer, value))
+    assert bank.update_joint(observations) == []
+    for tid, center in centers.items():
+        estimate = bank.estimate(tid)
+        assert estimate.n_updates == len(samples[tid])
+        np.testing.assert_allclose(
+            estimate.position_m, lattice_posterior_mean(center, samples[tid]), atol=0.05
+        )
+    assert bank.estimate(7).n_updates == 0
+
+
+@pytest.mark.parametrize('resampling', ['systematic', 'multinomial'])
+def test_degenerate_filter_reinitialises_under_either_resampling(resampling):
+    bank = make_bank(resampling=resampling)
+    bank.track(4, (300.0, 300.0))
+    bank.track(5, (1500.0, 1500.0))
+    observer = np.array([1500.0, 1500.0])
+    assert bank.update(observer, [4, 5], [-30.0, -80.0]) == [4]
+    assert bank.estimate(4).n_updates == 0
+    assert bank.estimate(5).n_updates == 1
+    assert np.all(np.isfinite(bank.particles(4)))
