@@ -98,7 +98,10 @@ def _deliver(
     if loss > 0.0:
         in_range &= rng.random((n, n)) >= loss
     np.fill_diagonal(in_range, False)
-    return [[outputs[j].broadcast for j in np.flatnonzero(in_range[i])] for i in range(n)]
+    messages = [out.broadcast for out in outputs]
+    return [
+        [m for m, heard in zip(messages, row, strict=True) if heard] for row in in_range.tolist()
+    ]
 
 
 def run_batch(
@@ -140,8 +143,8 @@ def run_batch(
         now += dt
         samples = targets.sample_rssi(positions, world_rng)
         outputs = []
-        for i, controller in enumerate(controllers):
-            heard = {int(t): float(samples[i, t]) for t in np.flatnonzero(~np.isnan(samples[i]))}
+        for i, (controller, row) in enumerate(zip(controllers, samples.tolist(), strict=True)):
+            heard = {t: value for t, value in enumerate(row) if value == value}  # not NaN
             outputs.append(
                 controller.step(
                     now, positions[i], heard, inbox[i], notices[i], with_estimates=False
