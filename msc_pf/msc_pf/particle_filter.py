@@ -131,7 +131,9 @@ def systematic_counts(
     """
     k, n = weights.shape
     c = np.cumsum(weights, axis=1, dtype=np.float32, out=work)
-    np.minimum(c, np.float32(1.0), out=c)
+    # Rows are non-decreasing, so only rows whose total exceeds 1 need the cap.
+    for row in np.flatnonzero(c[:, -1] > np.float32(1.0)):
+        np.minimum(c[row], np.float32(1.0), out=c[row])
     c *= np.float32(n)
     c -= offsets.astype(np.float32)
     np.ceil(c, out=c)
@@ -179,6 +181,7 @@ class ParticleFilterBank:
             if config.noise_pool_size
             else np.empty(0, np.float32)
         )
+        self._pool_abs_max = float(np.abs(self._pool).max()) if self._pool.size else math.inf
         self._ids: list[int] = []
         self._any_updated = False
         self._slot_of: dict[int, int] = {}
@@ -534,8 +537,10 @@ class ParticleFilterBank:
         """Add N(0, sigma_r^2) jitter per coordinate, sigma_r = kappa E N^(-1/2), floored."""
         cfg = self._cfg
         scale = cfg.roughening_kappa / math.sqrt(self._n)
-        sx = np.maximum(scale * (x.max(axis=1) - x.min(axis=1)), cfg.roughening_floor_m)
-        sy = np.maximum(scale * (y.max(axis=1) - y.min(axis=1)), cfg.roughening_floor_m)
+        x_lo, x_hi = x.min(axis=1), x.max(axis=1)  # float32, as the jitter scale
+        y_lo, y_hi = y.min(axis=1), y.max(axis=1)
+        sx = np.maximum(scale * (x_hi - x_lo), cfg.roughening_floor_m)
+        sy = np.maximum(scale * (y_hi - y_lo), cfg.roughening_floor_m)
         need = 2 * k * self._n
         if need <= self._pool.size:
             start = int(self._rng.integers(0, self._pool.size - need + 1))
@@ -547,8 +552,20 @@ class ParticleFilterBank:
         x += b
         np.multiply(noise[1], sy.astype(np.float32)[:, None], out=b)
         y += b
-        np.clip(x, 0.0, self._field_size_m, out=x)
-        np.clip(y, 0.0, self._field_size_m, out=y)
+        # Clipping is skipped when no jitter from the pool can push a particle out (the bound
+        # is loose, so a skipped clip would not have changed anything).
+        field = self._field_size_m
+        inside = need <= self._pool.size
+        for lo, hi, sigma in ((x_lo, x_hi, sx), (y_lo, y_hi, sy)):
+            reach = 1.001 * self._pool_abs_max * sigma.astype(np.float64) + 0.01
+            inside = (
+                inside
+                and float((lo.astype(np.float64) - reach).min()) >= 0.0
+                and float((hi.astype(np.float64) + reach).max()) <= field
+            )
+        if not inside:
+            np.clip(x, 0.0, field, out=x)
+            np.clip(y, 0.0, field, out=y)
 
     # ----------------------------------------------------------------- convergence
     def end_step(self) -> None:
