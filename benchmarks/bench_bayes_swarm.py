@@ -11,6 +11,8 @@ machine inflates far less than wall-clock time).
 Experiments (``--experiments``, default all):
 
 * main: Case 1 with 5 robots and Case 2 with 10 robots (Bayes-Swarm-P);
+* shifted: the same with the field and its source moved by a seeded offset (up to 0.3 m in
+  Case 1, 3 m in Case 2), to show how much a result hinges on the exact source position;
 * penalty: Bayes-Swarm-P against -O (Table 5);
 * comm: limited communication ranges (Experiment 5, Table 6);
 * authors: the authors' code options (inert penalty, origin paths, floor downsampling,
@@ -44,11 +46,12 @@ from typing import Any  # noqa: E402
 import numpy as np  # noqa: E402
 from bayes_swarm.batch_sim import MissionSpec, run_mission  # noqa: E402
 from bayes_swarm.messages import DecisionKind  # noqa: E402
-from bayes_swarm.settings import Arena, BayesSwarmConfig, ExhaustiveConfig  # noqa: E402
 from sim_bridge.signal_fields import get_case  # noqa: E402
+from sim_bridge.spawn_bayes_swarm import batch_mission_spec  # noqa: E402
 
 EXPERIMENTS = (
     'main',
+    'shifted',
     'penalty',
     'authors',
     'comm',
@@ -81,6 +84,7 @@ class Job:
     max_mission_time_s: float | None = None
     partition: str = 'strips'
     comm_range_m: float | None = None
+    source_shift_m: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -94,41 +98,31 @@ class RunOutcome:
     wall_s: float
 
 
-def mission_spec(job: Job) -> MissionSpec:
-    """Batch-simulator spec of the job's case with the paper's settings."""
+def mission_spec(job: Job, seed: int = 0) -> MissionSpec:
+    """Batch-simulator spec of the job's case with the paper's settings.
+
+    A job with ``source_shift_m`` moves the field and its source by an offset drawn
+    uniformly from [-shift, shift]^2 with the run's seed.
+    """
     case = get_case(job.case)
-    t_max = job.max_mission_time_s or case.max_mission_time_s
-    planner = BayesSwarmConfig(
-        arena=Arena(*case.arena_m),
-        velocity_mps=case.velocity_mps,
-        horizon_s=case.horizon_s,
-        observation_rate_hz=case.observation_rate_hz,
-        detection_radius_m=case.detection_radius_m,
-        max_mission_time_s=t_max,
-        initial_direction_range_deg=case.direction_range_deg,
-        max_signal=case.max_signal,
-        lipschitz=case.lipschitz,
-    )
-    options = dict(job.planner)
-    if job.noise_std > 0.0:
-        options.setdefault('gp', replace(planner.gp, noise_std=job.noise_std))
-    planner = replace(planner, **options)
-    return MissionSpec(
-        field=case.field,
-        source_m=case.source_m,
-        depots_m=case.depots_m,
-        planner=planner,
-        depot_direction_offsets_deg=case.depot_direction_offsets_deg,
+    if job.max_mission_time_s is not None:
+        case = replace(case, max_mission_time_s=job.max_mission_time_s)
+    if job.source_shift_m > 0.0:
+        rng = np.random.default_rng(seed)
+        case = case.with_source_moved(rng.uniform(-job.source_shift_m, job.source_shift_m, 2))
+    return batch_mission_spec(
+        case,
         noise_std=job.noise_std,
         comm_range_m=job.comm_range_m,
-        exhaustive=ExhaustiveConfig(partition=job.partition),
+        partition=job.partition,
+        planner_options=job.planner,
     )
 
 
 def run_one(job: Job, seed: int) -> RunOutcome:
     """One seeded run of a job."""
     start = time.perf_counter()
-    result = run_mission(mission_spec(job), job.algorithm, job.robots, seed)
+    result = run_mission(mission_spec(job, seed), job.algorithm, job.robots, seed)
     wall = time.perf_counter() - start
     decisions = result.decisions[result.finder] if result.found else []
     times = [d.compute_time_s for d in decisions]
@@ -158,6 +152,19 @@ def plan_jobs(experiments: list[str], runs: int, baseline_runs: int, large_runs:
             Job('main', 'Case 1, 5 robots, Bayes-Swarm-P', 'case1', 'bayes_swarm_p', 5, runs),
             Job('main', 'Case 2, 10 robots, Bayes-Swarm-P', 'case2', 'bayes_swarm_p', 10, runs),
         ]
+    if 'shifted' in experiments:
+        for case, m, shift in (('case1', 5, 0.3), ('case2', 10, 3.0)):
+            jobs.append(
+                Job(
+                    'shifted',
+                    f'Case {case[-1]}, {m} robots, Bayes-Swarm-P, source moved <= {shift:g} m',
+                    case,
+                    'bayes_swarm_p',
+                    m,
+                    runs,
+                    source_shift_m=shift,
+                )
+            )
     if 'penalty' in experiments:
         jobs += [
             Job('penalty', 'Case 1, 5 robots, Bayes-Swarm-O', 'case1', 'bayes_swarm_o', 5, runs),

@@ -7,9 +7,10 @@ Zero prior mean, squared-exponential kernel
 hyperparameters (s2, l) by maximum marginal likelihood within bounds (a projected
 trust-region Newton method on their logarithms with the analytic gradient and Hessian; the
 authors use L-BFGS-B, which reaches the same optimum with two to three times the likelihood
-evaluations and a costly set-up per call). The posterior is kept as a Cholesky factor; if it fails the
-diagonal receives growing jitter, and if even ``max_jitter`` fails the hyperparameters are
-reset and refitted once before :class:`~bayes_swarm.errors.GpFitError` is raised.
+evaluations and a costly set-up per call). The posterior is kept as a Cholesky factor; if it
+fails the diagonal receives growing jitter, and if even ``max_jitter`` fails the
+hyperparameters are reset and refitted once before :class:`~bayes_swarm.errors.GpFitError` is
+raised.
 
 Posterior variance does not depend on the observed values, so the "extended" variance of
 Eq. 7 (observations plus the peers' planned path points) reuses the same hyperparameters and

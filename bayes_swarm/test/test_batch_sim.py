@@ -30,6 +30,41 @@ def test_case_1_run_finds_the_source_within_t_max_deterministically(case1_spec):
     assert waypoints == [[d.waypoint_m.tolist() for d in ds] for ds in second.decisions]
 
 
+def _waypoints(result):
+    return [[d.waypoint_m.tolist() for d in ds] for ds in result.decisions]
+
+
+def test_the_robots_decide_from_their_samples_never_from_the_true_source(case1_spec):
+    """Moving only the ground-truth source (same field) changes nothing the robots do."""
+    run = run_mission(case1_spec, 'bayes_swarm_p', 5, seed=3)
+    assert run.found
+    # The decoy mission runs a little longer than the original one, then stops.
+    planner = replace(case1_spec.planner, max_mission_time_s=run.found_time_s + 1.0)
+    decoy_spec = replace(case1_spec, source_m=np.array([2.3, 0.1]), planner=planner)
+    decoy = run_mission(decoy_spec, 'bayes_swarm_p', 5, seed=3)
+    assert not decoy.found
+    # Every decision taken before the original run ended is taken identically.
+    for original, moved in zip(_waypoints(run), _waypoints(decoy), strict=True):
+        assert moved[: len(original)] == original
+
+
+def test_moving_the_field_changes_every_decision_after_the_first(case1_spec):
+    """The first decision is a fixed fan; the later ones follow the sampled field."""
+    offset = np.array([0.15, -0.1])
+    # Both missions stop after the second decisions (at t = 10 s, end of the first legs).
+    spec = replace(case1_spec, planner=replace(case1_spec.planner, max_mission_time_s=12.0))
+    moved_spec = replace(
+        spec,
+        field=lambda p: spec.field(np.asarray(p, dtype=float).reshape(-1, 2) - offset),
+        source_m=spec.source_m + offset,
+    )
+    run = run_mission(spec, 'bayes_swarm_p', 5, seed=3)
+    moved = run_mission(moved_spec, 'bayes_swarm_p', 5, seed=3)
+    for original, shifted in zip(_waypoints(run), _waypoints(moved), strict=True):
+        assert shifted[0] == original[0]
+        assert np.hypot(*np.subtract(shifted[1], original[1])) > 0.01
+
+
 def test_out_of_range_robots_hear_only_the_broadcasts_made_at_the_common_depot(case1_spec):
     spec = replace(case1_spec, comm_range_m=0.0)
     result = run_mission(spec, 'bayes_swarm_p', 3, seed=1, keep_planners=True)

@@ -25,7 +25,7 @@ Choices where the paper is silent or inconsistent (see docs/bayes_swarm.md):
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Protocol
 
 import numpy as np
@@ -50,6 +50,10 @@ class SignalField(Protocol):
 
     def __call__(self, points_m: np.ndarray) -> np.ndarray: ...
 
+    def translated(self, offset_m: np.ndarray) -> SignalField:
+        """The same field moved by (2,) ``offset_m`` [m]."""
+        ...
+
 
 @dataclass(frozen=True)
 class GaussianMixtureField:
@@ -64,6 +68,10 @@ class GaussianMixtureField:
     centres_m: np.ndarray
     divisors_m2: np.ndarray
     weights: np.ndarray
+
+    def translated(self, offset_m: np.ndarray) -> GaussianMixtureField:
+        """The same field moved by (2,) ``offset_m`` [m]."""
+        return replace(self, centres_m=self.centres_m + np.asarray(offset_m, dtype=float))
 
     def __call__(self, points_m: np.ndarray) -> np.ndarray:
         pts = np.asarray(points_m, dtype=float).reshape(-1, 2)
@@ -87,6 +95,10 @@ class DipoleField:
     beacon_m: np.ndarray
     depth_m: float
     moment: np.ndarray
+
+    def translated(self, offset_m: np.ndarray) -> DipoleField:
+        """The same field moved by (2,) ``offset_m`` [m]."""
+        return replace(self, beacon_m=self.beacon_m + np.asarray(offset_m, dtype=float))
 
     def __call__(self, points_m: np.ndarray) -> np.ndarray:
         pts = np.asarray(points_m, dtype=float).reshape(-1, 2)
@@ -148,6 +160,16 @@ class SignalCase:
     def depot_of(self, robot_index: int) -> int:
         """Index of the depot robot ``robot_index`` (0-based) starts from."""
         return robot_index % self.depots_m.shape[0]
+
+    def with_source_moved(self, offset_m: np.ndarray) -> SignalCase:
+        """The case with its field and source moved by (2,) ``offset_m`` [m].
+
+        Arena, depots and every setting stay. Used to check that a result does not hinge on
+        the exact source position (the benchmark's shifted Case 2) and, in the tests, that the
+        robots' decisions follow the samples.
+        """
+        offset = np.asarray(offset_m, dtype=float).reshape(2)
+        return replace(self, field=self.field.translated(offset), source_m=self.source_m + offset)
 
     def ideal_time_s(self, start_m: np.ndarray) -> float:
         """t_idealized of Eq. 12 for a robot starting at (2,) ``start_m`` [s]."""

@@ -39,7 +39,7 @@ from sim_bridge.signal_extension import SignalExtension, SignalMissionModel
 from sim_bridge.signal_fields import CASE_NAMES, SignalCase, UnknownCaseError, get_case
 from sim_bridge.world import BodyConfig
 
-__all__ = ['ALGORITHMS', 'BayesSwarmRun', 'SpawnSettings', 'main', 'run']
+__all__ = ['ALGORITHMS', 'BayesSwarmRun', 'SpawnSettings', 'batch_mission_spec', 'main', 'run']
 
 ALGORITHMS = ('bayes_swarm_p', 'bayes_swarm_o', 'glowworm', 'levy', 'exhaustive')
 DEFAULT_RECORD_TOPICS = (
@@ -218,6 +218,51 @@ def node_parameters(case: SignalCase, settings: SpawnSettings, n: int, i: int) -
     }
     params.update(settings.extra_parameters)
     return params
+
+
+def batch_mission_spec(
+    case: SignalCase,
+    *,
+    noise_std: float = 0.0,
+    comm_range_m: float | None = None,
+    partition: str = 'strips',
+    planner_options: dict[str, Any] | None = None,
+) -> Any:
+    """The case as a spec of the ROS-free batch simulator (``bayes_swarm.batch_sim``).
+
+    The planners get the case's settings (arena, V, T, f_Hz, eps, T_max, delta theta, M, L),
+    never its source; ``planner_options`` override BayesSwarmConfig fields. With measurement
+    noise the GP noise term is raised to it unless ``planner_options`` sets ``gp``.
+    """
+    from bayes_swarm.batch_sim import MissionSpec as BatchMissionSpec
+    from bayes_swarm.settings import Arena, BayesSwarmConfig, ExhaustiveConfig
+
+    planner = BayesSwarmConfig(
+        arena=Arena(*case.arena_m),
+        velocity_mps=case.velocity_mps,
+        horizon_s=case.horizon_s,
+        observation_rate_hz=case.observation_rate_hz,
+        detection_radius_m=case.detection_radius_m,
+        max_mission_time_s=case.max_mission_time_s,
+        initial_direction_range_deg=case.direction_range_deg,
+        max_signal=case.max_signal,
+        lipschitz=case.lipschitz,
+    )
+    options = dict(planner_options or {})
+    if noise_std > 0.0:
+        options.setdefault(
+            'gp', replace(planner.gp, noise_std=max(noise_std, planner.gp.noise_std))
+        )
+    return BatchMissionSpec(
+        field=case.field,
+        source_m=case.source_m,
+        depots_m=case.depots_m,
+        planner=replace(planner, **options),
+        depot_direction_offsets_deg=case.depot_direction_offsets_deg,
+        noise_std=noise_std,
+        comm_range_m=comm_range_m,
+        exhaustive=ExhaustiveConfig(partition=partition),
+    )
 
 
 def _initial_yaw(case: SignalCase, fan_index: int, fan_size: int, offset: float) -> float:

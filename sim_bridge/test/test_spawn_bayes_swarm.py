@@ -1,5 +1,6 @@
 """End to end: the spawner on the built-in runtime, bags, and agreement with the harness."""
 
+import dataclasses
 import math
 
 import numpy as np
@@ -10,7 +11,7 @@ from bayes_swarm.messages import DecisionKind
 from bayes_swarm.settings import Arena, BayesSwarmConfig
 from sim_bridge.errors import SimBridgeError
 from sim_bridge.signal_fields import get_case
-from sim_bridge.spawn_bayes_swarm import SpawnSettings, main, run
+from sim_bridge.spawn_bayes_swarm import SpawnSettings, batch_mission_spec, main, run
 from swarm_analysis.tau import tau_from_bag
 
 
@@ -20,6 +21,38 @@ def _recorder_available():
     except ImportError:
         return False
     return True
+
+
+def _waypoints(result):
+    return [[d.waypoint_m.tolist() for d in ds] for ds in result.decisions]
+
+
+def test_case_2_decisions_follow_the_samples_and_never_the_true_source():
+    """No ground truth leaks into the planners of the batch harness (Case 2, 10 robots).
+
+    Moving only the declared source leaves every decision unchanged. Moving the field with
+    its source keeps the first decisions (a fixed fan) and moves every robot's expected source
+    (Eq. 5) at its second decision, and so the waypoint of every robot that exploits it;
+    exploring legs may end at the same point of the discrete polar grid.
+    """
+    case = dataclasses.replace(get_case('case2'), max_mission_time_s=21.0)  # 2 decisions each
+    base = run_harness(batch_mission_spec(case), 'bayes_swarm_p', 10, seed=0)
+    decoy_case = dataclasses.replace(case, source_m=np.array([-20.0, -20.0]))
+    decoy = run_harness(batch_mission_spec(decoy_case), 'bayes_swarm_p', 10, seed=0)
+    moved = run_harness(
+        batch_mission_spec(case.with_source_moved((-2.0, 1.0))), 'bayes_swarm_p', 10, seed=0
+    )
+    assert _waypoints(decoy) == _waypoints(base)
+    exploiting = 0
+    for original, shifted in zip(base.decisions, moved.decisions, strict=True):
+        assert len(original) == len(shifted) == 2
+        np.testing.assert_array_equal(shifted[0].waypoint_m, original[0].waypoint_m)
+        expected = original[1].expected_source_m
+        assert np.hypot(*(shifted[1].expected_source_m - expected)) > 0.1
+        if np.hypot(*(original[1].waypoint_m - expected)) < 3.0:
+            exploiting += 1
+            assert np.hypot(*(shifted[1].waypoint_m - original[1].waypoint_m)) > 0.1
+    assert exploiting >= 2
 
 
 @pytest.mark.slow
