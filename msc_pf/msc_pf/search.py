@@ -33,6 +33,7 @@ class CoverageHistory:
         self.cell_size_m = float(cell_size_m)
         self.cells_per_side = max(1, math.ceil(field_size_m / cell_size_m))
         self.counts = np.zeros((self.cells_per_side, self.cells_per_side), dtype=np.float64)
+        self._centres_m = (np.arange(self.cells_per_side) + 0.5) * self.cell_size_m
 
     def cell_of(self, position_m: np.ndarray) -> int:
         """Flat index (row = y cell, column = x cell) of the cell holding ``position_m``."""
@@ -55,17 +56,16 @@ class CoverageHistory:
         """
         n, size = self.cells_per_side, self.cell_size_m
         reach = math.ceil(radius_m / size)
-        col = min(max(int(position_m[0] // size), 0), n - 1)
-        row = min(max(int(position_m[1] // size), 0), n - 1)
+        px, py = float(position_m[0]), float(position_m[1])
+        col = min(max(int(px // size), 0), n - 1)
+        row = min(max(int(py // size), 0), n - 1)
         r0, r1 = max(row - reach, 0), min(row + reach + 1, n)
         c0, c1 = max(col - reach, 0), min(col + reach + 1, n)
         window = self.counts[r0:r1, c0:c1]
         if not window.any():
             return np.zeros(2)
-        cy = (np.arange(r0, r1) + 0.5) * size
-        cx = (np.arange(c0, c1) + 0.5) * size
-        dx = position_m[0] - cx[None, :]
-        dy = position_m[1] - cy[:, None]
+        dx = px - self._centres_m[None, c0:c1]
+        dy = py - self._centres_m[r0:r1, None]
         d2 = dx * dx + dy * dy
         weight = np.where(d2 < radius_m * radius_m, window / np.maximum(d2, size * size), 0.0)
         return unit(np.array([np.sum(weight * dx), np.sum(weight * dy)]))
