@@ -5,7 +5,9 @@ An update takes one observation point (the robot that took the samples) and the 
 every target it heard there, and updates all those filters in one vectorised pass:
 
 1. likelihood, eq. (3)-(4): ``w_j = exp(-(P - R_j)^2 / sigma^2)``, ``R_j = P0 - 10 K log10 d_j``
-   (optionally the Gaussian ``2 sigma^2``);
+   (optionally the Gaussian ``2 sigma^2``), divided by default by the chance
+   ``Phi((R_j - gamma_D) / s)`` that the sample would have been heard at all (the receiver
+   reports nothing below gamma_D, so samples near the detection edge are biased upward);
 2. normalisation, eq. (2); estimate, eq. (5); spread sigma_k and the largest-weight particle,
    all from these post-update, pre-resampling weights;
 3. systematic (or multinomial) resampling and roughening (Gordon, Salmond and Smith 1993).
@@ -144,6 +146,32 @@ def systematic_counts(
     return counts
 
 
+_CENSOR_STEP_DB = 0.01
+_CENSOR_U_MAX = 6.0  # Phi(6) = 1 - 1e-9: no correction beyond
+_CENSOR_U_MIN = -8.0  # the squared error term dominates beyond
+
+
+def _censoring_table(
+    config: ParticleFilterConfig, radio: RadioConfig, denominator: float
+) -> tuple[np.ndarray, float, float]:
+    """``-log Phi((R - gamma_D) / s)`` tabulated over the path loss ``L = P0 - R`` [dB].
+
+    ``s = sqrt(denominator / 2)`` is the noise standard deviation the likelihood of eq. (3)
+    implies (sigma / sqrt 2 for the paper's form, sigma for the Gaussian one). Returns the
+    table (empty when the correction is off), the path loss of its first bin and 1 / bin width.
+    """
+    if not config.censored_likelihood:
+        return np.empty(0, np.float32), 0.0, 1.0
+    s = math.sqrt(denominator / 2.0)
+    margin = radio.rssi_at_1m_dbm - radio.detection_threshold_dbm  # L at which R = gamma_D
+    lo = margin - _CENSOR_U_MAX * s
+    count = math.ceil((_CENSOR_U_MAX - _CENSOR_U_MIN) * s / _CENSOR_STEP_DB)
+    loss = lo + (np.arange(count) + 0.5) * _CENSOR_STEP_DB
+    u = (margin - loss) / s
+    table = np.array([-math.log(0.5 * math.erfc(-v / math.sqrt(2.0))) for v in u], np.float32)
+    return table, lo, 1.0 / _CENSOR_STEP_DB
+
+
 class ParticleFilterBank:
     """The particle filters of one robot, one per tracked target ID."""
 
@@ -176,6 +204,9 @@ class ParticleFilterBank:
         )
         self._denominator = config.noise_variance_db2 * (2.0 if config.gaussian_likelihood else 1.0)
         self._log_scale = 5.0 * radio.path_loss_exponent  # 10 K log10 d = 5 K log10 d^2
+        self._censor_table, self._censor_lo_db, self._censor_inv_step = _censoring_table(
+            config, radio, self._denominator
+        )
         self._pool = (
             rng.standard_normal(config.noise_pool_size, dtype=np.float32)
             if config.noise_pool_size
@@ -215,6 +246,7 @@ class ParticleFilterBank:
         self._buf_b = np.empty((capacity, n), np.float32)
         self._buf_c32 = np.empty((capacity, n), np.float32)
         self._buf_d32 = np.empty((capacity, n), np.float32)
+        self._buf_censor = np.empty((capacity, n), np.float32)
         self._buf_cum = np.empty((capacity, n), np.float32)
         self._buf_nx = np.empty((capacity, n), np.float32)
         self._buf_ny = np.empty((capacity, n), np.float32)
@@ -390,13 +422,29 @@ class ParticleFilterBank:
         )
 
     def _log_likelihood(self, d2: np.ndarray, values: np.ndarray, out: np.ndarray) -> np.ndarray:
-        """Eqs. (3)-(4) in log form, -((P - P0) + 5 K log10 d^2)^2 / sigma^2, into ``out``."""
+        """Eqs. (3)-(4) in log form, -((P - P0) + 5 K log10 d^2)^2 / sigma^2, into ``out``.
+
+        With the censoring correction, ``-log Phi((R_j - gamma_D) / s)`` is added, looked up
+        in a table indexed by the path loss ``10 K log10 d``.
+        """
         np.maximum(d2, np.float32(1.0), out=out)  # d < 1 m counts as 1 m
         np.log10(out, out=out)
-        out *= np.float32(self._log_scale)
+        out *= np.float32(self._log_scale)  # path loss 10 K log10 d = P0 - R_j
+        censor = None
+        if self._censor_table.size:
+            rows, cols = out.shape
+            scaled = self._buf_censor[:rows, :cols]
+            np.subtract(out, np.float32(self._censor_lo_db), out=scaled)
+            scaled *= np.float32(self._censor_inv_step)
+            np.clip(scaled, 0.0, np.float32(self._censor_table.size - 1), out=scaled)
+            index = self._counts[:rows, :cols]  # free until resampling
+            index[...] = scaled
+            censor = np.take(self._censor_table, index, out=scaled)
         out += (np.asarray(values) - self._radio.rssi_at_1m_dbm).astype(np.float32)[:, None]
         np.multiply(out, out, out=out)
         out *= np.float32(-1.0 / self._denominator)
+        if censor is not None:
+            out += censor
         return out
 
     def _add_extra_samples(self, a: np.ndarray, x: np.ndarray, y: np.ndarray, extra: np.ndarray):

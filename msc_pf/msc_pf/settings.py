@@ -103,6 +103,11 @@ class ParticleFilterConfig:
         noise_variance_db2: sigma^2 of eq. (3) [dB^2].
         gaussian_likelihood: False uses the paper's exp(-e^2 / sigma^2); True the Gaussian
             exp(-e^2 / (2 sigma^2)).
+        censored_likelihood: divide each sample's likelihood by the chance
+            Phi((R_j - gamma_D) / s) that a target at the particle would have been heard at
+            all (s: the noise standard deviation the likelihood implies). The receiver reports
+            only samples above gamma_D, so near the detection edge the reported ones are
+            biased upward; without this a swarm lingering there converges on a wrong point.
         initial_prior: 'detection_square' puts the lattice on the square around the detection
             disc centred on the observer; 'field' spreads it over the whole field.
         init_half_width_m: half width of the detection square [m]; None uses the radio model's
@@ -126,6 +131,7 @@ class ParticleFilterConfig:
     window: int = 10
     noise_variance_db2: float = 1.0
     gaussian_likelihood: bool = False
+    censored_likelihood: bool = True
     initial_prior: str = 'detection_square'
     init_half_width_m: float | None = None
     resampling: str = 'systematic'

@@ -1,5 +1,7 @@
 """Particle filter: convergence, its two tests at their thresholds, resampling, degeneracy."""
 
+import math
+
 import numpy as np
 import pytest
 from msc_pf.errors import ObservationError
@@ -210,7 +212,7 @@ def test_joint_update_multiplies_every_sample_of_each_target(hearing):
     # Ten observers: more than one block of work rows. Filter 7 is tracked first but not
     # heard, so the updated filters are not the first rows of the bank, and target 1 (the
     # one with most samples) is the last of them.
-    bank = make_bank(3)
+    bank = make_bank(3, censored_likelihood=False)
     centers = {1: (1000.0, 1000.0), 2: (1100.0, 900.0), 3: (900.0, 1100.0), 4: (1000.0, 950.0)}
     bank.track(7, (400.0, 400.0))
     for tid in (2, 4, 3, 1):
@@ -233,6 +235,48 @@ def test_joint_update_multiplies_every_sample_of_each_target(hearing):
             estimate.position_m, lattice_posterior_mean(center, samples[tid]), atol=0.05
         )
     assert bank.estimate(7).n_updates == 0
+
+
+@pytest.mark.parametrize('gaussian', [False, True])
+def test_censored_likelihood_divides_by_the_chance_of_being_heard(gaussian):
+    # log w = -(P - R)^2 / sigma^2 - log Phi((R - gamma_D) / s), s = sqrt(denominator / 2).
+    censored = make_bank(gaussian_likelihood=gaussian)
+    plain = make_bank(gaussian_likelihood=gaussian, censored_likelihood=False)
+    distances = np.array([[1.0, 100.0, 200.0, 260.0, 292.0, 330.0, 380.0]])
+    d2 = (distances**2).astype(np.float32)
+    got = censored._log_likelihood(d2, np.array([-100.0]), np.empty_like(d2))
+    uncorrected = plain._log_likelihood(d2, np.array([-100.0]), np.empty_like(d2))
+    s = math.sqrt((2.0 if gaussian else 1.0) / 2.0)
+    mean = RADIO.rssi_at_1m_dbm - 30.0 * np.log10(distances)
+    heard = np.array([0.5 * math.erfc(-u / math.sqrt(2.0)) for u in ((mean - -101.0) / s)[0]])
+    np.testing.assert_allclose(got - uncorrected, -np.log(heard)[None, :], rtol=5e-3, atol=0.02)
+    # Near the sensor the correction vanishes; beyond the detection range it favours particles.
+    assert abs(got[0, 1] - uncorrected[0, 1]) < 1e-6
+    assert got[0, -1] - uncorrected[0, -1] > 1.0
+
+
+def test_censored_likelihood_removes_the_inward_bias_of_edge_samples():
+    # Observers 300 m from a target hear it only when the noise lifts it above -101 dBm.
+    # Those samples pull the range inward; with the correction the mean range is unbiased.
+    rng = np.random.default_rng(4)
+    target = np.array([1000.0, 1000.0])
+    ranges = {}
+    for censored in (False, True):
+        bank = make_bank(5, censored_likelihood=censored, init_half_width_m=420.0)
+        bank.track(0, target + np.array([0.0, -300.0]))
+        heard = 0
+        for i in range(400):
+            angle = -math.pi / 2.0 + 0.02 * (i % 50 - 25)
+            observer = target + 300.0 * np.array([math.cos(angle), math.sin(angle)])
+            value = noisy_rssi(observer, target, rng)
+            if value >= RADIO.detection_threshold_dbm:
+                bank.update(observer, [0], [value])
+                heard += 1
+        assert 50 < heard < 350
+        particles = bank.particles(0)
+        ranges[censored] = float(np.mean(np.hypot(*(particles - (1000.0, 700.0)).T)))
+    assert ranges[False] < 285.0
+    assert abs(ranges[True] - 300.0) < abs(ranges[False] - 300.0)
 
 
 @pytest.mark.parametrize('resampling', ['systematic', 'multinomial'])
