@@ -6,10 +6,12 @@ targets uniform, robots starting in a 30 m disc at the centre, Table I parameter
 
 * main: CCT mean +- std for proposed, msc_pf and msc at 10, 15 and 20 targets with the
   default robot count, the ratios of the means, unfinished runs (CCT > T_max, never dropped:
-  they count as T_max in the mean, so the mean is then a lower bound), wall time per run;
+  they count as T_max in the mean, so the mean is then a lower bound), CPU and wall time per
+  run (CPU time of the process that ran it: the better figure on a shared machine);
 * robots: CCT against the robot count (sensitivity);
-* pf: time of one particle-filter update of 20 targets x 5041 particles from one
-  observation (median over repeats), and of one fused update of 3 observers.
+* pf: time of one particle-filter step of 20 targets x 5041 particles from one observation
+  (the update and the convergence test, median over repeats), and of one fused step of 3
+  observers; the filters start on their lattice and take fresh noisy samples every repeat.
 
 A seed fixes target and robot placement, noise and every controller, and runs with the same
 seed see the same targets under every scheme. Example::
@@ -38,7 +40,7 @@ from msc_pf.settings import ParticleFilterConfig, RadioConfig  # noqa: E402
 from sim_bridge.msc_pf_batch import BatchScenario, run_batch  # noqa: E402
 
 SCHEMES = ('proposed', 'msc_pf', 'msc')
-CSV_HEADER = 'scheme,targets,robots,seed,cct_s,finished,wall_s,mean_capture_s\n'
+CSV_HEADER = 'scheme,targets,robots,seed,cct_s,finished,wall_s,mean_capture_s,cpu_s\n'
 EXPERIMENTS = ('main', 'robots', 'pf')
 
 
@@ -54,10 +56,12 @@ class RunOutcome:
     finished: bool
     wall_time_s: float
     mean_capture_s: float = math.nan
+    cpu_time_s: float = math.nan
 
 
 def _run_one(job: tuple[str, int, int, int, float]) -> RunOutcome:
     scheme, n_targets, n_robots, seed, max_time_s = job
+    start_cpu = time.process_time()
     result = run_batch(
         BatchScenario(
             scheme=Scheme(scheme),
@@ -67,12 +71,13 @@ def _run_one(job: tuple[str, int, int, int, float]) -> RunOutcome:
             max_time_s=max_time_s,
         )
     )
+    cpu = time.process_time() - start_cpu
     finished = not math.isnan(result.cct_s)
     cct = result.cct_s if finished else max_time_s
     times = np.where(np.isnan(result.capture_times_s), max_time_s, result.capture_times_s)
     mean_capture = float(times.mean()) if times.size else math.nan
     return RunOutcome(
-        scheme, n_targets, n_robots, seed, cct, finished, result.wall_time_s, mean_capture
+        scheme, n_targets, n_robots, seed, cct, finished, result.wall_time_s, mean_capture, cpu
     )
 
 
@@ -86,7 +91,8 @@ def _log(outcome: RunOutcome, csv_path: Path | None) -> RunOutcome:
     status = f'{outcome.cct_s:7.0f} s' if outcome.finished else 'unfinished'
     print(
         f'  {outcome.scheme:8s} {outcome.n_targets:2d} targets {outcome.n_robots:2d} robots '
-        f'seed {outcome.seed:2d}: CCT {status}, wall {outcome.wall_time_s:5.1f} s',
+        f'seed {outcome.seed:2d}: CCT {status}, CPU {outcome.cpu_time_s:5.1f} s, '
+        f'wall {outcome.wall_time_s:5.1f} s',
         flush=True,
     )
     return outcome
@@ -95,7 +101,7 @@ def _log(outcome: RunOutcome, csv_path: Path | None) -> RunOutcome:
 def _csv_row(o: RunOutcome) -> str:
     return (
         f'{o.scheme},{o.n_targets},{o.n_robots},{o.seed},{o.cct_s:.0f},{o.finished:d},'
-        f'{o.wall_time_s:.1f},{o.mean_capture_s:.0f}\n'
+        f'{o.wall_time_s:.1f},{o.mean_capture_s:.0f},{o.cpu_time_s:.1f}\n'
     )
 
 
@@ -108,19 +114,23 @@ def _run_all(
         return [_log(outcome, csv_path) for outcome in pool.map(_run_one, jobs)]
 
 
-def _stats(outcomes: list[RunOutcome]) -> tuple[float, float, int, float]:
+def _stats(outcomes: list[RunOutcome]) -> tuple[float, float, int, str]:
     cct = np.array([o.cct_s for o in outcomes])
     unfinished = sum(not o.finished for o in outcomes)
-    wall = float(np.mean([o.wall_time_s for o in outcomes]))
-    return float(cct.mean()), float(cct.std()), unfinished, wall
+    wall = np.mean([o.wall_time_s for o in outcomes])
+    cpu = [o.cpu_time_s for o in outcomes if not math.isnan(o.cpu_time_s)]
+    cost = f'{np.mean(cpu):.0f}/{wall:.0f}' if cpu else f'-/{wall:.0f}'
+    return float(cct.mean()), float(cct.std()), unfinished, cost
 
 
 def pf_update_time_ms(
     n_targets: int = 20, repeats: int = 200, observers: int = 1
 ) -> tuple[float, float]:
-    """Median wall and CPU time [ms] of one update of ``n_targets`` filters (Table I's N_p).
+    """Median wall and CPU time [ms] of one step of ``n_targets`` filters (Table I's N_p).
 
-    CPU time (this process only) is the better figure on a machine shared with other jobs.
+    A step is what a robot does with one control period's samples: the (fused) update of
+    every filter and the convergence test. CPU time (this process only) is the better figure
+    on a machine shared with other jobs.
     """
     radio = RadioConfig()
     rng = np.random.default_rng(0)
@@ -140,17 +150,18 @@ def pf_update_time_ms(
         batch = [observation(p) for p in where]
         start, start_cpu = time.perf_counter(), time.process_time()
         bank.update_joint(batch)
+        bank.end_step()
         if i >= 5:
             wall.append(time.perf_counter() - start)
             cpu.append(time.process_time() - start_cpu)
     return 1e3 * float(np.median(wall)), 1e3 * float(np.median(cpu))
 
 
-def _cell(outcomes: list[RunOutcome]) -> tuple[str, float, int, float]:
+def _cell(outcomes: list[RunOutcome]) -> tuple[str, float, int, str]:
     if not outcomes:
-        return '-', math.nan, 0, math.nan
-    mean, std, late, wall = _stats(outcomes)
-    return f'{mean:.0f} +- {std:.0f} (n={len(outcomes)})', mean, late, wall
+        return '-', math.nan, 0, '-'
+    mean, std, late, cost = _stats(outcomes)
+    return f'{mean:.0f} +- {std:.0f} (n={len(outcomes)})', mean, late, cost
 
 
 def main_table(outcomes: list[RunOutcome], robots: int, schemes: tuple[str, ...]) -> list[str]:
@@ -161,19 +172,19 @@ def main_table(outcomes: list[RunOutcome], robots: int, schemes: tuple[str, ...]
         '',
         '| targets | '
         + ' | '.join(schemes)
-        + ' | proposed/msc | msc_pf/msc | proposed/msc_pf | unfinished | wall s/run |',
+        + ' | proposed/msc | msc_pf/msc | proposed/msc_pf | unfinished | CPU/wall s per run |',
         '|---' * (len(schemes) + 6) + '|',
     ]
     for n in sorted({o.n_targets for o in rows}):
-        cells, means, unfinished, walls = [], {}, [], []
+        cells, means, unfinished, costs = [], {}, [], []
         for scheme in schemes:
-            text, mean, late, wall = _cell(
+            text, mean, late, cost = _cell(
                 [o for o in rows if o.n_targets == n and o.scheme == scheme]
             )
             means[scheme] = mean
             cells.append(text)
             unfinished.append(f'{scheme}:{late}')
-            walls.append(f'{scheme}:{wall:.0f}')
+            costs.append(f'{scheme}:{cost}')
 
         def ratio(a: str, b: str, means: dict[str, float] = means) -> str:
             if a in means and b in means and means[b] > 0:
@@ -185,7 +196,7 @@ def main_table(outcomes: list[RunOutcome], robots: int, schemes: tuple[str, ...]
             + ' | '.join(cells)
             + f' | {ratio("proposed", "msc")} | {ratio("msc_pf", "msc")}'
             + f' | {ratio("proposed", "msc_pf")} | {" ".join(unfinished)}'
-            + f' | {" ".join(walls)} |'
+            + f' | {" ".join(costs)} |'
         )
     lines += [
         '',
@@ -233,19 +244,27 @@ def robot_table(outcomes: list[RunOutcome], n_targets: int, schemes: tuple[str, 
 
 
 def read_outcomes(path: Path) -> list[RunOutcome]:
-    """Outcomes from a CSV written by :func:`run` (e.g. of an interrupted benchmark)."""
+    """Outcomes from a CSV written by :func:`run` (e.g. of an interrupted benchmark).
+
+    Columns are found by name; files from before the mean capture time or the CPU time were
+    recorded read those as NaN.
+    """
+    header, *lines = path.read_text().splitlines()
+    names = header.split(',')
     outcomes = []
-    for line in path.read_text().splitlines()[1:]:
-        scheme, targets, robots, seed, cct, finished, wall = line.split(',')
+    for line in lines:
+        row = dict(zip(names, line.split(','), strict=True))
         outcomes.append(
             RunOutcome(
-                scheme,
-                int(targets),
-                int(robots),
-                int(seed),
-                float(cct),
-                bool(int(finished)),
-                float(wall),
+                row['scheme'],
+                int(row['targets']),
+                int(row['robots']),
+                int(row['seed']),
+                float(row['cct_s']),
+                bool(int(row['finished'])),
+                float(row['wall_s']),
+                float(row.get('mean_capture_s', 'nan')),
+                float(row.get('cpu_s', 'nan')),
             )
         )
     return outcomes
@@ -256,12 +275,12 @@ def pf_table() -> list[str]:
     one = pf_update_time_ms(20, observers=1)
     three = pf_update_time_ms(20, observers=3)
     return [
-        '## Particle-filter update time (20 targets x 5041 particles, median)',
+        '## Particle-filter step time (20 targets x 5041 particles, median)',
         '',
-        '| update | wall ms | CPU ms |',
+        '| step (update + convergence test) | wall ms | CPU ms |',
         '|---|---|---|',
         f'| one observation of 20 targets | {one[0]:.2f} | {one[1]:.2f} |',
-        f'| fused step: 3 observers x 20 targets | {three[0]:.2f} | {three[1]:.2f} |',
+        f'| fused: 3 observers x 20 targets | {three[0]:.2f} | {three[1]:.2f} |',
         '',
     ]
 
@@ -342,7 +361,7 @@ def main() -> None:
         print('\n'.join(lines))
         return
     start = time.perf_counter()
-    report, _ = run(
+    report, outcomes = run(
         experiments=tuple(args.experiments),
         targets=tuple(args.targets),
         robots=args.robots,
@@ -356,7 +375,11 @@ def main() -> None:
         workers=args.workers,
         csv_path=args.out.with_suffix('.csv') if args.out is not None else None,
     )
-    report += f'\nTotal wall time: {time.perf_counter() - start:.0f} s\n'
+    cpu = sum(o.cpu_time_s for o in outcomes)
+    report += (
+        f'\nTotal wall time: {time.perf_counter() - start:.0f} s; '
+        f'CPU time of the {len(outcomes)} runs: {cpu:.0f} s\n'
+    )
     print(report)
     if args.out is not None:
         args.out.write_text(report)
