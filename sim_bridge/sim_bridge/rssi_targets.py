@@ -154,8 +154,10 @@ class RssiTargetField:
     ) -> list[Capture]:
         """Let still robots within D_th work for ``dt_s``; return the captures it completes."""
         cfg = self.config
-        near = self.distances_m(robot_positions_m) < cfg.task_area_m
         still = np.asarray(robot_speeds_m_s, dtype=np.float64) < cfg.still_speed_m_s
+        if not still.any():
+            return []  # nobody works while moving
+        near = self.distances_m(robot_positions_m) < cfg.task_area_m
         workers = near & still[:, None] & ~self.captured[None, :]
         before = self.captured.copy()
         self.remaining_load -= cfg.work_rate_per_s * dt_s * workers.sum(axis=0)
