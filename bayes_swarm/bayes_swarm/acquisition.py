@@ -30,10 +30,15 @@ __all__ = [
 StdFunction = Callable[[np.ndarray], np.ndarray]
 
 
-def omega(points_m: np.ndarray, expected_source_m: np.ndarray) -> np.ndarray:
-    """Source-seeking term (q,) of Eq. 4 at (q, 2) points for the expected source (2,)."""
+def omega(
+    points_m: np.ndarray, expected_source_m: np.ndarray, distance_unit_m: float = 1.0
+) -> np.ndarray:
+    """Source-seeking term (q,) of Eq. 4 at (q, 2) points for the expected source (2,).
+
+    Distances are measured in ``distance_unit_m`` (the paper: metres).
+    """
     diff = np.asarray(points_m, dtype=float).reshape(-1, 2) - np.asarray(expected_source_m)
-    return 1.0 / (1.0 + np.einsum('ij,ij->i', diff, diff))
+    return 1.0 / (1.0 + np.einsum('ij,ij->i', diff, diff) / distance_unit_m**2)
 
 
 def path_points(

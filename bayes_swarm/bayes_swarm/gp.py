@@ -96,6 +96,7 @@ class GaussianProcess:
         self._hyper = Hyperparameters(config.initial_signal_variance, config.initial_length_scale_m)
         self._fitted_hyper: Hyperparameters | None = None
         self._n_at_last_fit = 0
+        self._scale_at_last_fit = 0.0
         self._x = np.zeros((0, 2))
         self._y = np.zeros(0)
         self._chol = np.zeros((0, 0))
@@ -137,7 +138,8 @@ class GaussianProcess:
         """Condition the GP on (n, 2) locations ``x_m`` and (n,) ``values``.
 
         ``optimise`` None applies the refit policy (first fit, or data grown by
-        ``refit_growth_factor`` since the last fit); True/False force it. Explicit
+        ``refit_growth_factor`` in size or largest |value| since the last fit); True/False
+        force it. Explicit
         ``hyperparameters`` skip the likelihood fit.
         """
         x = np.ascontiguousarray(x_m, dtype=float)
@@ -155,24 +157,39 @@ class GaussianProcess:
             self._hyper = hyperparameters
         else:
             if optimise is None:
-                optimise = self._fitted_hyper is None or x.shape[0] >= math.ceil(
-                    self._config.refit_growth_factor * self._n_at_last_fit
-                )
+                optimise = self._needs_refit(y)
             if optimise:
-                self._hyper = self._maximise_likelihood(x, y)
-                self._fitted_hyper = self._hyper
-                self._n_at_last_fit = x.shape[0]
+                self._refit(x, y)
         self._x, self._y = x, y
         try:
             self._chol, self._jitter = self._factor(x, self._hyper)
         except GpFitError:
             # Recover once: restart the hyperparameters from their initial values and refit.
-            self._hyper = self._maximise_likelihood(x, y, warm=False)
-            self._fitted_hyper = self._hyper
-            self._n_at_last_fit = x.shape[0]
+            self._refit(x, y, warm=False)
             self._chol, self._jitter = self._factor(x, self._hyper)
         self._weights, _ = dpotrs(self._chol, y, lower=1)
         self._chol_inv = None
+
+    def _needs_refit(self, y: np.ndarray) -> bool:
+        """Refit policy: first fit, or the data grew by the growth factor in size or in scale.
+
+        The scale (largest |value|) matters where the signal rises steeply toward the source:
+        hyperparameters fitted on the faint tail of a field extrapolate wildly once samples
+        near the peak arrive.
+        """
+        if self._fitted_hyper is None:
+            return True
+        growth = self._config.refit_growth_factor
+        scale = float(np.max(np.abs(y)))
+        return y.shape[0] >= math.ceil(growth * self._n_at_last_fit) or (
+            scale > growth * self._scale_at_last_fit
+        )
+
+    def _refit(self, x: np.ndarray, y: np.ndarray, *, warm: bool = True) -> None:
+        self._hyper = self._maximise_likelihood(x, y, warm=warm)
+        self._fitted_hyper = self._hyper
+        self._n_at_last_fit = x.shape[0]
+        self._scale_at_last_fit = float(np.max(np.abs(y)))
 
     def _factor(self, x: np.ndarray, hyper: Hyperparameters) -> tuple[np.ndarray, float]:
         """Lower Cholesky factor of K + (noise + jitter) I with escalating jitter."""
@@ -310,6 +327,11 @@ class ExtendedVariance:
         full[n:, n:] = c
         self._x = np.vstack([x, extra_m])
         self._chol = full
+
+    @property
+    def hyperparameters(self) -> Hyperparameters:
+        """Kernel hyperparameters (those of the belief GP)."""
+        return self._hyper
 
     @property
     def n_points(self) -> int:

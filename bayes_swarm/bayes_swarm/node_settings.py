@@ -65,6 +65,11 @@ PARAMETERS: tuple[ParameterSpec, ...] = (
         'fixed_alpha', -1.0, 'Constant alpha in [0, 1] instead of Algorithm 2 (-1: off).'
     ),
     ParameterSpec('outer_optimizer', 'grid', 'Eq. 1 solver: grid, cobyla or pso.'),
+    ParameterSpec(
+        'dimensionless_acquisition',
+        False,
+        'Omega in leg lengths and Sigma over prior std x leg (not in the paper).',
+    ),
     ParameterSpec('authors_negated_m', False, "Authors' defect: M = -max(mu) (inert penalty)."),
     ParameterSpec('authors_origin_paths', False, "Authors' defect: paths measured from (0, 0)."),
     ParameterSpec('authors_floor_downsampling', False, "Authors' defect: floor(n / N_max)."),
@@ -136,6 +141,7 @@ def settings_from_values(values: dict[str, Any]) -> NodeSettings:
         alpha_time_scale=float(v['alpha_time_scale']),
         fixed_alpha=None if float(v['fixed_alpha']) < 0.0 else float(v['fixed_alpha']),
         outer_optimizer=v['outer_optimizer'],
+        dimensionless_acquisition=bool(v['dimensionless_acquisition']),
         gp=GpConfig(noise_std=float(v['noise_std'])),
         authors_negated_m=bool(v['authors_negated_m']),
         authors_origin_paths=bool(v['authors_origin_paths']),

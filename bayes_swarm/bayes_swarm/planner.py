@@ -470,6 +470,15 @@ class _OuterProblem:
         self.ray_step_m = cfg.max_leg_m / self.n_steps
         # Path parameter u in [0, 1] (n_steps + 1,) of the paths sampled by values().
         self.path_u = np.linspace(0.0, 1.0, self.n_steps + 1)
+        # The paper's units: Omega with distances in metres, Sigma in signal * m. Dimensionless:
+        # Omega with distances in leg lengths V T, Sigma divided by its largest value (the prior
+        # std along the longest leg); both then lie in [0, 1] whatever the field's scale.
+        self.sigma_scale = 1.0
+        self.omega_unit_m = 1.0
+        if cfg.dimensionless_acquisition:
+            self.omega_unit_m = cfg.max_leg_m
+            prior_std = math.sqrt(ext.hyperparameters.signal_variance)
+            self.sigma_scale = 1.0 / max(prior_std * cfg.max_leg_m, 1e-300)
 
     def gamma(self, points: np.ndarray) -> np.ndarray:
         return local_penalty(
@@ -492,7 +501,10 @@ class _OuterProblem:
         std = self.ext.std(samples.reshape(-1, 2)).reshape(pts.shape[0], -1)
         length = np.hypot(offsets[:, 0], offsets[:, 1])
         sigma = length * np.trapezoid(std, u, axis=1)
-        return acquisition(self.alpha, omega(pts, self.expected), sigma, self.gamma(pts))
+        sigma *= self.sigma_scale
+        return acquisition(
+            self.alpha, omega(pts, self.expected, self.omega_unit_m), sigma, self.gamma(pts)
+        )
 
     def grid(self) -> tuple[np.ndarray, np.ndarray]:
         """Candidates (c, 2) on the polar grid of the reachable disk and their values (c,)."""
@@ -511,7 +523,10 @@ class _OuterProblem:
         )
         pts = candidates.reshape(-1, 2)
         values = acquisition(
-            self.alpha, omega(pts, self.expected), sigma.reshape(-1), self.gamma(pts)
+            self.alpha,
+            omega(pts, self.expected, self.omega_unit_m),
+            self.sigma_scale * sigma.reshape(-1),
+            self.gamma(pts),
         )
         values[~cfg.arena.contains(pts)] = -np.inf
         return pts, values

@@ -137,6 +137,10 @@ class BayesSwarmConfig:
     M = 1.2, L = 2, delta theta = 90 deg, f = 1 Hz, N_max = 1000, l_robot = 0.1 m).
     ``robot_index`` is 0-based; the first decision uses r = robot_index + 1 as in Algorithm 1.
     ``fixed_alpha`` replaces Algorithm 2 by a constant (the paper's 'alpha = 1' variant).
+    ``dimensionless_acquisition`` (not in the paper) measures Omega's distances in leg lengths
+    V T and divides Sigma by the prior std times V T, so both terms lie in [0, 1]; with the
+    paper's units Sigma dwarfs Omega on a field of large values (the avalanche, up to 47) and
+    Omega is flat far from the expected source on a large arena.
     """
 
     arena: Arena = field(default_factory=lambda: Arena(0.0, 2.4, 0.0, 2.4))
@@ -155,6 +159,7 @@ class BayesSwarmConfig:
     n_max: int = 1000
     alpha_time_scale: float = 1.0
     fixed_alpha: float | None = None
+    dimensionless_acquisition: bool = False
     outer_optimizer: OuterOptimizer = 'grid'
     inner_optimizer: Literal['newton', 'lbfgsb'] = 'newton'
     n_candidate_headings: int = 24

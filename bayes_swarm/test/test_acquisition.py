@@ -85,3 +85,9 @@ def test_planned_path_points_skip_the_start_and_respect_the_cap():
 def test_acquisition_combines_the_terms_as_eq_1():
     value = acquisition(0.25, np.array([0.8]), np.array([2.0]), np.array([0.5]))
     assert value[0] == pytest.approx((0.25 * 0.8 + 0.75 * 2.0) * 0.5)
+
+
+def test_source_seeking_term_can_measure_distances_in_another_unit():
+    points = np.array([[3.0, 4.0]])
+    assert omega(points, np.zeros(2), distance_unit_m=5.0)[0] == pytest.approx(0.5)
+    assert omega(points, np.zeros(2))[0] == pytest.approx(1.0 / 26.0)

@@ -205,3 +205,18 @@ def test_non_finite_training_data_is_rejected():
         gp.fit(np.array([[0.0, 0.0], [1.0, np.nan]]), np.array([1.0, 2.0]))
     with pytest.raises(ObservationError, match=r'\(n, 2\)'):
         gp.fit(np.zeros((3, 3)), np.zeros(3))
+
+
+def test_a_refit_follows_a_jump_in_the_signal_scale_before_the_data_doubles():
+    rng = np.random.default_rng(4)
+    x = rng.uniform(0, 3, size=(30, 2))
+    faint = 0.01 * np.cos(x[:, 0])
+    gp = GaussianProcess(GpConfig())
+    gp.fit(x[:20], faint[:20])
+    first = gp.hyperparameters
+    gp.fit(x[:25], faint[:25])
+    assert gp.hyperparameters == first  # 25 < 2 x 20 samples, same scale: no refit
+    strong = faint.copy()
+    strong[24] = 0.5  # one sample 50 times stronger than the rest
+    gp.fit(x[:25], strong[:25])
+    assert gp.hyperparameters != first

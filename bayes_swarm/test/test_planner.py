@@ -189,3 +189,28 @@ def test_fixed_alpha_replaces_the_adaptive_schedule():
     fixed.decide([0, 0], 0.0)
     leg(fixed, [0, 0], [0.71, 0.71])
     assert fixed.decide([0.71, 0.71], 50.0).alpha == 1.0
+
+
+def _decision_on_scaled_field(scale, dimensionless):
+    cfg = BayesSwarmConfig(
+        dimensionless_acquisition=dimensionless,
+        fixed_alpha=0.9,
+        gp=GpConfig(noise_std=1e-3 * scale),
+        max_signal=1.2 * scale,
+        lipschitz=2.0 * scale,
+    )
+    planner = BayesSwarmPlanner(cfg, 'r0', seed=1)
+    planner.decide([0, 0], 0.0)
+    for end in ([0.26, 0.97], [0.71, 0.71], [0.97, 0.26]):
+        pts = np.linspace([0, 0], end, 11)
+        planner.add_observations(pts, scale * case1_field(pts))
+    # 0.36 m from the expected source (2.4, 1.49): Omega asks for a short leg, Sigma a long one.
+    return planner.decide([2.1, 1.3], 10.0).waypoint_m
+
+
+def test_dimensionless_acquisition_makes_the_decision_independent_of_the_signal_scale():
+    same = _decision_on_scaled_field(1.0, True)
+    np.testing.assert_allclose(_decision_on_scaled_field(100.0, True), same, atol=1e-3)
+    # In the paper's units a 100 times stronger field lets the exploration term dominate.
+    paper = _decision_on_scaled_field(1.0, False)
+    assert np.hypot(*(_decision_on_scaled_field(100.0, False) - paper)) > 0.5

@@ -139,6 +139,8 @@ class SignalCase:
         direction_range_deg: delta theta of the first decision.
         observation_rate_hz: f_Hz.
         default_robots: swarm size used in the paper for this case.
+        dimensionless_acquisition: the planners' acquisition terms in [0, 1] (see
+            BayesSwarmConfig); on for the avalanche, whose signal reaches 47.
     """
 
     name: str
@@ -156,6 +158,7 @@ class SignalCase:
     observation_rate_hz: float = 1.0
     default_robots: int = 5
     depot_direction_offsets_deg: tuple[float, ...] = field(default=(0.0,))
+    dimensionless_acquisition: bool = False
 
     def depot_of(self, robot_index: int) -> int:
         """Index of the depot robot ``robot_index`` (0-based) starts from."""
@@ -259,6 +262,7 @@ def _avalanche() -> SignalCase:
         direction_range_deg=90.0,
         observation_rate_hz=0.5,
         default_robots=6,
+        dimensionless_acquisition=True,
     )
 
 

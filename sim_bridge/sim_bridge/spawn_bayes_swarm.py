@@ -215,6 +215,7 @@ def node_parameters(case: SignalCase, settings: SpawnSettings, n: int, i: int) -
         'lipschitz': float(case.lipschitz),
         'noise_std': float(max(1e-3, settings.noise_std)),
         'outer_optimizer': settings.outer_optimizer,
+        'dimensionless_acquisition': case.dimensionless_acquisition,
     }
     params.update(settings.extra_parameters)
     return params
@@ -247,6 +248,7 @@ def batch_mission_spec(
         initial_direction_range_deg=case.direction_range_deg,
         max_signal=case.max_signal,
         lipschitz=case.lipschitz,
+        dimensionless_acquisition=case.dimensionless_acquisition,
     )
     options = dict(planner_options or {})
     if noise_std > 0.0:
