@@ -134,8 +134,9 @@ def systematic_counts(
     k, n = weights.shape
     c = np.cumsum(weights, axis=1, dtype=np.float32, out=work)
     # Rows are non-decreasing, so only rows whose total exceeds 1 need the cap.
-    for row in np.flatnonzero(c[:, -1] > np.float32(1.0)):
-        np.minimum(c[row], np.float32(1.0), out=c[row])
+    if c[:, -1].max() > 1.0:
+        for row in np.flatnonzero(c[:, -1] > np.float32(1.0)):
+            np.minimum(c[row], np.float32(1.0), out=c[row])
     c *= np.float32(n)
     c -= offsets.astype(np.float32)
     np.ceil(c, out=c)
@@ -402,6 +403,7 @@ class ParticleFilterBank:
             return []
         slots = sorted(samples)
         first = np.array([samples[slot][0] for slot in slots])
+        first[:, 2] -= self._radio.rssi_at_1m_dbm
         # Later samples, level by level (a filter's second samples, then its third...), each
         # level in row order: the log-likelihoods add up in observation order.
         extra: list[tuple[int, float, float, float]] = []
@@ -414,15 +416,14 @@ class ParticleFilterBank:
             if len(extra) == start:
                 break
             level += 1
-        return self._update_slots(
-            np.array(slots, dtype=np.int64),
-            first[:, :2],
-            first[:, 2],
-            np.array(extra).reshape(-1, 4),
-        )
+        later = np.array(extra).reshape(-1, 4)
+        later[:, 3] -= self._radio.rssi_at_1m_dbm
+        return self._update_slots(np.array(slots, dtype=np.int64), first, later)
 
-    def _log_likelihood(self, d2: np.ndarray, values: np.ndarray, out: np.ndarray) -> np.ndarray:
+    def _log_likelihood(self, d2: np.ndarray, excess: np.ndarray, out: np.ndarray) -> np.ndarray:
         """Eqs. (3)-(4) in log form, -((P - P0) + 5 K log10 d^2)^2 / sigma^2, into ``out``.
+
+        ``excess`` is the (rows, 1) float32 column of P - P0 [dB].
 
         With the censoring correction, ``-log Phi((R_j - gamma_D) / s)`` is added, looked up
         in a table indexed by the path loss ``10 K log10 d``.
@@ -440,7 +441,7 @@ class ParticleFilterBank:
             index = self._counts[:rows, :cols]  # free until resampling
             index[...] = scaled
             censor = np.take(self._censor_table, index, out=scaled)
-        out += (np.asarray(values) - self._radio.rssi_at_1m_dbm).astype(np.float32)[:, None]
+        out += excess
         np.multiply(out, out, out=out)
         out *= np.float32(-1.0 / self._denominator)
         if censor is not None:
@@ -450,7 +451,7 @@ class ParticleFilterBank:
     def _add_extra_samples(self, a: np.ndarray, x: np.ndarray, y: np.ndarray, extra: np.ndarray):
         """Add the log-likelihoods of the later samples to ``a`` (rows of the first samples).
 
-        ``extra`` holds (row, observer x, observer y, RSSI) per sample, level by level; the
+        ``extra`` holds (row, observer x, observer y, P - P0) per sample, level by level; the
         samples are evaluated in blocks as large as the work buffers.
         """
         k = a.shape[0]
@@ -461,8 +462,8 @@ class ParticleFilterBank:
             chunk = extra[start : start + block]
             m = len(rows)
             ex, ey, ll = self._buf_nx[:m], self._buf_ny[:m], self._buf_cum[:m]
-            ox = chunk[:, 1:2].astype(np.float32)
-            oy = chunk[:, 2:3].astype(np.float32)
+            chunk32 = chunk.astype(np.float32)
+            ox, oy = chunk32[:, 1:2], chunk32[:, 2:3]
             if k == 1:
                 np.subtract(x[0], ox, out=ex)
                 np.subtract(y[0], oy, out=ey)
@@ -472,7 +473,7 @@ class ParticleFilterBank:
             ex *= ex
             ey *= ey
             ex += ey
-            self._log_likelihood(ex, chunk[:, 3], out=ll)
+            self._log_likelihood(ex, chunk32[:, 3:], out=ll)
             # One level has each row at most once and in order; a row's levels come in order.
             i = 0
             while i < m:
@@ -487,10 +488,15 @@ class ParticleFilterBank:
                     a[rows[i:j]] += ll[i:j]
                 i = j
 
-    def _update_slots(
-        self, slots: np.ndarray, observers: np.ndarray, values: np.ndarray, extra: np.ndarray
-    ) -> list[int]:
+    def _update_slots(self, slots: np.ndarray, first: np.ndarray, extra: np.ndarray) -> list[int]:
+        """Update the filters in ``slots`` (sorted) with their samples.
+
+        ``first`` holds each filter's first sample (observer x, observer y, P - P0), ``extra``
+        the later ones as in :meth:`_add_extra_samples`.
+        """
         k = slots.size
+        observers = first[:, :2]
+        first32 = first.astype(np.float32)
         contiguous = bool(slots[-1] == k - 1)  # slots are sorted and distinct
         if contiguous:
             x, y = self._x[:k], self._y[:k]
@@ -502,21 +508,21 @@ class ParticleFilterBank:
 
         # Offsets from each filter's first observer; the estimate is accumulated relative to
         # it so float32 keeps millimetres.
-        np.subtract(x, observers[:, :1].astype(np.float32), out=dx)
-        np.subtract(y, observers[:, 1:].astype(np.float32), out=dy)
+        np.subtract(x, first32[:, 0:1], out=dx)
+        np.subtract(y, first32[:, 1:2], out=dy)
         np.multiply(dx, dx, out=d2)
         np.multiply(dy, dy, out=a)
         d2 += a
-        self._log_likelihood(d2, values, out=a)
+        self._log_likelihood(d2, first32[:, 2:], out=a)
         if len(extra):
             self._add_extra_samples(a, x, y, extra)
         peak = a.max(axis=1)
         degenerate = ~(peak >= _LOG_TINY)  # also catches NaN
-        # Eq. (2): normalised weights exp(l - max) / sum; degenerate rows are handled below.
-        a -= np.where(degenerate, 0.0, peak).astype(np.float32)[:, None]
+        # Eq. (2): normalised weights exp(l - max) / sum (each row's largest is 1, so the sum
+        # is at least 1); degenerate rows are re-initialised below.
+        a -= peak[:, None]
         np.exp(a, out=a)
         total = a.sum(axis=1, dtype=np.float32).astype(np.float64)
-        total[degenerate | ~(total > 0.0)] = 1.0
         a *= (1.0 / total).astype(np.float32)[:, None]
 
         # Eq. (5), the spread and the largest-weight particle (pre-resampling weights).
@@ -526,7 +532,7 @@ class ParticleFilterBank:
         ex, ey = observers[:, 0] + mx, observers[:, 1] + my
         best = a.argmax(axis=1)
         rows = np.arange(k)
-        best_xy = np.stack([x[rows, best], y[rows, best]], axis=1).astype(np.float64)
+        best_x, best_y = x[rows, best], y[rows, best]
 
         if degenerate.any():
             # Re-initialised below; uniform weights keep the resampling well defined.
@@ -547,7 +553,8 @@ class ParticleFilterBank:
         self._estimate[slots, 0] = ex
         self._estimate[slots, 1] = ey
         self._spread[slots] = np.sqrt(np.maximum(spread2, 0.0))
-        self._best[slots] = best_xy
+        self._best[slots, 0] = best_x
+        self._best[slots, 1] = best_y
         self._updated[slots] = True
         self._any_updated = True
         self._n_updates[slots] += 1
@@ -555,10 +562,11 @@ class ParticleFilterBank:
             self._n_updates[slots] += np.bincount(extra[:, 0].astype(np.int64), minlength=k)
 
         reinitialised: list[int] = []
-        for row in np.flatnonzero(degenerate):
-            slot = int(slots[row])
-            self._reinitialise(slot, observers[row])
-            reinitialised.append(self._ids[slot])
+        if degenerate.any():
+            for row in np.flatnonzero(degenerate):
+                slot = int(slots[row])
+                self._reinitialise(slot, observers[row])
+                reinitialised.append(self._ids[slot])
         return reinitialised
 
     def _resample(
@@ -596,21 +604,19 @@ class ParticleFilterBank:
         else:
             noise = self._rng.standard_normal((2, k, self._n), dtype=np.float32)
         b = self._buf_b[:k]
-        np.multiply(noise[0], sx.astype(np.float32)[:, None], out=b)
+        np.multiply(noise[0], sx[:, None], out=b)
         x += b
-        np.multiply(noise[1], sy.astype(np.float32)[:, None], out=b)
+        np.multiply(noise[1], sy[:, None], out=b)
         y += b
         # Clipping is skipped when no jitter from the pool can push a particle out (the bound
         # is loose, so a skipped clip would not have changed anything).
         field = self._field_size_m
-        inside = need <= self._pool.size
-        for lo, hi, sigma in ((x_lo, x_hi, sx), (y_lo, y_hi, sy)):
-            reach = 1.001 * self._pool_abs_max * sigma.astype(np.float64) + 0.01
-            inside = (
-                inside
-                and float((lo.astype(np.float64) - reach).min()) >= 0.0
-                and float((hi.astype(np.float64) + reach).max()) <= field
-            )
+        reach = 1.001 * self._pool_abs_max * max(float(sx.max()), float(sy.max())) + 0.01
+        inside = (
+            need <= self._pool.size
+            and min(float(x_lo.min()), float(y_lo.min())) - reach >= 0.0
+            and max(float(x_hi.max()), float(y_hi.max())) + reach <= field
+        )
         if not inside:
             np.clip(x, 0.0, field, out=x)
             np.clip(y, 0.0, field, out=y)
