@@ -437,10 +437,10 @@ class ParticleFilterBank:
             scaled = self._buf_censor[:rows, :cols]
             np.subtract(out, np.float32(self._censor_lo_db), out=scaled)
             scaled *= np.float32(self._censor_inv_step)
-            np.clip(scaled, 0.0, np.float32(self._censor_table.size - 1), out=scaled)
             index = self._counts[:rows, :cols]  # free until resampling
-            index[...] = scaled
-            censor = np.take(self._censor_table, index, out=scaled)
+            index[...] = scaled  # truncation; the path loss is small enough for int32
+            # Clamping the truncated bin equals truncating the clamped value.
+            censor = np.take(self._censor_table, index, out=scaled, mode='clip')
         out += excess
         np.multiply(out, out, out=out)
         out *= np.float32(-1.0 / self._denominator)
