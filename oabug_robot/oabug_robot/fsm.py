@@ -116,6 +116,8 @@ class FsmMemory:
     preferred_direction_rad: float = 0.0
     target_yaw_rad: float = 0.0
     wrap_start_yaw_rad: float = 0.0
+    previous_yaw_rad: float | None = None
+    arc_without_wall_rad: float = 0.0
     leave_at_next_corner: bool = False
     visit_count: int = 0
     flip_count: int = 0
@@ -189,6 +191,10 @@ class OABugFsm:
         cfg = self._config
         scan = snap.scan
         front_blocked = scan.front_wall_m <= cfg.perception.wall_hit_distance_m
+        yaw_change = 0.0
+        if mem.previous_yaw_rad is not None:
+            yaw_change = angle_difference(snap.yaw_rad, mem.previous_yaw_rad)
+        mem.previous_yaw_rad = snap.yaw_rad
         # Only a robot that drives can hit another: not while it turns on the spot (to a
         # heading, or away from a wall at an inner corner).
         driving = mem.mode is not Mode.TURN and not (mem.mode is Mode.FOLLOW and front_blocked)
@@ -215,6 +221,8 @@ class OABugFsm:
             # Turning away from an inner corner swings the old wall out of the abeam strip
             # before the new one comes in: that is no outer corner.
             self._corners.reset()
+            if mem.state is FsmState.JUST_STARTED and cfg.inner_corner_resumes_following:
+                self._on_inner_corner_after_revisit()
         elif self._corners.update(scan.side(mem.wall_side)):
             self._on_outer_corner(snap)
             if mem.mode is Mode.TURN:
@@ -222,7 +230,29 @@ class OABugFsm:
                 return turn_in_place(error, cfg.motion)
             if mem.mode is Mode.WRAP:
                 return wrap_corner(mem.wall_side, cfg.motion)
-        return follow_wall(mem.wall_side, scan.side(mem.wall_side), front_blocked, cfg.motion)
+        wall = scan.side(mem.wall_side)
+        if mem.mode is Mode.FOLLOW and self._wall_lost(wall.found, front_blocked, yaw_change):
+            self._leave_wall(mem.preferred_direction_rad, Event.LEAVE_WALL)
+            error = angle_difference(mem.target_yaw_rad, snap.yaw_rad)
+            return turn_in_place(error, cfg.motion)
+        return follow_wall(mem.wall_side, wall, front_blocked, cfg.motion)
+
+    def _wall_lost(self, wall_found: bool, front_blocked: bool, yaw_change_rad: float) -> bool:
+        """True once the follower has arced ``lost_wall_arc_rad`` towards its side unseen.
+
+        With no wall beside it the follower arcs towards its side until one is back (round
+        a wall end that is not a corner of the grid, or a thin jamb). A "wall" that was a
+        peer taken for a wall, or a follower pushed off its wall into open space, leaves it
+        circling on the spot for ever; the authors' grid robots, always touching their wall,
+        could not lose it. After that much arc the robot leaves towards its preferred
+        direction, as it does when it starts.
+        """
+        mem = self._memory
+        if wall_found or front_blocked:
+            mem.arc_without_wall_rad = 0.0
+            return False
+        mem.arc_without_wall_rad += max(0.0, mem.wall_side * yaw_change_rad)
+        return mem.arc_without_wall_rad >= self._config.motion.lost_wall_arc_rad
 
     def _on_hit_robot(self, snap: SensorSnapshot) -> None:
         """Hitting others: turn right by 90 deg and start again (paper).
@@ -258,7 +288,20 @@ class OABugFsm:
         mem.mode = Mode.FOLLOW
         mem.wall_side = side
         mem.leave_at_next_corner = False
+        mem.arc_without_wall_rad = 0.0
         self._corners.reset()
+        self._record(Event.HIT_WALL)
+
+    def _on_inner_corner_after_revisit(self) -> None:
+        """Hitting a wall in Just Started (still on the wall after a revisit): Following Wall.
+
+        Paper Fig. 3: hitting a wall takes Just Started to Following Wall, so the pending
+        departure is dropped and the next outer corner is checked for scent again. The robot
+        keeps its wall side: at an inner corner it can only turn away from the wall ahead.
+        """
+        mem = self._memory
+        mem.state = FsmState.FOLLOWING_WALL
+        mem.leave_at_next_corner = False
         self._record(Event.HIT_WALL)
 
     def _side_from_sound(self, theta_rad: float, yaw_rad: float, default_side: int) -> int:
@@ -320,6 +363,7 @@ class OABugFsm:
         mem = self._memory
         mem.mode = Mode.WRAP
         mem.wrap_start_yaw_rad = snap.yaw_rad
+        mem.arc_without_wall_rad = 0.0
         self._corners.reset()
 
     def _leave_wall(self, heading_rad: float, event: Event) -> None:
@@ -333,6 +377,7 @@ class OABugFsm:
         mem.mode = Mode.TURN
         mem.target_yaw_rad = wrap_angle(heading_rad)
         mem.wall_side = 0
+        mem.arc_without_wall_rad = 0.0
         mem.leave_at_next_corner = False
 
     def _sound_direction(self, snap: SensorSnapshot) -> float | None:

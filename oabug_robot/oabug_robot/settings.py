@@ -209,6 +209,9 @@ class MotionConfig:
             random_turn_probability after each such distance driven (the authors' action
             length, 0.1 m).
         random_turn_probability: see random_step_m (authors' simulator: 1/2).
+        lost_wall_arc_rad: a follower that has arced this far towards its side without a
+            wall beside it has lost the wall and leaves towards its preferred direction
+            (going round a wall end takes at most half a turn) [rad].
     """
 
     forward_speed_mps: float = 0.3
@@ -221,6 +224,7 @@ class MotionConfig:
     wall_angle_gain_per_s: float = 2.5
     random_step_m: float = 0.1
     random_turn_probability: float = 0.5
+    lost_wall_arc_rad: float = 1.5 * math.pi
 
     def __post_init__(self) -> None:
         for f in fields(self):
@@ -253,6 +257,10 @@ class OABugConfig:
             (paper: "e.g., three times"; counted as >=, like the authors' simulator).
         visit_count_resets_on_fresh_corner: forget the revisit count at an unscented corner,
             i.e. count revisits in a row (the paper's "nearby area thoroughly searched").
+        inner_corner_resumes_following: a wall hit at an inner corner while the robot is
+            still on its wall after a revisit (Just Started) takes it back to Following Wall,
+            as paper Fig. 3 and the authors' simulator do, so the next outer corner is
+            checked for scent again; False keeps the departure for the next outer corner.
         fixed_turn: side turned to at a first wall contact without sound, and after hitting
             another robot (paper: "all turn right").
         robot_hit_repeat_s: a robot hit this soon after the previous one turns to a random
@@ -284,6 +292,7 @@ class OABugConfig:
     scent_window_s: float = 2.0
     revisit_flip_count: int = 3
     visit_count_resets_on_fresh_corner: bool = True
+    inner_corner_resumes_following: bool = True
     fixed_turn: TurnDirection = TurnDirection.RIGHT
     robot_hit_repeat_s: float = 4.0
     sound_turn_rule: SoundTurnRule = SoundTurnRule.TOWARD

@@ -316,6 +316,96 @@ def test_scented_outer_corner_switches_to_just_started_and_leaves_at_the_next_on
     assert fsm.memory.target_yaw_rad == pytest.approx(fsm.memory.preferred_direction_rad)
 
 
+def revisit(script: Script, follow_steps: int = 8) -> None:
+    """Hit a wall, pass a scented outer corner and finish the arc round it (Just Started)."""
+    reach_wall(script)
+    script.follow_straight(1)
+    script.gas_raw = 400
+    script.pass_outer_corner(1)
+    script.gas_raw = 0
+    script.finish_wrap(1)
+    script.follow_straight(1, steps=follow_steps)
+
+
+def inner_corner() -> ScanFeatures:
+    return ScanFeatures(front_wall_m=0.2, left=SideWall(0.25, 0.0, abeam=True))
+
+
+@pytest.mark.parametrize('variant', [Variant.GAS, Variant.GAS_SOUND])
+def test_an_inner_corner_after_a_revisit_returns_to_following_wall(variant: Variant) -> None:
+    """Paper Fig. 3: hitting a wall in Just Started leads to Following Wall."""
+    fsm = make(variant, robot_count=1)
+    script = Script(fsm)
+    revisit(script)
+    assert fsm.memory.state is FsmState.JUST_STARTED
+    assert fsm.memory.leave_at_next_corner
+    command = script.step(inner_corner())
+    assert fsm.memory.state is FsmState.FOLLOWING_WALL
+    assert fsm.memory.event is Event.HIT_WALL
+    assert not fsm.memory.leave_at_next_corner
+    assert fsm.memory.wall_side == 1, 'it keeps the wall it follows'
+    assert command.linear_mps == 0.0
+    assert command.angular_radps < 0.0, 'turning right, away from the wall ahead'
+    script.step(side_wall(1), yaw_rad=-math.pi / 2)
+    script.follow_straight(1)
+    script.pass_outer_corner(1)
+    assert fsm.memory.event is Event.OUTER_CORNER, 'an unscented corner: into the room'
+    assert fsm.memory.mode is Mode.WRAP
+
+
+def test_with_inner_corners_kept_the_robot_leaves_at_the_next_outer_corner() -> None:
+    fsm = make(Variant.GAS, robot_count=1, inner_corner_resumes_following=False)
+    script = Script(fsm)
+    revisit(script)
+    script.step(inner_corner())
+    assert fsm.memory.state is FsmState.JUST_STARTED
+    script.step(side_wall(1), yaw_rad=-math.pi / 2)
+    script.follow_straight(1)
+    script.pass_outer_corner(1)
+    assert fsm.memory.event is Event.LEAVE_WALL
+    assert fsm.memory.mode is Mode.TURN
+
+
+@pytest.mark.parametrize('variant', BUG_VARIANTS)
+def test_a_follower_that_circles_without_a_wall_leaves_towards_its_preferred_direction(
+    variant: Variant,
+) -> None:
+    fsm = make(variant, robot_count=1, heading_bias_rad=0.4)
+    script = Script(fsm, yaw_rad=0.4)
+    reach_wall(script)
+    assert fsm.memory.mode is Mode.FOLLOW
+    side = fsm.memory.wall_side
+    yaw = script.yaw_rad
+    arc_rad = fsm.config.motion.lost_wall_arc_rad
+    step_rad = math.radians(5.0)
+    turned = 0.0
+    while turned + step_rad < arc_rad:
+        command = script.step(free(), yaw_rad=yaw + side * turned)
+        assert fsm.memory.mode is Mode.FOLLOW, f'still looking for the wall at {turned:.2f} rad'
+        assert command.linear_mps > 0.0
+        assert command.angular_radps * side > 0.0, 'arcing towards the side of the wall'
+        turned += step_rad
+    command = script.step(free(), yaw_rad=yaw + side * (turned + step_rad))
+    assert fsm.memory.event is Event.LEAVE_WALL
+    assert fsm.memory.state is FsmState.JUST_STARTED
+    assert fsm.memory.mode is Mode.TURN
+    assert fsm.memory.target_yaw_rad == pytest.approx(fsm.memory.preferred_direction_rad)
+
+
+def test_going_round_a_wall_end_does_not_count_as_losing_the_wall() -> None:
+    fsm = make(Variant.MINIMUM, robot_count=1)
+    script = Script(fsm)
+    reach_wall(script)
+    for k in range(40):
+        # Half a turn without a wall beside it, then the wall is back: the count restarts.
+        script.step(free(), yaw_rad=math.radians(4.5 * k))
+    script.step(side_wall(1, abeam=False), yaw_rad=math.pi)
+    for k in range(40):
+        script.step(free(), yaw_rad=math.pi + math.radians(4.5 * k))
+    assert fsm.memory.mode is Mode.FOLLOW
+    assert fsm.memory.state is FsmState.FOLLOWING_WALL
+
+
 def test_scent_older_than_the_window_does_not_count_as_a_revisit() -> None:
     fsm = make(Variant.GAS, scent_window_s=1.0)
     script = Script(fsm)
@@ -341,13 +431,7 @@ def test_scent_below_the_threshold_is_not_a_revisit() -> None:
 
 def revisit_and_leave(script: Script) -> None:
     """Hit a wall, pass a scented corner, pass the next corner (and leave), head out again."""
-    reach_wall(script)
-    script.follow_straight(1)
-    script.gas_raw = 400
-    script.pass_outer_corner(1)
-    script.gas_raw = 0
-    script.finish_wrap(1)
-    script.follow_straight(1, steps=25)
+    revisit(script, follow_steps=25)
     script.pass_outer_corner(1)
     script.step(free(), yaw_rad=script.fsm.memory.target_yaw_rad)
 
@@ -504,13 +588,7 @@ def test_gas_sound_leaves_a_revisited_wall_towards_the_sound_direction(
     )
     phi = fsm.memory.preferred_direction_rad
     script = Script(fsm, yaw_rad=phi)
-    reach_wall(script)
-    script.follow_straight(1)
-    script.gas_raw = 300
-    script.pass_outer_corner(1)
-    script.gas_raw = 0
-    script.finish_wrap(1)
-    script.follow_straight(1, steps=25)
+    revisit(script, follow_steps=25)
     script.hear([0.0], [2.0])  # peer straight ahead: theta_opp behind
     expected = script.yaw_rad + math.pi
     script.pass_outer_corner(1)
