@@ -272,7 +272,7 @@ class RobotController:
         change = self.membership.update(self._peers, own_target, self.phase)
         self._swarm_changes = (change,) if change else ()
 
-        neighbours = np.array([p.position_m for p in self._peers.values()]).reshape(-1, 2)
+        neighbours = [p.position_m for p in self._peers.values()]
         avoidance = avoidance_vector(position, neighbours, self.config.avoidance)
         leader = self._peers.get(self.membership.leader_id)
         if self.phase == Phase.WORK:
