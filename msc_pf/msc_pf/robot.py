@@ -48,6 +48,7 @@ from msc_pf.targeting import Candidate, select_retarget
 __all__ = ['RobotController', 'RobotStatus', 'StepOutput']
 
 _GOAL_PHASES = (Phase.DIRECT_APPROACH,)
+_NO_GOAL = (math.nan, math.nan)
 _MSC_PHASES = (Phase.MSC_APPROACH, Phase.FINAL_APPROACH, Phase.WORK)
 
 
@@ -221,7 +222,9 @@ class RobotController:
             ObservationError: position not finite, or time not advancing.
         """
         position = np.asarray(position_m, dtype=np.float64)
-        if position.shape != (2,) or not np.all(np.isfinite(position)):
+        if position.shape != (2,) or not (
+            math.isfinite(position[0]) and math.isfinite(position[1])
+        ):
             raise ObservationError(f'position must be 2 finite numbers, got {position_m!r}')
         if not now_s > self._last_step_s:
             raise ObservationError(f'time {now_s} s does not advance past {self._last_step_s} s')
@@ -575,6 +578,7 @@ class RobotController:
         rssi = math.nan if mean is None else mean
         evaluation = self._evaluation(target, now_s) if target != NO_TARGET else math.nan
         role = self.membership.role
+        captured = tuple(sorted(self._captured))
         broadcast = PeerInfo(
             robot_id=self.robot_id,
             stamp_s=float(now_s),
@@ -588,10 +592,10 @@ class RobotController:
             target_rssi_dbm=rssi,
             evaluation=evaluation,
             readings=tuple(sorted(own.items())),
-            captured_ids=tuple(sorted(self._captured)),
+            captured_ids=captured,
             visited_cell=own_cell,
         )
-        goal = self._goal.copy() if self.phase == Phase.DIRECT_APPROACH else np.full(2, np.nan)
+        goal = self._goal.copy() if self.phase == Phase.DIRECT_APPROACH else np.array(_NO_GOAL)
         status = RobotStatus(
             robot_id=self.robot_id,
             stamp_s=float(now_s),
@@ -606,7 +610,7 @@ class RobotController:
                 if self._bank is not None and self._with_estimates
                 else ()
             ),
-            captured_ids=tuple(sorted(self._captured)),
+            captured_ids=captured,
         )
         changes, self._swarm_changes = self._swarm_changes, ()
         return StepOutput(displacement, vector.copy(), broadcast, status, tuple(events), changes)
