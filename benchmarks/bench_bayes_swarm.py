@@ -46,7 +46,7 @@ from typing import Any  # noqa: E402
 import numpy as np  # noqa: E402
 from bayes_swarm.batch_sim import MissionSpec, run_mission  # noqa: E402
 from bayes_swarm.messages import DecisionKind  # noqa: E402
-from sim_bridge.signal_fields import get_case  # noqa: E402
+from sim_bridge.signal_fields import avalanche_case, get_case  # noqa: E402
 from sim_bridge.spawn_bayes_swarm import batch_mission_spec  # noqa: E402
 
 EXPERIMENTS = (
@@ -85,6 +85,7 @@ class Job:
     partition: str = 'strips'
     comm_range_m: float | None = None
     source_shift_m: float = 0.0
+    avalanche_depth_m: float | None = None
 
 
 @dataclass(frozen=True)
@@ -104,7 +105,11 @@ def mission_spec(job: Job, seed: int = 0) -> MissionSpec:
     A job with ``source_shift_m`` moves the field and its source by an offset drawn
     uniformly from [-shift, shift]^2 with the run's seed.
     """
-    case = get_case(job.case)
+    case = (
+        get_case(job.case)
+        if job.avalanche_depth_m is None
+        else avalanche_case(job.avalanche_depth_m)
+    )
     if job.max_mission_time_s is not None:
         case = replace(case, max_mission_time_s=job.max_mission_time_s)
     if job.source_shift_m > 0.0:
@@ -262,24 +267,36 @@ def plan_jobs(experiments: list[str], runs: int, baseline_runs: int, large_runs:
     if 'avalanche' in experiments:
         noise = 47.0 / 100.0
         av = 'Avalanche, 6 UAVs'
-        jobs += [
-            Job(
-                'avalanche', f'{av}, Bayes-Swarm-P', 'avalanche', 'bayes_swarm_p', 6, baseline_runs
-            ),
-            Job(
-                'avalanche', f'{av}, Bayes-Swarm-O', 'avalanche', 'bayes_swarm_o', 6, baseline_runs
-            ),
-            Job(
-                'avalanche',
-                f'{av}, Bayes-Swarm-P (alpha = 1)',
-                'avalanche',
-                'bayes_swarm_p',
-                6,
-                baseline_runs,
-                {'fixed_alpha': 1.0},
-            ),
-            Job('avalanche', f'{av}, Glowworm', 'avalanche', 'glowworm', 6, baseline_runs),
-            Job('avalanche', f'{av}, Levy walk', 'avalanche', 'levy', 6, baseline_runs),
+        paper_units = {'dimensionless_acquisition': False}
+        rows: list[tuple[str, str, dict[str, Any], float, float | None, float | None]] = [
+            ('Bayes-Swarm-P', 'bayes_swarm_p', {}, 0.0, None, None),
+            ('Bayes-Swarm-O', 'bayes_swarm_o', {}, 0.0, None, None),
+            ('Bayes-Swarm-P (alpha = 1)', 'bayes_swarm_p', {'fixed_alpha': 1.0}, 0.0, None, None),
+            ("Bayes-Swarm-P, paper's Eq. 1 units", 'bayes_swarm_p', paper_units, 0.0, None, None),
+            ('Glowworm', 'glowworm', {}, 0.0, None, None),
+            ('Levy walk', 'levy', {}, 0.0, None, None),
+            ('noise 0.47, Bayes-Swarm-P', 'bayes_swarm_p', {}, noise, None, None),
+            ('noise 0.47, Bayes-Swarm-O', 'bayes_swarm_o', {}, noise, None, None),
+            ('noise 0.47, Glowworm', 'glowworm', {}, noise, None, None),
+            ('beacon 5 m deep, Bayes-Swarm-P', 'bayes_swarm_p', {}, 0.0, None, 5.0),
+            ('beacon 5 m deep, noise 0.47, Bayes-Swarm-P', 'bayes_swarm_p', {}, noise, None, 5.0),
+        ]
+        for label, algorithm, options, noise_std, t_max, depth in rows:
+            jobs.append(
+                Job(
+                    'avalanche',
+                    f'{av}, {label}',
+                    'avalanche',
+                    algorithm,
+                    6,
+                    baseline_runs,
+                    options,
+                    noise_std=noise_std,
+                    max_mission_time_s=t_max,
+                    avalanche_depth_m=depth,
+                )
+            )
+        jobs.append(
             Job(
                 'avalanche',
                 f'{av}, exhaustive, T_max x30',
@@ -288,35 +305,8 @@ def plan_jobs(experiments: list[str], runs: int, baseline_runs: int, large_runs:
                 6,
                 1,
                 max_mission_time_s=3000.0,
-            ),
-            Job(
-                'avalanche',
-                f'{av}, noise 0.47, Bayes-Swarm-P',
-                'avalanche',
-                'bayes_swarm_p',
-                6,
-                baseline_runs,
-                noise_std=noise,
-            ),
-            Job(
-                'avalanche',
-                f'{av}, noise 0.47, Bayes-Swarm-O',
-                'avalanche',
-                'bayes_swarm_o',
-                6,
-                baseline_runs,
-                noise_std=noise,
-            ),
-            Job(
-                'avalanche',
-                f'{av}, noise 0.47, Glowworm',
-                'avalanche',
-                'glowworm',
-                6,
-                baseline_runs,
-                noise_std=noise,
-            ),
-        ]
+            )
+        )
     return jobs
 
 

@@ -5,7 +5,13 @@ import math
 import numpy as np
 import pytest
 from scipy.optimize import minimize
-from sim_bridge.signal_fields import CASE_NAMES, DipoleField, UnknownCaseError, get_case
+from sim_bridge.signal_fields import (
+    CASE_NAMES,
+    DipoleField,
+    UnknownCaseError,
+    avalanche_case,
+    get_case,
+)
 
 
 @pytest.mark.parametrize('name', CASE_NAMES)
@@ -99,3 +105,14 @@ def test_avalanche_peak_is_47_directly_above_the_beacon_and_decays_with_distance
 def test_unknown_case_is_rejected_with_the_choices_listed():
     with pytest.raises(UnknownCaseError, match='case1'):
         get_case('case9')
+
+
+@pytest.mark.parametrize('depth_m', [2.0, 5.0])
+def test_avalanche_lipschitz_constant_is_the_largest_gradient_of_its_field(depth_m):
+    case = avalanche_case(depth_m)
+    grid = np.linspace(10.0, 30.0, 401)
+    gx, gy = np.meshgrid(grid, grid)
+    values = case.field(np.column_stack([gx.ravel(), gy.ravel()])).reshape(gx.shape)
+    d_dy, d_dx = np.gradient(values, grid, grid)
+    assert np.hypot(d_dx, d_dy).max() == pytest.approx(case.lipschitz, rel=0.05)
+    assert case.field(case.source_m[None])[0] == pytest.approx(47.0)
