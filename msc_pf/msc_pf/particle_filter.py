@@ -20,8 +20,11 @@ most R_conv and each of the last n estimates lies within R_err of their mean. A 
 filter stays converged (its estimate keeps being refined).
 
 Particle positions are stored as float32 (x and y in separate (targets, N) arrays, the
-millimetre resolution is far below the metre-scale spread) and the work arrays are
-preallocated: 20 targets x 5041 particles update in about 2 ms on one core.
+millimetre resolution is far below the metre-scale spread), the work arrays are
+preallocated, and a filter's several samples of one step are evaluated together. One step
+of 20 targets x 5041 particles costs about 3 ms of CPU (docs/msc_pf.md, "Benchmark"); most
+of it is the resampling (cumulative sum, copy counts, gather), whose float32 arithmetic is
+kept exactly so that seeded runs stay reproducible across versions.
 """
 
 from __future__ import annotations
