@@ -101,8 +101,10 @@ class ParticleFilterConfig:
         r_err_m: radius of the permissible error circle R_err, eq. (7).
         window: number n of recent estimates tested by eq. (7), one per control step.
         noise_variance_db2: sigma^2 of eq. (3) [dB^2].
-        gaussian_likelihood: False uses the paper's exp(-e^2 / sigma^2); True the Gaussian
-            exp(-e^2 / (2 sigma^2)).
+        gaussian_likelihood: True (default) uses the Gaussian exp(-e^2 / (2 sigma^2)) for the
+            noise variance sigma^2; False the paper's eq. (3) as printed, exp(-e^2 / sigma^2),
+            which treats the 1 dB noise as 0.71 dB: with a dozen neighbours' samples fused per
+            step that filter converged tens to hundreds of metres off the target.
         censored_likelihood: divide each sample's likelihood by the chance
             Phi((R_j - gamma_D) / s) that a target at the particle would have been heard at
             all (s: the noise standard deviation the likelihood implies). The receiver reports
@@ -113,7 +115,11 @@ class ParticleFilterConfig:
         init_half_width_m: half width of the detection square [m]; None uses the radio model's
             detection range (about 292 m).
         resampling: 'systematic' (one uniform offset) or 'multinomial'.
-        roughening_kappa: kappa of the roughening jitter kappa * E * N^(-1/2).
+        roughening_kappa: kappa of the roughening jitter kappa * E * N^(-1/2). The common
+            0.2 left the static-target filter to collapse by resampling alone onto one arc of
+            the ring of distances a far swarm observes (spread under R_conv, estimate 100-400 m
+            off); 0.5 keeps that ring populated until the observations decide, while the
+            jitter it adds to the spread (about 6 m) stays well under R_conv.
         roughening_floor_m: lower bound of the jitter standard deviation [m].
         noise_pool_size: size of the pre-drawn pool of standard normals the jitter is taken
             from at a random offset (a speed choice: drawing 2 x 20 x 5041 normals per update
@@ -130,12 +136,12 @@ class ParticleFilterConfig:
     r_err_m: float = 10.0
     window: int = 10
     noise_variance_db2: float = 1.0
-    gaussian_likelihood: bool = False
+    gaussian_likelihood: bool = True
     censored_likelihood: bool = True
     initial_prior: str = 'detection_square'
     init_half_width_m: float | None = None
     resampling: str = 'systematic'
-    roughening_kappa: float = 0.2
+    roughening_kappa: float = 0.5
     roughening_floor_m: float = 0.5
     noise_pool_size: int = 1 << 20
     update_after_convergence: bool = True
@@ -173,8 +179,12 @@ class SearchConfig:
         k_o: weight of the neighbours'-history repulsion v^o.
         random_period_s: how long one random direction v^r is kept [s]; 0 redraws every step.
         cell_size_m: edge of a coverage-history cell [m].
-        history_radius_m: only cells closer than this repel [m].
-        wall_margin_m: field edges closer than this repel [m].
+        history_radius_m: only cells closer than this repel [m]. About twice the detection
+            range (292 m), so the search sees the strip its own passes already covered; with
+            150 m robots re-crossed searched ground and the last target took up to 18000 s.
+        wall_margin_m: field edges closer than this repel [m]. About half the detection range:
+            a robot that far from an edge still hears targets on it, and with 50 m the
+            history terms pressed swarms against the edges, half their coverage wasted.
         wall_weight: weight of the field-edge repulsion; None uses k_s.
     """
 
@@ -184,8 +194,8 @@ class SearchConfig:
     k_o: float = 0.5
     random_period_s: float = 10.0
     cell_size_m: float = 20.0
-    history_radius_m: float = 150.0
-    wall_margin_m: float = 50.0
+    history_radius_m: float = 600.0
+    wall_margin_m: float = 150.0
     wall_weight: float | None = None
 
     def __post_init__(self) -> None:

@@ -31,12 +31,13 @@ def noisy_rssi(observer: np.ndarray, target: np.ndarray, rng: np.random.Generato
 def test_filter_converges_on_static_target_from_moving_observers(seed):
     # Three robots abreast 20 m apart (the (b-1) formation) drive past a target ~190 m away.
     # The ring ambiguity of one RSSI sample is resolved after a few tens of metres of
-    # baseline, and eq. (7) needs a window of 10 steps: expect ~30 steps, allow 60.
+    # baseline; the roughening keeps the spread above R_conv for a while longer, and eq. (7)
+    # needs a window of 10 steps: expect 50-75 steps, allow 150.
     target = np.array([1150.0, 1120.0])
     rng = np.random.default_rng(100 + seed)
     bank = make_bank(seed)
     offsets = np.array([[0.0, 0.0], [0.0, 20.0], [0.0, -20.0]])
-    for step in range(1, 61):
+    for step in range(1, 151):
         for offset in offsets:
             observer = np.array([1000.0 + step, 1000.0]) + offset
             bank.update(observer, [3], [noisy_rssi(observer, target, rng)])
@@ -212,7 +213,7 @@ def test_joint_update_multiplies_every_sample_of_each_target(hearing):
     # Ten observers: more than one block of work rows. Filter 7 is tracked first but not
     # heard, so the updated filters are not the first rows of the bank, and target 1 (the
     # one with most samples) is the last of them.
-    bank = make_bank(3, censored_likelihood=False)
+    bank = make_bank(3, censored_likelihood=False, gaussian_likelihood=False)
     centers = {1: (1000.0, 1000.0), 2: (1100.0, 900.0), 3: (900.0, 1100.0), 4: (1000.0, 950.0)}
     bank.track(7, (400.0, 400.0))
     for tid in (2, 4, 3, 1):
