@@ -116,7 +116,10 @@ class PerceptionConfig:
     Attributes:
         robot_radius_m: radius of the own body (and of the peers' bodies) [m].
         front_half_width_m: half width of the corridor ahead checked for walls [m].
-        wall_hit_distance_m: a wall return this close ahead (from the lidar origin) is a hit [m].
+        wall_hit_distance_m: a wall return this close ahead (from the lidar origin) is a hit
+            [m]. The authors' robot hits a wall when its next 0.1 m step would touch it,
+            0.2 m from its centre; 0.22 m also lets a robot turn on the spot in the middle of
+            a 2-cell (0.53 m) corridor or room without the side walls counting as hits.
         wrap_stop_distance_m: while arcing round a wall end into a door, only a wall this
             close ahead stops the arc (the far jamb of a 0.5 m door is nearer than
             wall_hit_distance_m) [m].
@@ -153,7 +156,7 @@ class PerceptionConfig:
 
     robot_radius_m: float = 0.1
     front_half_width_m: float = 0.12
-    wall_hit_distance_m: float = 0.28
+    wall_hit_distance_m: float = 0.22
     wrap_stop_distance_m: float = 0.18
     robot_hit_distance_m: float = 0.25
     robot_cone_half_angle_rad: float = math.radians(30.0)
@@ -198,11 +201,15 @@ class MotionConfig:
 
     Attributes:
         forward_speed_mps: cruise speed [m/s].
-        turn_rate_radps: largest yaw rate commanded [rad/s].
+        turn_rate_radps: largest yaw rate commanded [rad/s]. A turn costs at most one action
+            on the authors' grid but real time from the mission budget here, so turns run at
+            the simulated body's limit (2 rad/s).
         min_turn_rate_radps: smallest yaw rate of a turn in place, so turns finish [rad/s].
         heading_gain_per_s: P gain of the heading controller [1/s].
         heading_tolerance_rad: a turn in place ends when the heading error is below this [rad].
-        wall_distance_m: distance kept from the followed wall, lidar origin to wall [m].
+        wall_distance_m: distance kept from the followed wall, lidar origin to wall [m]; the
+            authors' robots hug their wall (0.1-0.2 m centre to wall), and 0.2 m leaves room
+            in 2-cell corridors, rooms and doors.
         wall_distance_gain_radps_per_m: yaw rate per metre of wall-distance error [rad/(s m)].
         wall_angle_gain_per_s: yaw rate per radian of wall-direction error [1/s].
         random_step_m: the Random variant redraws its heading with probability
@@ -215,11 +222,11 @@ class MotionConfig:
     """
 
     forward_speed_mps: float = 0.3
-    turn_rate_radps: float = 1.5
+    turn_rate_radps: float = 2.0
     min_turn_rate_radps: float = 0.3
     heading_gain_per_s: float = 3.0
     heading_tolerance_rad: float = math.radians(3.0)
-    wall_distance_m: float = 0.25
+    wall_distance_m: float = 0.2
     wall_distance_gain_radps_per_m: float = 6.0
     wall_angle_gain_per_s: float = 2.5
     random_step_m: float = 0.1
