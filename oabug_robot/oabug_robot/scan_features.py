@@ -162,13 +162,15 @@ class ScanFeatureExtractor:
         range_min = max(float(scan.range_min_m), 0.0)
         range_max = float(scan.range_max_m)
         too_close = ranges == -math.inf
-        if too_close.any():
+        if np.count_nonzero(too_close):
             # REP 117: -inf means "too close to measure", i.e. an obstacle at range_min.
             ranges = np.where(too_close, range_min, ranges)
-        # Nothing farther than the feature range changes a feature; NaN and +inf fail both tests.
+        # Nothing farther than the feature range changes a feature; NaN and +inf fail both tests
+        # (NaN compares False without a warning).
         limit = min(range_max, self._feature_range_m)
-        with np.errstate(invalid='ignore'):
-            index = np.flatnonzero((ranges >= range_min) & (ranges <= limit))
+        keep = ranges >= range_min
+        keep &= ranges <= limit
+        index = keep.nonzero()[0]
         if index.size == 0:
             return ScanFeatures()
         r = ranges[index]
@@ -184,7 +186,8 @@ class ScanFeatureExtractor:
             else:
                 distances = np.asarray(peer_distances_m, dtype=float)
             is_peer = self._peer_mask(r, rays.angles_rad[index], azimuths, distances)
-        front = (x > 0.0) & (np.abs(y) <= cfg.front_half_width_m)
+        front = x > 0.0
+        front &= np.abs(y) <= cfg.front_half_width_m
         captured = r <= cfg.follow_capture_m
         front_robot = math.inf
         peer_returns = 0
@@ -192,13 +195,15 @@ class ScanFeatureExtractor:
             peer_returns = int(np.count_nonzero(is_peer))
             if peer_returns:
                 cone = is_peer & (cos >= math.cos(cfg.robot_cone_half_angle_rad))
-                if cone.any():
+                if np.count_nonzero(cone):
                     front_robot = float(r[cone].min())
                 is_wall = ~is_peer
                 front &= is_wall
                 captured &= is_wall
-        front_wall = float(x[front].min()) if front.any() else math.inf
-        beside = captured & (x <= cfg.side_lookahead_m) & (x >= -cfg.side_window_behind_m)
+        front_wall = float(x[front].min()) if np.count_nonzero(front) else math.inf
+        beside = captured
+        beside &= x <= cfg.side_lookahead_m
+        beside &= x >= -cfg.side_window_behind_m
         left = right = SideWall()
         if 1 in sides:
             left = self._side_wall(x, y, beside & (y > 0.0))
@@ -233,27 +238,27 @@ class ScanFeatureExtractor:
         """
         cfg = self._config
         is_peer = np.zeros(r.size, dtype=bool)
-        near = np.flatnonzero(r <= cfg.peer_mask_range_m)
-        if near.size == 0:
+        near = (r <= cfg.peer_mask_range_m).nonzero()[0]
+        finite = np.isfinite(azimuths)
+        if near.size == 0 or not np.count_nonzero(finite):
             return is_peer
         r_near = r[near]
-        a_near = angles[near]
         half_width = cfg.peer_bearing_tolerance_rad + np.arctan2(cfg.robot_radius_m, r_near)
+        # (B, K): which returns lie in the angular window of each bearing.
+        azimuths = azimuths[finite]
+        bearing = np.arctan2(np.sin(azimuths), np.cos(azimuths))
+        offset = np.abs(angles[near] - bearing[:, None])
+        window = np.minimum(offset, 2.0 * math.pi - offset) <= half_width
+        nearest = np.where(window, r_near, math.inf).min(axis=1)
+        # A peer heard far beyond its nearest return is behind a wall: the wall stays a wall
+        # (NaN distances compare False: kept).
+        heard = np.isfinite(nearest)
+        heard &= ~(distances[finite] > cfg.peer_distance_factor * (nearest + cfg.robot_radius_m))
+        if not np.count_nonzero(heard):
+            return is_peer
         body_m = 2.0 * cfg.robot_radius_m
-        peer_near = np.zeros(near.size, dtype=bool)
-        for azimuth, distance in zip(azimuths.tolist(), distances.tolist(), strict=True):
-            if not math.isfinite(azimuth):
-                continue
-            bearing = math.atan2(math.sin(azimuth), math.cos(azimuth))
-            offset = np.abs(a_near - bearing)
-            window = np.minimum(offset, 2.0 * math.pi - offset) <= half_width
-            if not window.any():
-                continue
-            nearest = float(r_near[window].min())
-            if distance > cfg.peer_distance_factor * (nearest + cfg.robot_radius_m):
-                continue  # heard through a wall (NaN compares False: kept)
-            peer_near |= window & (r_near <= nearest + body_m)
-        is_peer[near] = peer_near
+        mine = window[heard] & (r_near <= (nearest[heard] + body_m)[:, None])
+        is_peer[near] = np.logical_or.reduce(mine, axis=0)
         return is_peer
 
     def _side_wall(self, x: np.ndarray, lateral: np.ndarray, mask: np.ndarray) -> SideWall:
@@ -269,7 +274,7 @@ class ScanFeatureExtractor:
             The wall with its angle as seen on the left; the caller mirrors the right side.
         """
         cfg = self._config
-        if not mask.any():
+        if not np.count_nonzero(mask):
             return SideWall()
         xs = x[mask]
         ls = lateral[mask]
@@ -278,8 +283,8 @@ class ScanFeatureExtractor:
         near = ls <= ls.min() + cfg.side_wall_band_m
         xs = xs[near]
         ls = ls[near]
-        abeam = bool(np.any((xs >= -cfg.abeam_behind_m) & (ls <= cfg.abeam_reach_m)))
-        if xs.size < 3 or np.ptp(xs) < 0.05:
+        abeam = bool(np.count_nonzero((xs >= -cfg.abeam_behind_m) & (ls <= cfg.abeam_reach_m)))
+        if xs.size < 3 or xs.max() - xs.min() < 0.05:
             return SideWall(distance_m=float(ls.min()), angle_rad=0.0, abeam=abeam)
         angle, distance = _fit_line(xs, ls)
         # Once more without the returns off that line (a corner inside the window).
@@ -295,8 +300,9 @@ def _fit_line(xs: np.ndarray, ls: np.ndarray) -> tuple[float, float]:
 
     The direction is in (-pi/2, pi/2] from the x axis; the distance is from the origin.
     """
-    mx = float(xs.mean())
-    ml = float(ls.mean())
+    # sum / size is what mean() computes, without its Python-level overhead.
+    mx = float(xs.sum()) / xs.size
+    ml = float(ls.sum()) / ls.size
     dx = xs - mx
     dl = ls - ml
     angle = math.atan2(float(dx @ dl), float(dx @ dx))

@@ -31,7 +31,10 @@ from sim_bridge.sensors.odometry import OdometryConfig, WheelOdometry
 from sim_bridge.sensors.scent import PumpDepositor, ScentConfig, ScentField
 from sim_bridge.world import BodyConfig, World
 
-__all__ = ['EngineConfig', 'SimEngine', 'SiteGeometry', 'StepOutput']
+__all__ = ['READINGS', 'EngineConfig', 'SimEngine', 'SiteGeometry', 'StepOutput']
+
+# The per-robot readings the engine produces (the bridge's sensor topics).
+READINGS = frozenset({'scan', 'gas', 'bearings', 'imu', 'odometry'})
 
 
 @dataclass(frozen=True)
@@ -152,7 +155,27 @@ class SimEngine:
         site: SiteGeometry,
         initial_poses: np.ndarray,
         config: EngineConfig | None = None,
+        *,
+        readings: frozenset[str] = READINGS,
     ) -> None:
+        """Build the world and its models.
+
+        Args:
+            site: walls and rooms.
+            initial_poses: (N, 3) start poses x [m], y [m], yaw [rad].
+            config: the world's configuration.
+            readings: the readings to produce (all by default). Each model draws from its
+                own random stream, so leaving one out changes none of the others; a caller
+                that consumes no odometry (the OA-Bug batch path) saves its cost.
+
+        Raises:
+            ConfigurationError: an unknown reading is named.
+        """
+        unknown = set(readings) - READINGS
+        if unknown:
+            msg = f'unknown readings {sorted(unknown)}; choose from {sorted(READINGS)}'
+            raise ConfigurationError(msg)
+        self.readings = frozenset(readings)
         self.config = config or EngineConfig()
         cfg = self.config
         self.site = site
@@ -260,21 +283,22 @@ class SimEngine:
         out = StepOutput(time_s=self.time_s, poses=poses)
         out.new_room_entries = self.coverage.update(poses, self.time_s)
         sched = self._schedules
-        if sched['scan'].due(self.time_s)[0]:
+        wanted = self.readings
+        if sched['scan'].due(self.time_s)[0] and 'scan' in wanted:
             out.scans = self.lidar.measure(poses)
         due, elapsed = sched['gas'].due(self.time_s)
-        if due:
+        if due and 'gas' in wanted:
             c = self.scent.concentration(self.gas_sensor_positions(poses), self.time_s)
             out.gas_raw = self.gas.update(c, elapsed)
-        if sched['bearings'].due(self.time_s)[0]:
+        if sched['bearings'].due(self.time_s)[0] and 'bearings' in wanted:
             out.bearings = self.bearing_model.measure(poses)
         due, elapsed = sched['imu'].due(self.time_s)
-        if due:
+        if due and 'imu' in wanted:
             change = np.asarray(wrap_angle(poses[:, 2] - self._imu_last_yaw), dtype=float)
             self._imu_last_yaw = poses[:, 2].copy()
             out.imu = self.imu.update(change, elapsed)
         due, elapsed = sched['odometry'].due(self.time_s)
-        if due:
+        if due and 'odometry' in wanted:
             out.odometry = self.odometry.update(poses, elapsed)
         out.ground_truth_due = sched['ground_truth'].due(self.time_s)[0]
         return out

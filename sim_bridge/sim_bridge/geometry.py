@@ -69,7 +69,14 @@ def point_segment_distance(points: np.ndarray, segments: np.ndarray) -> np.ndarr
         (K, M) array of Euclidean distances [m].
     """
     ax, ay = segments[:, 0, 0], segments[:, 0, 1]
-    abx, aby = segments[:, 1, 0] - ax, segments[:, 1, 1] - ay
+    return _distance_to(points, ax, ay, segments[:, 1, 0] - ax, segments[:, 1, 1] - ay)
+
+
+def _distance_to(
+    points: np.ndarray, ax: np.ndarray, ay: np.ndarray, abx: np.ndarray, aby: np.ndarray
+) -> np.ndarray:
+    """Distance [m] from each of the (K, 2) points to segments from (ax, ay) along (abx, aby),
+    given as (M,) arrays shared by every point or as (K, W) arrays, one row per point."""
     inv_len2 = 1.0 / (abx * abx + aby * aby)
     apx = points[:, 0, None] - ax
     apy = points[:, 1, None] - ay
@@ -99,13 +106,31 @@ def count_crossings(
     """
     if len(segments) == 0 or len(starts) == 0:
         return np.zeros(len(starts), dtype=int)
-    qx, qy = segments[:, 0, 0], segments[:, 0, 1]
-    sx, sy = segments[:, 1, 0] - qx, segments[:, 1, 1] - qy
-    if candidates is not None:
-        # A zero-length "wall" far away stands for the padding index M.
-        pad = np.array([_FAR])
-        qx, qy = np.append(qx, pad)[candidates], np.append(qy, pad)[candidates]
-        sx, sy = np.append(sx, 0.0)[candidates], np.append(sy, 0.0)[candidates]
+    q, s = _padded_walls(segments)
+    if candidates is None:
+        candidates = np.arange(len(segments))
+    return _count_hits(starts, ends, q[:, 0][candidates], q[:, 1][candidates], s, candidates)
+
+
+def _padded_walls(segments: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Wall start points (M + 1, 2) and direction vectors (M + 1, 2) [m]; row M is a
+    zero-length "wall" far away that stands for the padding index M."""
+    q = np.append(segments[:, 0], [[_FAR, _FAR]], axis=0)
+    s = np.append(segments[:, 1] - segments[:, 0], [[0.0, 0.0]], axis=0)
+    return q, s
+
+
+def _count_hits(
+    starts: np.ndarray,
+    ends: np.ndarray,
+    qx: np.ndarray,
+    qy: np.ndarray,
+    s: np.ndarray,
+    candidates: np.ndarray,
+) -> np.ndarray:
+    """Crossings of the paths with the candidate walls (start ``qx``, ``qy`` per candidate,
+    directions ``s`` per wall index)."""
+    sx, sy = s[:, 0][candidates], s[:, 1][candidates]
     px, py = starts[:, 0, None], starts[:, 1, None]
     rx, ry = (ends[:, 0] - starts[:, 0])[:, None], (ends[:, 1] - starts[:, 1])[:, None]
     denom = rx * sy - ry * sx
@@ -131,6 +156,7 @@ class WallGrid:
         segments = as_segments(segments)
         self.cell_m = float(cell_m)
         self.num_segments = len(segments)
+        self._q, self._s = _padded_walls(segments)
         if len(segments) == 0:
             self._origin = np.zeros(2)
             self._shape = (1, 1)
@@ -158,6 +184,39 @@ class WallGrid:
         cy = np.clip(cell[:, 1], 0, self._shape[1] - 1)
         return self._table[cx * self._shape[1] + cy]
 
+    def nearest_distance(self, points: np.ndarray) -> np.ndarray:
+        """(K,) distance [m] from each of the (K, 2) points to the nearest wall.
+
+        Exact (the value :func:`point_segment_distance` gives) where it is at most
+        ``reach_m``; elsewhere some larger value, since only the walls near a point's cell
+        are measured.
+        """
+        candidates = self.candidates(points)
+        q = self._q[candidates]
+        s = self._s[candidates]
+        with np.errstate(divide='ignore', invalid='ignore'):
+            # The zero-length padding "wall" lies 1e12 m away; its NaN is dropped below.
+            distance = _distance_to(points, q[..., 0], q[..., 1], s[..., 0], s[..., 1])
+        return np.fmin.reduce(distance, axis=1, initial=np.inf)
+
+    def count_crossings(
+        self, starts: np.ndarray, ends: np.ndarray, candidates: np.ndarray | None = None
+    ) -> np.ndarray:
+        """Like :func:`count_crossings` for paths that stay within ``reach_m`` of their
+        (K, 2) ``starts``: only the walls near each start are tested.
+
+        Args:
+            starts: (K, 2) path start points [m].
+            ends: (K, 2) path end points [m].
+            candidates: ``self.candidates(starts)`` when the caller has it already.
+        """
+        if self.num_segments == 0 or len(starts) == 0:
+            return np.zeros(len(starts), dtype=int)
+        if candidates is None:
+            candidates = self.candidates(starts)
+        q = self._q[candidates]
+        return _count_hits(starts, ends, q[..., 0], q[..., 1], self._s, candidates)
+
 
 def _expand_intervals(starts: np.ndarray, counts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Expand integer intervals [start, start + count) into (owner, index) pairs."""
@@ -173,7 +232,8 @@ class _Pairs:
     """(robot, wall face) pairs of one scan and the bins each face covers."""
 
     robot: np.ndarray
-    normal: np.ndarray
+    normal_x: np.ndarray
+    normal_y: np.ndarray
     face_m: np.ndarray
     first: np.ndarray
     counts: np.ndarray
@@ -183,7 +243,7 @@ class _Pairs:
     def empty(cls) -> _Pairs:
         z = np.zeros(0)
         zi = np.zeros(0, dtype=int)
-        return cls(zi, np.zeros((0, 2)), z, zi, zi, z)
+        return cls(zi, z, z, z, zi, zi, z)
 
     @property
     def size(self) -> int:
@@ -192,7 +252,8 @@ class _Pairs:
     def select(self, mask: np.ndarray) -> _Pairs:
         return _Pairs(
             self.robot[mask],
-            self.normal[mask],
+            self.normal_x[mask],
+            self.normal_y[mask],
             self.face_m[mask],
             self.first[mask],
             self.counts[mask],
@@ -266,6 +327,11 @@ class RayCaster:
         self._all_segments = np.concatenate([segments, caps]) if len(caps) else segments
         self._all_half = np.concatenate([np.full(len(segments), half), np.zeros(len(caps))])
         self._all_outward = np.concatenate([np.zeros(len(segments)), self._cap_outward])
+        # Per-face columns, contiguous, for the per-scan gathers.
+        all_segments = self._all_segments
+        self._ax, self._ay = all_segments[:, 0, 0].copy(), all_segments[:, 0, 1].copy()
+        self._bx, self._by = all_segments[:, 1, 0].copy(), all_segments[:, 1, 1].copy()
+        self._one_sided = np.flatnonzero(self._all_outward != 0.0)
         self.near_range_m = near_range_m
         self._sector_bins = max(1, num_bins // 36)
         self._half_thickness_m = half
@@ -335,39 +401,45 @@ class RayCaster:
         dist = point_segment_distance(origin, segs)
         near = dist <= max_range_m + self._all_half
         # An end face is seen only from in front of it: cull the pairs where it faces away.
-        one_sided = self._all_outward != 0.0
-        a = segs[:, 0]
-        ab = segs[:, 1] - a
-        rel_x = origin[:, 0, None] - a[None, :, 0]
-        rel_y = origin[:, 1, None] - a[None, :, 1]
-        side = rel_x * ab[None, :, 1] - rel_y * ab[None, :, 0]
-        near &= ~one_sided[None, :] | (side * self._all_outward[None, :] > 0.0)
+        capped = self._one_sided
+        if len(capped):
+            ax, ay = self._ax[capped], self._ay[capped]
+            rel_x = origin[:, 0, None] - ax
+            rel_y = origin[:, 1, None] - ay
+            side = rel_x * (self._by[capped] - ay) - rel_y * (self._bx[capped] - ax)
+            near[:, capped] &= side * self._all_outward[capped] > 0.0
         robot_idx, seg_idx = np.nonzero(near)
         if len(robot_idx) == 0:
             return _Pairs.empty()
         half = self._all_half[seg_idx]
-        o = origin[robot_idx]
-        a = segs[seg_idx, 0] - o
-        b = segs[seg_idx, 1] - o
-        ab = b - a
-        normal = np.column_stack([ab[:, 1], -ab[:, 0]])
-        normal /= np.linalg.norm(normal, axis=1)[:, None]
-        offset = np.einsum('ij,ij->i', a, normal)
-        # Orient each normal from the robot towards the wall's centre line.
-        normal[offset < 0.0] *= -1.0
+        ox = origin[robot_idx, 0]
+        oy = origin[robot_idx, 1]
+        ax = self._ax[seg_idx] - ox
+        ay = self._ay[seg_idx] - oy
+        bx = self._bx[seg_idx] - ox
+        by = self._by[seg_idx] - oy
+        # The unit normal of the face, oriented from the robot towards the wall.
+        nx = by - ay
+        ny = -(bx - ax)
+        length = np.sqrt(nx * nx + ny * ny)
+        nx /= length
+        ny /= length
+        offset = ax * nx + ay * ny
+        flip = offset < 0.0
+        nx[flip] *= -1.0
+        ny[flip] *= -1.0
         face = np.maximum(np.abs(offset) - half, 1e-6)
         # The angular interval is the one of the face nearest to the robot.
-        a_face = a - half[:, None] * normal
-        b_face = b - half[:, None] * normal
         first, counts = self._arc_bins(
             yaw[robot_idx],
-            np.arctan2(a_face[:, 1], a_face[:, 0]),
-            np.arctan2(b_face[:, 1], b_face[:, 0]),
+            np.arctan2(ay - half * ny, ax - half * nx),
+            np.arctan2(by - half * ny, bx - half * nx),
         )
         keep = counts > 0
         return _Pairs(
             robot=robot_idx[keep],
-            normal=normal[keep],
+            normal_x=nx[keep],
+            normal_y=ny[keep],
             face_m=face[keep],
             first=first[keep] % self.num_bins,
             counts=counts[keep],
@@ -400,8 +472,7 @@ class RayCaster:
         owner, k = _expand_intervals(pairs.first, pairs.counts)
         k %= self.num_bins
         flat = pairs.robot[owner] * self.num_bins + k
-        normal = pairs.normal[owner]
-        along = ray_dir[0][flat] * normal[:, 0] + ray_dir[1][flat] * normal[:, 1]
+        along = ray_dir[0][flat] * pairs.normal_x[owner] + ray_dir[1][flat] * pairs.normal_y[owner]
         with np.errstate(divide='ignore'):
             ranges = np.where(along > 1e-9, pairs.face_m[owner] / along, np.inf)
         np.minimum.at(best, flat, ranges)

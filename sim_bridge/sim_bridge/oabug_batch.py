@@ -34,7 +34,7 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -48,7 +48,7 @@ from oabug_robot.sound import PeerBearings
 from swarm_runtime.builtin._messages import cdr_roundtrip_enabled
 
 from sim_bridge.conversions import yaw_to_quaternion
-from sim_bridge.engine import SimEngine, SiteGeometry
+from sim_bridge.engine import READINGS, SimEngine, SiteGeometry
 from sim_bridge.errors import ConfigurationError
 from sim_bridge.mission import MissionProgress, MissionResult, MissionSpec, StopReason
 from sim_bridge.sensors.bearings import PeerBearings as BearingReport
@@ -60,11 +60,6 @@ __all__ = ['BatchRobot', 'run_oabug_batch', 'run_spawn_batch']
 
 _NS_PER_S = 1_000_000_000
 _STOP = Command(linear_mps=0.0, angular_radps=0.0, pump_on=False)
-
-
-def _to_float32(value: float) -> float:
-    """``value`` as a float32 message field carries it after serialization."""
-    return float(np.float32(value))
 
 
 def _stamp_ns(time_s: float) -> int:
@@ -114,12 +109,12 @@ class BatchRobot:
         self.own_tag = str(values['own_tag_id']).strip().upper()
         self.fsm = OABugFsm(self.config)
         self._extractor = ScanFeatureExtractor(self.config.perception)
-        self._float = _to_float32 if float32_fields else float
-        self._scan_frame = (
-            self._float(-math.pi),
-            self._float(lidar.angle_increment_rad),
-            self._float(lidar.range_min_m),
-            self._float(lidar.range_max_m),
+        # Fields of the messages: float32 after serialization, else the Python float.
+        self._field_type = np.float32 if float32_fields else np.float64
+        field = self._field_type
+        self._scan_frame = tuple(
+            float(field(v))
+            for v in (-math.pi, lidar.angle_increment_rad, lidar.range_min_m, lidar.range_max_m)
         )
         self._needs_gas = self.config.variant.uses_scent
         self._scan = _Held()
@@ -132,8 +127,8 @@ class BatchRobot:
     # Readings, in the order the bridge publishes them within a step.
 
     def receive_scan(self, ranges_m: np.ndarray, now_s: float) -> None:
-        """A lidar revolution ([m], REP 117) arrives; kept as the float32 of the message."""
-        self._scan.value = LaserScanData(np.asarray(ranges_m, dtype=np.float32), *self._scan_frame)
+        """A lidar revolution arrives: float32 ranges [m] (REP 117), as in the message."""
+        self._scan.value = LaserScanData(ranges_m, *self._scan_frame)
         self._scan.time_s = now_s
 
     def receive_gas(self, raw: int, now_s: float) -> None:
@@ -141,20 +136,24 @@ class BatchRobot:
         self._gas.value = int(raw)
         self._gas.time_s = now_s
 
-    def receive_bearings(
-        self, report: BearingReport, tag_ids: tuple[str, ...], now_s: float
-    ) -> None:
-        """A locator cycle arrives; stamped with the yaw held now (the previous IMU)."""
-        keep = [
-            k
-            for k, tag in enumerate(report.tags.tolist())
-            if not self.own_tag or tag_ids[tag] != self.own_tag
-        ]
+    def receive_bearings(self, report: BearingReport, tag_ids: Sequence[str], now_s: float) -> None:
+        """A locator cycle arrives; stamped with the yaw held now (the previous IMU).
+
+        Args:
+            report: the locator's report; its tags index ``tag_ids``.
+            tag_ids: the tag id of every robot.
+            now_s: node time [s].
+        """
+        azimuths = np.asarray(report.azimuth_rad, dtype=self._field_type)
+        distances = np.asarray(report.distance_m, dtype=self._field_type)
+        if self.own_tag in tag_ids:
+            # The node drops its own tag (the engine never reports it, a user's id might).
+            keep = report.tags != tag_ids.index(self.own_tag)
+            azimuths, distances = azimuths[keep], distances[keep]
         yaw = self._yaw.value if math.isfinite(self._yaw.value) else 0.0
-        field_type = np.float32 if self._float is _to_float32 else float
         self._bearings = PeerBearings(
-            azimuths_rad=np.asarray(report.azimuth_rad, dtype=field_type)[keep].astype(float),
-            distances_m=np.asarray(report.distance_m, dtype=field_type)[keep].astype(float),
+            azimuths_rad=azimuths.astype(float),
+            distances_m=distances.astype(float),
             stamp_s=now_s,
             yaw_at_stamp_rad=yaw,
         )
@@ -244,7 +243,13 @@ def run_oabug_batch(
     wall_start = time.perf_counter()
     site = spec.site
     geometry = site if isinstance(site, SiteGeometry) else geometry_from_site(site)
-    engine = SimEngine(geometry, np.asarray(spec.initial_poses, dtype=float), spec.engine_config)
+    # The OA-Bug node subscribes to no odometry; every other reading is consumed.
+    engine = SimEngine(
+        geometry,
+        np.asarray(spec.initial_poses, dtype=float),
+        spec.engine_config,
+        readings=READINGS - {'odometry'},
+    )
     n = engine.num_robots
     names = tuple(f'r{i}' for i in range(n))
     tag_ids = tuple(name.upper() for name in names)
@@ -313,7 +318,7 @@ def _deliver(
     now_ns = _stamp_ns(out.time_s)
     now_s = now_ns * 1e-9
     if out.scans is not None:
-        for robot, ranges in zip(robots, out.scans, strict=True):
+        for robot, ranges in zip(robots, out.scans.astype(np.float32), strict=True):
             robot.receive_scan(ranges, now_s)
     if out.gas_raw is not None:
         for robot, raw in zip(robots, out.gas_raw.tolist(), strict=True):

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from sim_bridge.errors import ConfigurationError, WorldGeometryError
-from sim_bridge.geometry import as_segments, point_segment_distance, wrap_angle
+from sim_bridge.geometry import WallGrid, as_segments, wrap_angle
 
 __all__ = ['BodyConfig', 'World']
 
@@ -78,13 +78,14 @@ class World:
         self._wall_clearance_m = self.body.robot_radius_m + 0.5 * self.body.wall_thickness_m
         self.collision_count = np.zeros(len(poses), dtype=int)
         self._clearance_cache: np.ndarray | None = None
+        self._limits = np.array([self.body.max_linear_speed_mps, self.body.max_angular_speed_radps])
+        self._walls_near = WallGrid(self.walls, cell_m=0.5, reach_m=2.0 * self._wall_clearance_m)
 
     def _wall_clearance(self) -> np.ndarray:
-        """(N,) distance [m] from each robot centre to the nearest wall centre line."""
+        """(N,) distance [m] from each robot centre to the nearest wall centre line (exact
+        up to twice the contact clearance; only smaller values decide a move)."""
         if self._clearance_cache is None:
-            self._clearance_cache = point_segment_distance(self._poses[:, :2], self.walls).min(
-                axis=1
-            )
+            self._clearance_cache = self._walls_near.nearest_distance(self._poses[:, :2])
         return self._clearance_cache
 
     @property
@@ -108,12 +109,10 @@ class World:
         Non-finite commands become zero (a base driver ignores garbage and stops).
         """
         cmd = np.array(commands, dtype=float).reshape(self.num_robots, 2)
-        cmd[~np.isfinite(cmd)] = 0.0
-        v_max = self.body.max_linear_speed_mps
-        w_max = self.body.max_angular_speed_radps
-        cmd[:, 0] = np.clip(cmd[:, 0], -v_max, v_max)
-        cmd[:, 1] = np.clip(cmd[:, 1], -w_max, w_max)
-        return cmd
+        bad = ~np.isfinite(cmd)
+        if bad.any():
+            cmd[bad] = 0.0
+        return np.clip(cmd, -self._limits, self._limits, out=cmd)
 
     def step(self, commands: np.ndarray, dt_s: float) -> None:
         """Advance every robot by ``dt_s`` seconds under (N, 2) velocity commands.
@@ -129,14 +128,16 @@ class World:
         new_yaw = yaw + w * dt_s
         small = np.abs(w) < 1e-9
         safe_w = np.where(small, 1.0, w)
-        dx = np.where(small, v * dt_s * np.cos(yaw), v / safe_w * (np.sin(new_yaw) - np.sin(yaw)))
-        dy = np.where(small, v * dt_s * np.sin(yaw), -v / safe_w * (np.cos(new_yaw) - np.cos(yaw)))
+        cos_yaw, sin_yaw = np.cos(yaw), np.sin(yaw)
+        dx = np.where(small, v * dt_s * cos_yaw, v / safe_w * (np.sin(new_yaw) - sin_yaw))
+        dy = np.where(small, v * dt_s * sin_yaw, -v / safe_w * (np.cos(new_yaw) - cos_yaw))
         old_xy = self._poses[:, :2]
         cand_xy = old_xy + np.column_stack([dx, dy])
         moves = (dx != 0.0) | (dy != 0.0)
         allowed = moves.copy()
+        new_clear = None
         if len(self.walls) and moves.any():
-            new_clear = point_segment_distance(cand_xy, self.walls).min(axis=1)
+            new_clear = self._walls_near.nearest_distance(cand_xy)
             old_clear = self._wall_clearance()
             blocked = (new_clear < self._wall_clearance_m) & (new_clear < old_clear)
             allowed &= ~blocked
@@ -157,9 +158,11 @@ class World:
                 allowed[i] = False
                 continue
             final_xy[i] = cand_xy[i]
-        self.collision_count += (moves & ~allowed).astype(int)
+        self.collision_count += moves & ~allowed
         self._poses[:, :2] = final_xy
         self._poses[:, 2] = wrap_angle(new_yaw)
-        self._clearance_cache = None
+        if new_clear is not None:
+            # The distance of a point does not depend on the others: reuse it.
+            self._clearance_cache = np.where(allowed, new_clear, self._wall_clearance())
         achieved_v = np.where(allowed, v, 0.0)
         self._velocities = np.column_stack([achieved_v, w])

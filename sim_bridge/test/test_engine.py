@@ -123,3 +123,31 @@ def test_coverage_counts_a_room_only_once_the_body_is_inside():
     assert [(e.room_index, e.robot_index, e.time_s) for e in first] == [(0, 0, 2.0)]
     assert tracker.update(np.array([[0.5, 0.5]]), 3.0) == []
     assert tracker.fraction == 1.0
+
+
+def test_leaving_a_reading_out_changes_none_of_the_others():
+    def outputs(**kwargs):
+        site = SiteGeometry(walls=WALLS, room_rects=ROOM, name='hall')
+        engine = SimEngine(site, np.array([[1.0, 1.5, 0.0], [2.0, 0.5, 1.0]]), **kwargs)
+        for i in range(2):
+            engine.set_pump(i, True)
+        return run(engine, 3.0, command=(0.2, 0.3))
+
+    full = outputs()
+    lean = outputs(readings=frozenset({'scan', 'gas', 'bearings', 'imu'}))
+    assert all(o.odometry is None for o in lean)
+    assert any(o.odometry is not None for o in full)
+    for a, b in zip(full, lean, strict=True):
+        assert np.array_equal(a.poses, b.poses)
+        for name in ('scans', 'gas_raw'):
+            x, y = getattr(a, name), getattr(b, name)
+            assert (x is None and y is None) or np.array_equal(x, y)
+        assert (a.imu is None) == (b.imu is None)
+        if a.imu is not None:
+            assert np.array_equal(a.imu[0], b.imu[0])
+        if a.bearings is not None:
+            assert [r.azimuth_rad.tolist() for r in a.bearings] == [
+                r.azimuth_rad.tolist() for r in b.bearings
+            ]
+    with pytest.raises(ConfigurationError, match='sonar'):
+        outputs(readings=frozenset({'scan', 'sonar'}))

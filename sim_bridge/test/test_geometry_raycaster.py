@@ -5,7 +5,13 @@ import math
 import numpy as np
 import pytest
 from sim_bridge.errors import WorldGeometryError
-from sim_bridge.geometry import RayCaster, count_crossings, point_segment_distance, wrap_angle
+from sim_bridge.geometry import (
+    RayCaster,
+    WallGrid,
+    count_crossings,
+    point_segment_distance,
+    wrap_angle,
+)
 
 BOX = np.array(
     [
@@ -108,3 +114,29 @@ def test_count_crossings_counts_each_wall_between_two_points():
 def test_wrap_angle_maps_into_minus_pi_to_pi():
     assert wrap_angle(-math.pi) == pytest.approx(math.pi)
     assert wrap_angle(3 * math.pi / 2) == pytest.approx(-math.pi / 2)
+
+
+def test_wall_grid_distance_is_exact_within_reach_and_never_too_small():
+    rng = np.random.default_rng(3)
+    walls = rng.uniform(0.0, 6.0, size=(40, 2, 2))
+    grid = WallGrid(walls, cell_m=0.5, reach_m=0.3)
+    points = rng.uniform(-0.5, 6.5, size=(2000, 2))
+    exact = point_segment_distance(points, walls).min(axis=1)
+    nearest = grid.nearest_distance(points)
+    within = exact <= 0.3
+    assert within.sum() > 100
+    assert np.array_equal(nearest[within], exact[within])
+    assert np.all(nearest[~within] > 0.3)
+
+
+def test_wall_grid_crossings_equal_the_full_test_for_short_paths():
+    rng = np.random.default_rng(4)
+    walls = rng.uniform(0.0, 6.0, size=(40, 2, 2))
+    grid = WallGrid(walls, cell_m=0.5, reach_m=0.45)
+    starts = rng.uniform(0.0, 6.0, size=(3000, 2))
+    angle = rng.uniform(-math.pi, math.pi, 3000)
+    length = rng.uniform(0.0, 0.45, 3000)
+    ends = starts + length[:, None] * np.column_stack([np.cos(angle), np.sin(angle)])
+    crossed = grid.count_crossings(starts, ends)
+    assert crossed.sum() > 100
+    assert np.array_equal(crossed, count_crossings(starts, ends, walls))

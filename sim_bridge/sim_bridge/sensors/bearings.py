@@ -9,6 +9,7 @@ shorter range: each wall between two robots multiplies the line-of-sight range b
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass
 
@@ -130,17 +131,17 @@ class BearingModel:
         distance = dist * np.exp(self._rng.normal(0.0, cfg.distance_noise_fraction, k))
         self._sequence[rx, tx] = (self._sequence[rx, tx] + 1) % 65536
         sequence = self._sequence[rx, tx]
-        reports = []
-        for i in range(n):
-            sel = rx == i
-            reports.append(
-                PeerBearings(
-                    receiver=i,
-                    tags=tx[sel],
-                    azimuth_rad=np.atleast_1d(azimuth)[sel],
-                    elevation_rad=elevation[sel],
-                    distance_m=distance[sel],
-                    sequence=sequence[sel],
-                )
+        azimuth = np.atleast_1d(azimuth)
+        # rx is sorted (np.nonzero order), so each receiver's reports are one slice.
+        bounds = np.searchsorted(rx, np.arange(n + 1)).tolist()
+        return [
+            PeerBearings(
+                receiver=i,
+                tags=tx[lo:hi],
+                azimuth_rad=azimuth[lo:hi],
+                elevation_rad=elevation[lo:hi],
+                distance_m=distance[lo:hi],
+                sequence=sequence[lo:hi],
             )
-        return reports
+            for i, (lo, hi) in enumerate(itertools.pairwise(bounds))
+        ]

@@ -99,7 +99,10 @@ class Mp503Model:
             (N,) int readings on the 10-bit scale, 0..1023.
         """
         cfg = self.config
-        c = np.maximum(np.nan_to_num(np.asarray(concentration_ppm, dtype=float)), 0.0)
+        c = np.asarray(concentration_ppm, dtype=float)
+        if not np.isfinite(c).all():
+            c = np.nan_to_num(c)
+        c = np.maximum(c, 0.0)
         tau = np.where(c > self._sensed_ppm, cfg.rise_time_constant_s, cfg.fall_time_constant_s)
         self._sensed_ppm += (c - self._sensed_ppm) * (1.0 - np.exp(-dt_s / tau))
         x = self._sensed_ppm

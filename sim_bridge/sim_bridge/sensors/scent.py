@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from sim_bridge.errors import ConfigurationError
-from sim_bridge.geometry import WallGrid, as_segments, count_crossings
+from sim_bridge.geometry import WallGrid, as_segments
 
 __all__ = ['PumpDepositor', 'ScentConfig', 'ScentField']
 
@@ -81,6 +81,7 @@ class ScentField:
         self.config = config
         self._walls = as_segments(walls if walls is not None else np.zeros((0, 2, 2)))
         reach = config.cutoff_sigmas * config.final_spread_m
+        self._cutoff2 = reach**2
         self._grid = WallGrid(self._walls, cell_m=0.5, reach_m=reach) if len(self._walls) else None
         self._xy = np.zeros((256, 2))
         self._time_s = np.zeros(256)
@@ -128,26 +129,28 @@ class ScentField:
     def concentration(self, points: np.ndarray, time_s: float) -> np.ndarray:
         """Ethanol concentration [ppm] at (K, 2) points at ``time_s``; returns (K,)."""
         points = np.atleast_2d(np.asarray(points, dtype=float))
-        out = np.zeros(len(points))
         n = self._count
         if n == 0:
-            return out
+            return np.zeros(len(points))
         cfg = self.config
         xy = self._xy[:n]
-        age = time_s - self._time_s[:n]
-        live = age >= 0.0
-        d2 = ((points[:, None, :] - xy[None, :, :]) ** 2).sum(axis=2)
-        cutoff2 = (cfg.cutoff_sigmas * cfg.final_spread_m) ** 2
-        near = (d2 <= cutoff2) & live[None, :]
+        dx = points[:, 0, None] - xy[:, 0]
+        dy = points[:, 1, None] - xy[:, 1]
+        d2 = dx * dx
+        d2 += dy * dy
+        near = d2 <= self._cutoff2
+        if self._time_s[n - 1] > time_s:
+            # Puffs are deposited in time order; only a query of the past sees later ones.
+            near &= self._time_s[:n] <= time_s
         q_idx, p_idx = np.nonzero(near)
         if len(q_idx) == 0:
-            return out
+            return np.zeros(len(points))
         if cfg.walls_block and self._grid is not None:
             near_walls = self._grid.candidates(points)[q_idx]
-            crossed = count_crossings(points[q_idx], xy[p_idx], self._walls, near_walls)
+            crossed = self._grid.count_crossings(points[q_idx], xy[p_idx], near_walls)
             open_path = crossed == 0
             q_idx, p_idx = q_idx[open_path], p_idx[open_path]
-        a = age[p_idx]
+        a = time_s - self._time_s[p_idx]
         sigma2 = self.spread_m(a) ** 2
         value = (
             self._mass[p_idx]
@@ -155,8 +158,8 @@ class ScentField:
             / (2.0 * math.pi * sigma2)
             * np.exp(-d2[q_idx, p_idx] / (2.0 * sigma2))
         )
-        np.add.at(out, q_idx, value)
-        return out
+        # Summed in index order, like np.add.at: the same float result.
+        return np.bincount(q_idx, weights=value, minlength=len(points))
 
 
 class PumpDepositor:
