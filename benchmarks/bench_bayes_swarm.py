@@ -13,12 +13,12 @@ Experiments (``--experiments``, default all):
 * main: Case 1 with 5 robots and Case 2 with 10 robots (Bayes-Swarm-P);
 * shifted: the same with the field and its source moved by a seeded offset (up to 0.3 m in
   Case 1, 3 m in Case 2), to show how much a result hinges on the exact source position;
-* penalty: Bayes-Swarm-P against -O (Table 5);
+* penalty: Bayes-Swarm-O on the same cases, also moved (Table 5: P against O);
 * comm: limited communication ranges (Experiment 5, Table 6);
 * authors: the authors' code options (inert penalty, origin paths, floor downsampling,
   alpha on 0.1 T_max, COBYLA) for comparison;
 * baselines: Glowworm, Levy walk and exhaustive search (Table 3);
-* scaling: Case 2 with 5 to 50 robots (Fig. 4);
+* scaling: Case 2 with 5 to 50 robots (Fig. 4); scaling_shifted: the same, source moved;
 * case3: Case 3 with 48 and 100 robots (Table 4);
 * avalanche: the avalanche field, 6 UAVs, without and with noise (Table 8).
 
@@ -57,6 +57,7 @@ EXPERIMENTS = (
     'comm',
     'baselines',
     'scaling',
+    'scaling_shifted',
     'case3',
     'avalanche',
 )
@@ -157,8 +158,9 @@ def plan_jobs(experiments: list[str], runs: int, baseline_runs: int, large_runs:
             Job('main', 'Case 1, 5 robots, Bayes-Swarm-P', 'case1', 'bayes_swarm_p', 5, runs),
             Job('main', 'Case 2, 10 robots, Bayes-Swarm-P', 'case2', 'bayes_swarm_p', 10, runs),
         ]
+    shifts = (('case1', 5, 0.3), ('case2', 10, 3.0))
     if 'shifted' in experiments:
-        for case, m, shift in (('case1', 5, 0.3), ('case2', 10, 3.0)):
+        for case, m, shift in shifts:
             jobs.append(
                 Job(
                     'shifted',
@@ -175,6 +177,18 @@ def plan_jobs(experiments: list[str], runs: int, baseline_runs: int, large_runs:
             Job('penalty', 'Case 1, 5 robots, Bayes-Swarm-O', 'case1', 'bayes_swarm_o', 5, runs),
             Job('penalty', 'Case 2, 10 robots, Bayes-Swarm-O', 'case2', 'bayes_swarm_o', 10, runs),
         ]
+        for case, m, shift in shifts:
+            jobs.append(
+                Job(
+                    'penalty',
+                    f'Case {case[-1]}, {m} robots, Bayes-Swarm-O, source moved <= {shift:g} m',
+                    case,
+                    'bayes_swarm_o',
+                    m,
+                    runs,
+                    source_shift_m=shift,
+                )
+            )
     if 'authors' in experiments:
         for case, m in (('case1', 5), ('case2', 10)):
             jobs.append(
@@ -240,16 +254,20 @@ def plan_jobs(experiments: list[str], runs: int, baseline_runs: int, large_runs:
                 partition='quadrants',
             ),
         ]
-    if 'scaling' in experiments:
+    for experiment, shift in (('scaling', 0.0), ('scaling_shifted', 3.0)):
+        if experiment not in experiments:
+            continue
+        moved = f', source moved <= {shift:g} m' if shift else ''
         for m in (5, 10, 20, 30, 40, 50):
             jobs.append(
                 Job(
-                    'scaling',
-                    f'Case 2, {m} robots, Bayes-Swarm-P',
+                    experiment,
+                    f'Case 2, {m} robots, Bayes-Swarm-P{moved}',
                     'case2',
                     'bayes_swarm_p',
                     m,
                     large_runs,
+                    source_shift_m=shift,
                 )
             )
     if 'case3' in experiments:
