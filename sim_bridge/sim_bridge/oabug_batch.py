@@ -127,7 +127,7 @@ class BatchRobot:
     # Readings, in the order the bridge publishes them within a step.
 
     def receive_scan(self, ranges_m: np.ndarray, now_s: float) -> None:
-        """A lidar revolution arrives: float32 ranges [m] (REP 117), as in the message."""
+        """A lidar revolution arrives: ranges [m] (REP 117) as the message's float32 hold."""
         self._scan.value = LaserScanData(ranges_m, *self._scan_frame)
         self._scan.time_s = now_s
 
@@ -318,7 +318,9 @@ def _deliver(
     now_ns = _stamp_ns(out.time_s)
     now_s = now_ns * 1e-9
     if out.scans is not None:
-        for robot, ranges in zip(robots, out.scans.astype(np.float32), strict=True):
+        # The message's float32 values, widened once for every robot's feature extractor.
+        ranges_m = out.scans.astype(np.float32).astype(float)
+        for robot, ranges in zip(robots, ranges_m, strict=True):
             robot.receive_scan(ranges, now_s)
     if out.gas_raw is not None:
         for robot, raw in zip(robots, out.gas_raw.tolist(), strict=True):

@@ -150,11 +150,12 @@ class World:
         close = (gap < contact + step_len.max() + 1e-9).any(axis=1)
         quiet = allowed & ~close
         final_xy[quiet] = cand_xy[quiet]
-        for i in np.flatnonzero(allowed & close):
-            others = np.delete(final_xy, i, axis=0)
-            new_d = np.hypot(*(others - cand_xy[i]).T).min()
-            old_d = np.hypot(*(others - old_xy[i]).T).min()
-            if new_d < contact and new_d < old_d:
+        for i in np.flatnonzero(allowed & close).tolist():
+            # Distances to the others (the robot itself set to inf), as they stand now.
+            new_d = np.hypot(*(final_xy - cand_xy[i]).T)
+            old_d = np.hypot(*(final_xy - old_xy[i]).T)
+            new_d[i] = old_d[i] = np.inf
+            if new_d.min() < contact and new_d.min() < old_d.min():
                 allowed[i] = False
                 continue
             final_xy[i] = cand_xy[i]
