@@ -9,12 +9,13 @@ repulsion keeps robots inside the field.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 import numpy as np
 
 from msc_pf.settings import SearchConfig
 
-__all__ = ['CoverageHistory', 'HistorySearch', 'unit', 'wall_repulsion']
+__all__ = ['CoverageHistory', 'HistorySearch', 'repulsions', 'unit', 'wall_repulsion']
 
 
 def unit(vector: np.ndarray) -> np.ndarray:
@@ -54,21 +55,41 @@ class CoverageHistory:
         Sum over visited cells c of ``h(c) (x - p_c) / |x - p_c|^2``; the distance is floored
         at one cell edge so the cell the robot stands in does not dominate.
         """
-        n, size = self.cells_per_side, self.cell_size_m
-        reach = math.ceil(radius_m / size)
-        px, py = float(position_m[0]), float(position_m[1])
-        col = min(max(int(px // size), 0), n - 1)
-        row = min(max(int(py // size), 0), n - 1)
-        r0, r1 = max(row - reach, 0), min(row + reach + 1, n)
-        c0, c1 = max(col - reach, 0), min(col + reach + 1, n)
-        window = self.counts[r0:r1, c0:c1]
-        if not window.any():
-            return np.zeros(2)
-        dx = px - self._centres_m[None, c0:c1]
-        dy = py - self._centres_m[r0:r1, None]
-        d2 = dx * dx + dy * dy
-        weight = np.where(d2 < radius_m * radius_m, window / np.maximum(d2, size * size), 0.0)
-        return unit(np.array([np.sum(weight * dx), np.sum(weight * dy)]))
+        return repulsions((self,), position_m, radius_m)[0]
+
+
+def repulsions(
+    histories: Sequence[CoverageHistory], position_m: np.ndarray, radius_m: float
+) -> list[np.ndarray]:
+    """:meth:`CoverageHistory.repulsion` of several histories on the same grid.
+
+    The cell geometry around ``position_m`` is computed once for all of them.
+    """
+    grid = histories[0]
+    n, size = grid.cells_per_side, grid.cell_size_m
+    reach = math.ceil(radius_m / size)
+    px, py = float(position_m[0]), float(position_m[1])
+    col = min(max(int(px // size), 0), n - 1)
+    row = min(max(int(py // size), 0), n - 1)
+    r0, r1 = max(row - reach, 0), min(row + reach + 1, n)
+    c0, c1 = max(col - reach, 0), min(col + reach + 1, n)
+    windows = [history.counts[r0:r1, c0:c1] for history in histories]
+    visited = [bool(window.any()) for window in windows]
+    if not any(visited):
+        return [np.zeros(2) for _ in histories]
+    dx = px - grid._centres_m[None, c0:c1]
+    dy = py - grid._centres_m[r0:r1, None]
+    d2 = dx * dx + dy * dy
+    near = d2 < radius_m * radius_m
+    floored = np.maximum(d2, size * size)
+    vectors = []
+    for window, any_visit in zip(windows, visited, strict=True):
+        if not any_visit:
+            vectors.append(np.zeros(2))
+            continue
+        weight = np.where(near, window / floored, 0.0)
+        vectors.append(unit(np.array([np.sum(weight * dx), np.sum(weight * dy)])))
+    return vectors
 
 
 def wall_repulsion(position_m: np.ndarray, field_size_m: float, margin_m: float) -> np.ndarray:
@@ -118,8 +139,9 @@ class HistorySearch:
     def vector(self, now_s: float, position_m: np.ndarray, avoidance: np.ndarray) -> np.ndarray:
         """Movement vector of eq. (1) plus the field-edge repulsion (metres, unscaled)."""
         cfg = self._cfg
-        v_s = self.swarm_history.repulsion(position_m, cfg.history_radius_m)
-        v_o = self.others_history.repulsion(position_m, cfg.history_radius_m)
+        v_s, v_o = repulsions(
+            (self.swarm_history, self.others_history), position_m, cfg.history_radius_m
+        )
         v_w = wall_repulsion(position_m, self._field_size_m, cfg.wall_margin_m)
         return (
             self.random_direction(now_s)
