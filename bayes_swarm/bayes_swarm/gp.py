@@ -6,7 +6,7 @@ Zero prior mean, squared-exponential kernel
 
 hyperparameters (s2, l) by maximum marginal likelihood within bounds (a projected
 trust-region Newton method on their logarithms with the analytic gradient and Hessian; the
-authors use L-BFGS-B, which reaches the same optimum with two to three times the likelihood
+authors use L-BFGS-B, which reaches the same optimum with about twice the likelihood
 evaluations and a costly set-up per call). The posterior is kept as a Cholesky factor; if it
 fails the diagonal receives growing jitter, and if even ``max_jitter`` fails the
 hyperparameters are reset and refitted once before :class:`~bayes_swarm.errors.GpFitError` is
@@ -139,8 +139,7 @@ class GaussianProcess:
 
         ``optimise`` None applies the refit policy (first fit, or data grown by
         ``refit_growth_factor`` in size or largest |value| since the last fit); True/False
-        force it. Explicit
-        ``hyperparameters`` skip the likelihood fit.
+        force it. Explicit ``hyperparameters`` skip the likelihood fit.
         """
         x = np.ascontiguousarray(x_m, dtype=float)
         y = np.ascontiguousarray(values, dtype=float)
