@@ -326,10 +326,11 @@ class RobotController:
         batches = [(position, own)]
         for peer in fresh:
             batch = {t: v for t, v in peer.readings if math.isfinite(v) and t not in self._captured}
-            batches.append((np.asarray(peer.position_m, dtype=np.float64), batch))
+            if batch:
+                batches.append((np.asarray(peer.position_m, dtype=np.float64), batch))
         observations = []
         for where, batch in batches:
-            if batch and np.all(np.isfinite(where)):
+            if batch and math.isfinite(where[0]) and math.isfinite(where[1]):
                 ids = sorted(batch)
                 observations.append((where, ids, [batch[t] for t in ids]))
         if self.config.particle_filter.fusion == 'joint':
