@@ -256,8 +256,10 @@ class ParticleFilterBank:
         self._buf_ny = np.empty((capacity, n), np.float32)
         self._buf_x = np.empty((capacity, n), np.float32)
         self._buf_y = np.empty((capacity, n), np.float32)
-        self._counts = np.empty((capacity, n), np.int32)
-        self._flat_index = np.arange(capacity * n, dtype=np.int32)
+        self._counts = np.empty(
+            (capacity, n), np.intp
+        )  # index width: no conversion in repeat or take
+        self._flat_index = np.arange(capacity * n, dtype=np.intp)
         self._capacity = max(capacity, old)
 
     @property
