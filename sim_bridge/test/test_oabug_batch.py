@@ -76,3 +76,21 @@ def test_a_robot_holds_still_until_scan_and_imu_arrive_and_when_they_go_stale():
     assert moving != stop
     # Nothing new for longer than stale_timeout_s: the node's fail safe.
     assert robot.control(0.2 + robot.stale_timeout_s + 0.1) == stop
+
+
+def test_without_the_cdr_round_trip_both_paths_still_agree(monkeypatch):
+    # In-process messages then keep Python floats in their float32 fields; the batch path
+    # follows the runtime's setting.
+    monkeypatch.setenv('SWARM_RUNTIME_CDR_ROUNDTRIP', '0')
+    config = SpawnConfig(
+        site=str(FIVE_ROOMS), robots=4, variant='gas', departure='edge', actions=150
+    )
+    spec, _ = build_mission(config)
+    ros = run_mission(spec)
+    batch = run_oabug_batch(spec)
+    assert ros.distance_travelled_m.min() > 2.0
+    np.testing.assert_array_equal(batch.trajectories, ros.trajectories)
+    assert batch.room_entries == ros.room_entries
+    # Rounding the bearings and scan angles as serialization does changes the run.
+    rounded = run_oabug_batch(spec, float32_fields=True)
+    assert not np.array_equal(rounded.trajectories, ros.trajectories)
