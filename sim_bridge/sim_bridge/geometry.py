@@ -382,22 +382,23 @@ class RayCaster:
         yaw = poses[:, 2]
         theta = (yaw[:, None] + self._bin_offsets_rad[None, :]).ravel()
         ray_dir = (np.cos(theta), np.sin(theta))
-        pairs = self._segment_pairs(origin, yaw, max_range_m)
-        near = pairs.distance_m <= self.near_range_m
-        self._fill(pairs.select(near), ray_dir, best)
+        near, far = self._segment_pairs(origin, yaw, max_range_m)
+        self._fill(near, ray_dir, best)
         if n > 1:
             self._scan_discs(origin, yaw, ray_dir, max_range_m, best)
-        far = pairs.select(~near)
         if far.size:
             self._fill(far.select(self._may_be_visible(far, best)), ray_dir, best)
         best[best > max_range_m] = np.inf
         return best.reshape(n, nb)
 
-    def _segment_pairs(self, origin: np.ndarray, yaw: np.ndarray, max_range_m: float) -> _Pairs:
-        """Every (robot, segment face) pair within range, with the face's bin interval."""
+    def _segment_pairs(
+        self, origin: np.ndarray, yaw: np.ndarray, max_range_m: float
+    ) -> tuple[_Pairs, _Pairs]:
+        """Every (robot, segment face) pair within range that covers a bin, with the face's
+        bin interval: those within ``near_range_m`` and the farther ones."""
         segs = self._all_segments
         if len(segs) == 0:
-            return _Pairs.empty()
+            return _Pairs.empty(), _Pairs.empty()
         dist = point_segment_distance(origin, segs)
         near = dist <= max_range_m + self._all_half
         # An end face is seen only from in front of it: cull the pairs where it faces away.
@@ -410,7 +411,7 @@ class RayCaster:
             near[:, capped] &= side * self._all_outward[capped] > 0.0
         robot_idx, seg_idx = np.nonzero(near)
         if len(robot_idx) == 0:
-            return _Pairs.empty()
+            return _Pairs.empty(), _Pairs.empty()
         half = self._all_half[seg_idx]
         ox = origin[robot_idx, 0]
         oy = origin[robot_idx, 1]
@@ -435,15 +436,20 @@ class RayCaster:
             np.arctan2(ay - half * ny, ax - half * nx),
             np.arctan2(by - half * ny, bx - half * nx),
         )
-        keep = counts > 0
-        return _Pairs(
-            robot=robot_idx[keep],
-            normal_x=nx[keep],
-            normal_y=ny[keep],
-            face_m=face[keep],
-            first=first[keep] % self.num_bins,
-            counts=counts[keep],
-            distance_m=np.maximum(dist[robot_idx, seg_idx] - half, 0.0)[keep],
+        distance = np.maximum(dist[robot_idx, seg_idx] - half, 0.0)
+        pairs = _Pairs(
+            robot=robot_idx,
+            normal_x=nx,
+            normal_y=ny,
+            face_m=face,
+            first=first % self.num_bins,
+            counts=counts,
+            distance_m=distance,
+        )
+        covers = counts > 0
+        close = distance <= self.near_range_m
+        return pairs.select((covers & close).nonzero()[0]), pairs.select(
+            (covers & ~close).nonzero()[0]
         )
 
     def _may_be_visible(self, pairs: _Pairs, best: np.ndarray) -> np.ndarray:
