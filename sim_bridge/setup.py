@@ -30,6 +30,8 @@ setup(
         'scipy',
         'matplotlib',
         'pybullet',
+        # The compiled lidar kernel (simulation only, like pybullet).
+        'numba',
         'PyYAML',
         'swarm_runtime',
         'swarm_analysis',

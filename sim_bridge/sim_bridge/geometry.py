@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from sim_bridge.errors import WorldGeometryError
+from sim_bridge.raycast_kernel import scan_kernel
 
 __all__ = [
     'RayCaster',
@@ -332,6 +333,10 @@ class RayCaster:
         self._ax, self._ay = all_segments[:, 0, 0].copy(), all_segments[:, 0, 1].copy()
         self._bx, self._by = all_segments[:, 1, 0].copy(), all_segments[:, 1, 1].copy()
         self._one_sided = np.flatnonzero(self._all_outward != 0.0)
+        # The same faces as rows for the compiled kernel.
+        self._faces = np.column_stack(
+            [self._ax, self._ay, self._bx, self._by, self._all_half, self._all_outward]
+        )
         self.near_range_m = near_range_m
         self._sector_bins = max(1, num_bins // 36)
         self._half_thickness_m = half
@@ -372,6 +377,32 @@ class RayCaster:
         Returns:
             (N, num_bins) float array of ranges [m] from each robot's centre.
         """
+        poses = np.asarray(poses, dtype=float)
+        n = len(poses)
+        nb = self.num_bins
+        best = np.full(n * nb, np.inf)
+        if n == 0:
+            return best.reshape(0, nb)
+        scan_kernel(
+            np.ascontiguousarray(poses[:, :2]),
+            np.ascontiguousarray(poses[:, 2]),
+            self._bin_offsets_rad,
+            self._faces,
+            self.angle_min_rad,
+            self.angle_increment_rad,
+            float(max_range_m),
+            float(self.near_range_m),
+            self._sector_bins,
+            self._robot_radius_m,
+            self._robot_radius_m**2,
+            best,
+        )
+        best[best > max_range_m] = np.inf
+        return best.reshape(n, nb)
+
+    def scan_reference(self, poses: np.ndarray, max_range_m: float) -> np.ndarray:
+        """:meth:`scan` in numpy, the reference the compiled kernel is tested against (same
+        ranges; see :mod:`sim_bridge.raycast_kernel`)."""
         poses = np.asarray(poses, dtype=float)
         n = len(poses)
         nb = self.num_bins

@@ -140,3 +140,58 @@ def test_wall_grid_crossings_equal_the_full_test_for_short_paths():
     crossed = grid.count_crossings(starts, ends)
     assert crossed.sum() > 100
     assert np.array_equal(crossed, count_crossings(starts, ends, walls))
+
+
+def _random_walls(rng: np.random.Generator, count: int) -> np.ndarray:
+    starts = rng.uniform(0.0, 8.0, (count, 2))
+    angles = rng.uniform(-math.pi, math.pi, count)
+    lengths = rng.uniform(0.2, 3.0, count)
+    ends = starts + lengths[:, None] * np.column_stack([np.cos(angles), np.sin(angles)])
+    return np.stack([starts, ends], axis=1)
+
+
+@pytest.mark.parametrize(
+    ('thickness', 'num_bins', 'robots'),
+    [(0.025, 360, 10), (0.0, 360, 4), (0.1, 100, 6), (0.025, 37, 3), (0.025, 360, 1)],
+)
+def test_compiled_scan_is_bit_identical_to_the_numpy_reference(thickness, num_bins, robots):
+    rng = np.random.default_rng(num_bins + robots)
+    for trial in range(40):
+        walls = _random_walls(rng, 30)
+        caster = RayCaster(walls, wall_thickness_m=thickness, robot_radius_m=0.1, num_bins=num_bins)
+        # Some robots crowded together, some near walls, headings anywhere.
+        xy = rng.uniform(0.0, 8.0, (robots, 2))
+        if trial % 2:
+            xy[1:] = xy[0] + rng.normal(0.0, 0.25, (robots - 1, 2))
+        if trial % 3 == 0:
+            xy[0] = walls[0, 0] + rng.normal(0.0, 0.05, 2)
+        poses = np.column_stack([xy, rng.uniform(-4.0, 4.0, robots)])
+        for max_range in (12.0, 1.5):
+            np.testing.assert_array_equal(
+                caster.scan(poses, max_range), caster.scan_reference(poses, max_range)
+            )
+
+
+def test_compiled_scan_is_bit_identical_on_a_generated_site():
+    from sim_bridge.site_geometry import geometry_from_site
+    from sim_bridge.spawn import SpawnConfig, build_mission
+
+    spec, _ = build_mission(SpawnConfig(site='small', robots=10))
+    walls = geometry_from_site(spec.site).walls
+    caster = RayCaster(walls, wall_thickness_m=0.025, robot_radius_m=0.1, num_bins=360)
+    rng = np.random.default_rng(7)
+    lo, hi = walls.reshape(-1, 2).min(axis=0), walls.reshape(-1, 2).max(axis=0)
+    poses = np.asarray(spec.initial_poses, dtype=float)
+    for _ in range(200):
+        np.testing.assert_array_equal(caster.scan(poses, 12.0), caster.scan_reference(poses, 12.0))
+        poses = np.column_stack(
+            [rng.uniform(lo[0], hi[0], 10), rng.uniform(lo[1], hi[1], 10), rng.uniform(-4, 4, 10)]
+        )
+
+
+def test_compiled_scan_handles_no_walls_and_no_robots():
+    caster = RayCaster(np.zeros((0, 2, 2)), wall_thickness_m=0.025, robot_radius_m=0.1, num_bins=36)
+    poses = np.array([[0.0, 0.0, 0.3], [1.0, 0.0, -2.0]])
+    np.testing.assert_array_equal(caster.scan(poses, 12.0), caster.scan_reference(poses, 12.0))
+    assert np.isfinite(caster.scan(poses, 12.0)).sum() > 0
+    assert caster.scan(np.zeros((0, 3)), 12.0).shape == (0, 36)
