@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from sim_bridge.errors import WorldGeometryError
-from sim_bridge.raycast_kernel import scan_kernel
+from sim_bridge.raycast_kernel import crossings_kernel, scan_kernel
 
 __all__ = [
     'RayCaster',
@@ -109,8 +109,8 @@ def count_crossings(
         return np.zeros(len(starts), dtype=int)
     q, s = _padded_walls(segments)
     if candidates is None:
-        candidates = np.arange(len(segments))
-    return _count_hits(starts, ends, q[:, 0][candidates], q[:, 1][candidates], s, candidates)
+        candidates = np.broadcast_to(np.arange(len(segments)), (len(starts), len(segments)))
+    return _count_hits(starts, ends, q, s, candidates)
 
 
 def _padded_walls(segments: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -122,6 +122,20 @@ def _padded_walls(segments: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _count_hits(
+    starts: np.ndarray, ends: np.ndarray, q: np.ndarray, s: np.ndarray, candidates: np.ndarray
+) -> np.ndarray:
+    """Crossings of the (K, 2) paths with their (K, W) candidate walls (``q``, ``s`` as
+    :func:`_padded_walls` gives them), counted by the compiled kernel."""
+    return crossings_kernel(
+        np.ascontiguousarray(starts, dtype=float),
+        np.ascontiguousarray(ends, dtype=float),
+        q,
+        s,
+        np.asarray(candidates, dtype=np.int64),
+    )
+
+
+def _count_hits_numpy(
     starts: np.ndarray,
     ends: np.ndarray,
     qx: np.ndarray,
@@ -130,7 +144,7 @@ def _count_hits(
     candidates: np.ndarray,
 ) -> np.ndarray:
     """Crossings of the paths with the candidate walls (start ``qx``, ``qy`` per candidate,
-    directions ``s`` per wall index)."""
+    directions ``s`` per wall index): the numpy reference of :func:`_count_hits`."""
     sx, sy = s[:, 0][candidates], s[:, 1][candidates]
     px, py = starts[:, 0, None], starts[:, 1, None]
     rx, ry = (ends[:, 0] - starts[:, 0])[:, None], (ends[:, 1] - starts[:, 1])[:, None]
@@ -215,8 +229,7 @@ class WallGrid:
             return np.zeros(len(starts), dtype=int)
         if candidates is None:
             candidates = self.candidates(starts)
-        q = self._q[candidates]
-        return _count_hits(starts, ends, q[..., 0], q[..., 1], self._s, candidates)
+        return _count_hits(starts, ends, self._q, self._s, candidates)
 
 
 def _expand_intervals(starts: np.ndarray, counts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -263,3 +263,49 @@ def scan_kernel(
                     far_ny[p],
                     far_face[p],
                 )
+
+
+@njit(cache=True)
+def crossings_kernel(
+    starts: np.ndarray,
+    ends: np.ndarray,
+    q: np.ndarray,
+    s: np.ndarray,
+    candidates: np.ndarray,
+) -> np.ndarray:  # pragma: no cover - compiled
+    """Number of candidate walls each path crosses: ``geometry._count_hits_numpy``'s test,
+    same operations, so the same integers.
+
+    Args:
+        starts: (K, 2) path start points [m].
+        ends: (K, 2) path end points [m].
+        q: (M + 1, 2) wall start points [m] (row M: the far padding "wall").
+        s: (M + 1, 2) wall direction vectors [m] (row M: zero).
+        candidates: (K, W) wall indices per path.
+    """
+    k_paths = starts.shape[0]
+    counts = np.zeros(k_paths, dtype=np.int64)
+    for k in range(k_paths):
+        px = starts[k, 0]
+        py = starts[k, 1]
+        rx = ends[k, 0] - px
+        ry = ends[k, 1] - py
+        hits = 0
+        for w in range(candidates.shape[1]):
+            m = candidates[k, w]
+            sx = s[m, 0]
+            sy = s[m, 1]
+            denom = rx * sy - ry * sx
+            qpx = q[m, 0] - px
+            qpy = q[m, 1] - py
+            t_num = qpx * sy - qpy * sx
+            u_num = qpx * ry - qpy * rx
+            # The reference multiplies by sign(denom) (-1, 0 or 1) and takes abs(denom).
+            sign = 1.0 if denom > 0.0 else (-1.0 if denom < 0.0 else 0.0)
+            t_s = t_num * sign
+            u_s = u_num * sign
+            d_s = abs(denom)
+            if d_s > 0.0 and t_s >= 0.0 and t_s <= d_s and u_s >= 0.0 and u_s <= d_s:
+                hits += 1
+        counts[k] = hits
+    return counts

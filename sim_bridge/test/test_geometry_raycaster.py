@@ -195,3 +195,24 @@ def test_compiled_scan_handles_no_walls_and_no_robots():
     np.testing.assert_array_equal(caster.scan(poses, 12.0), caster.scan_reference(poses, 12.0))
     assert np.isfinite(caster.scan(poses, 12.0)).sum() > 0
     assert caster.scan(np.zeros((0, 3)), 12.0).shape == (0, 36)
+
+
+def test_compiled_crossing_counts_equal_the_numpy_reference():
+    from sim_bridge.geometry import _count_hits, _count_hits_numpy, _padded_walls
+
+    rng = np.random.default_rng(5)
+    walls = np.concatenate([_random_walls(rng, 40), BOX * 2.0])
+    grid = WallGrid(walls, cell_m=0.5, reach_m=1.0)
+    q, s = _padded_walls(walls)
+    starts = rng.uniform(-0.5, 8.5, (4000, 2))
+    # Paths of every length, some along a wall or ending on one.
+    ends = starts + rng.normal(0.0, 1.0, (4000, 2)) * rng.choice([0.0, 0.1, 1.0, 5.0], (4000, 1))
+    ends[:40] = walls[:40, 1]
+    starts[40:80] = walls[:40, 0] + 0.3 * (walls[:40, 1] - walls[:40, 0])
+    ends[40:80] = walls[:40, 0] + 0.7 * (walls[:40, 1] - walls[:40, 0])
+    for candidates in (grid.candidates(starts), np.tile(np.arange(len(walls)), (4000, 1))):
+        expected = _count_hits_numpy(
+            starts, ends, q[:, 0][candidates], q[:, 1][candidates], s, candidates
+        )
+        assert expected.sum() > 100
+        np.testing.assert_array_equal(_count_hits(starts, ends, q, s, candidates), expected)
