@@ -224,3 +224,21 @@ def test_only_the_requested_side_walls_are_fitted(extractor) -> None:
     assert not neither.left.found
     assert not neither.right.found
     assert neither.front_wall_m == math.inf
+
+
+def corridor_ranges(half_width_m: float, heading_rad: float) -> np.ndarray:
+    """Ranges from the middle of an endless straight corridor, heading at an angle to it."""
+    s = np.abs(np.sin(ANGLES + heading_rad))
+    with np.errstate(divide='ignore'):
+        return np.where(s > 1e-9, half_width_m / s, np.inf)
+
+
+@pytest.mark.parametrize('heading_deg', [0.0, 30.0, 60.0, 90.0, 120.0, 150.0])
+def test_a_robot_can_turn_on_the_spot_in_the_middle_of_a_two_cell_corridor(
+    extractor, heading_deg: float
+) -> None:
+    """Generated sites have 2-cell (0.53 m) corridors, rooms and dead ends; turning round in
+    them must not read the side walls as a wall ahead, or the robot spins on the spot."""
+    half_width_m = 4.0 / 15.0
+    features = extractor.extract(scan_of(corridor_ranges(half_width_m, math.radians(heading_deg))))
+    assert features.front_wall_m > PerceptionConfig().wall_hit_distance_m
