@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from sim_bridge.errors import WorldGeometryError
-from sim_bridge.raycast_kernel import crossings_kernel, scan_kernel
+from sim_bridge.raycast_kernel import crossings_kernel, nearest_kernel, scan_kernel
 
 __all__ = [
     'RayCaster',
@@ -206,6 +206,20 @@ class WallGrid:
         ``reach_m``; elsewhere some larger value, since only the walls near a point's cell
         are measured.
         """
+        return nearest_kernel(
+            np.ascontiguousarray(points, dtype=float),
+            float(self._origin[0]),
+            float(self._origin[1]),
+            self.cell_m,
+            self._shape[0],
+            self._shape[1],
+            self._table,
+            self._q,
+            self._s,
+        )
+
+    def nearest_distance_reference(self, points: np.ndarray) -> np.ndarray:
+        """:meth:`nearest_distance` in numpy, the reference of the compiled kernel."""
         candidates = self.candidates(points)
         q = self._q[candidates]
         s = self._s[candidates]

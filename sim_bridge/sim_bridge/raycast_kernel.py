@@ -309,3 +309,59 @@ def crossings_kernel(
                 hits += 1
         counts[k] = hits
     return counts
+
+
+@njit(cache=True, error_model='numpy')
+def nearest_kernel(
+    points: np.ndarray,
+    origin_x: float,
+    origin_y: float,
+    cell_m: float,
+    shape_x: int,
+    shape_y: int,
+    table: np.ndarray,
+    q: np.ndarray,
+    s: np.ndarray,
+) -> np.ndarray:  # pragma: no cover - compiled
+    """``WallGrid.nearest_distance``: per point, the distance to the nearest wall of its
+    cell's table row, with the numpy version's operations (the padding "wall", whose NaN
+    ``fmin`` drops, is skipped).
+
+    Args:
+        points: (K, 2) query points [m].
+        origin_x: grid origin x [m].
+        origin_y: grid origin y [m].
+        cell_m: cell size [m].
+        shape_x: number of cells along x.
+        shape_y: number of cells along y.
+        table: (cells, W) wall indices per cell.
+        q: (M + 1, 2) wall start points [m].
+        s: (M + 1, 2) wall direction vectors [m].
+    """
+    k_points = points.shape[0]
+    out = np.empty(k_points)
+    for k in range(k_points):
+        px = points[k, 0]
+        py = points[k, 1]
+        cx = min(max(math.floor((px - origin_x) / cell_m), 0), shape_x - 1)
+        cy = min(max(math.floor((py - origin_y) / cell_m), 0), shape_y - 1)
+        row = cx * shape_y + cy
+        best = np.inf
+        for w in range(table.shape[1]):
+            m = table[row, w]
+            abx = s[m, 0]
+            aby = s[m, 1]
+            if abx == 0.0 and aby == 0.0:
+                continue  # the padding (walls have non-zero length)
+            inv_len2 = 1.0 / (abx * abx + aby * aby)
+            apx = px - q[m, 0]
+            apy = py - q[m, 1]
+            t = (apx * abx + apy * aby) * inv_len2
+            t = min(max(t, 0.0), 1.0)
+            dx = apx - t * abx
+            dy = apy - t * aby
+            d = math.sqrt(dx * dx + dy * dy)
+            if d < best:
+                best = d
+        out[k] = best
+    return out

@@ -216,3 +216,18 @@ def test_compiled_crossing_counts_equal_the_numpy_reference():
         )
         assert expected.sum() > 100
         np.testing.assert_array_equal(_count_hits(starts, ends, q, s, candidates), expected)
+
+
+def test_compiled_nearest_wall_distance_equals_the_numpy_reference():
+    rng = np.random.default_rng(6)
+    walls = np.concatenate([_random_walls(rng, 40), BOX * 2.0])
+    points = rng.uniform(-2.0, 10.0, (5000, 2))
+    points[:40] = walls[:40, 0]
+    for grid in (
+        WallGrid(walls, cell_m=0.5, reach_m=0.225),
+        WallGrid(walls, cell_m=0.3, reach_m=2.0),
+        WallGrid(np.zeros((0, 2, 2)), cell_m=0.5, reach_m=0.2),
+    ):
+        np.testing.assert_array_equal(
+            grid.nearest_distance(points), grid.nearest_distance_reference(points)
+        )
