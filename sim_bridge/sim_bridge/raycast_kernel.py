@@ -365,3 +365,45 @@ def nearest_kernel(
                 best = d
         out[k] = best
     return out
+
+
+@njit(cache=True)
+def lidar_noise_kernel(
+    exact: np.ndarray,
+    normal: np.ndarray,
+    uniform: np.ndarray,
+    noise_fraction: float,
+    noise_min_m: float,
+    dropout_probability: float,
+    range_min_m: float,
+    range_max_m: float,
+) -> np.ndarray:  # pragma: no cover - compiled
+    """``LidarModel``'s noisy ranges from exact ones, with the numpy version's operations.
+
+    Args:
+        exact: (N, B) exact ranges [m] (``inf`` for no return).
+        normal: one standard normal draw per finite range, in row-major order.
+        uniform: (N, B) uniform draws of the dropouts (unused if the probability is 0).
+        noise_fraction: noise standard deviation as a fraction of the range.
+        noise_min_m: floor of that standard deviation [m].
+        dropout_probability: chance that a sample is lost.
+        range_min_m: closer returns read ``-inf``.
+        range_max_m: farther returns read ``inf``.
+    """
+    noisy = exact.copy()
+    flat = noisy.ravel()
+    drops = uniform.ravel()
+    used = 0
+    for f in range(flat.shape[0]):
+        r = flat[f]
+        if math.isfinite(r):
+            r = r + normal[used] * max(noise_fraction * r, noise_min_m)
+            used += 1
+        if dropout_probability > 0.0 and drops[f] < dropout_probability:
+            r = np.inf
+        if r > range_max_m:
+            r = np.inf
+        if r < range_min_m:
+            r = -np.inf
+        flat[f] = r
+    return noisy

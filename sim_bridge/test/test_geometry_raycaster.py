@@ -231,3 +231,21 @@ def test_compiled_nearest_wall_distance_equals_the_numpy_reference():
         np.testing.assert_array_equal(
             grid.nearest_distance(points), grid.nearest_distance_reference(points)
         )
+
+
+@pytest.mark.parametrize('dropout', [0.005, 0.0, 0.3])
+def test_compiled_lidar_noise_equals_the_numpy_reference(dropout):
+    from sim_bridge.sensors.lidar import LidarConfig, LidarModel
+
+    rng = np.random.default_rng(8)
+    walls = np.concatenate([_random_walls(rng, 30), BOX * 2.0])
+    caster = RayCaster(walls, wall_thickness_m=0.025, robot_radius_m=0.1, num_bins=360)
+    config = LidarConfig(dropout_probability=dropout, range_max_m=4.0)
+    compiled = LidarModel(caster, config, np.random.default_rng(9))
+    reference = LidarModel(caster, config, np.random.default_rng(9))
+    for _ in range(30):
+        poses = np.column_stack([rng.uniform(0.0, 8.0, (6, 2)), rng.uniform(-4.0, 4.0, 6)])
+        got = compiled.measure(poses)
+        expected = reference.measure_reference(poses)
+        assert np.isneginf(expected).any() or np.isposinf(expected).any()
+        np.testing.assert_array_equal(got, expected)

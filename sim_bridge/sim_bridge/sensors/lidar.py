@@ -15,6 +15,7 @@ import numpy as np
 
 from sim_bridge.errors import ConfigurationError
 from sim_bridge.geometry import RayCaster
+from sim_bridge.raycast_kernel import lidar_noise_kernel
 
 __all__ = ['LidarConfig', 'LidarModel']
 
@@ -83,6 +84,25 @@ class LidarModel:
         Returns:
             (N, num_bins) ranges [m]; bin k at robot-frame angle -pi + k * angle_increment.
         """
+        cfg = self.config
+        exact = self._caster.scan(poses, cfg.range_max_m)
+        # The same draws as measure_reference, in the same order.
+        normal = self._rng.normal(0.0, 1.0, int(np.count_nonzero(np.isfinite(exact))))
+        uniform = self._rng.random(exact.shape) if cfg.dropout_probability > 0.0 else exact
+        return lidar_noise_kernel(
+            exact,
+            normal,
+            uniform,
+            cfg.range_noise_fraction,
+            cfg.range_noise_min_m,
+            cfg.dropout_probability,
+            cfg.range_min_m,
+            cfg.range_max_m,
+        )
+
+    def measure_reference(self, poses: np.ndarray) -> np.ndarray:
+        """:meth:`measure` in numpy, the reference of the compiled noise kernel (the same
+        ranges from the same random state)."""
         cfg = self.config
         exact = self._caster.scan(poses, cfg.range_max_m)
         noise_std = np.maximum(cfg.range_noise_fraction * exact, cfg.range_noise_min_m)
