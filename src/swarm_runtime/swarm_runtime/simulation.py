@@ -73,12 +73,15 @@ def spin_until(
         return True
     if not context.ok() or executor._is_shutdown:
         return False
-    limit_ns = None
-    if max_wall_time_s is not None:
-        limit_ns = context._elapsed_ns + round(max_wall_time_s * 1e9)
-
-    executor._run_callbacks(limit_ns, stop=predicate)
+    executor._run_callbacks(_wall_limit_ns(context, max_wall_time_s), stop=predicate)
     return predicate()
+
+
+def _wall_limit_ns(context: Context, max_wall_time_s: float | None) -> int | None:
+    """The virtual wall-clock instant [ns] a spin may not pass; None for no limit."""
+    if max_wall_time_s is None:
+        return None
+    return context._elapsed_ns + round(max_wall_time_s * 1e9)
 
 
 def spin_ready(executor: Executor) -> int:
@@ -116,9 +119,7 @@ def spin_until_time(
     if not reached():
         if not context.ok() or executor._is_shutdown:
             return False
-        limit_ns = None
-        if max_wall_time_s is not None:
-            limit_ns = context._elapsed_ns + round(max_wall_time_s * 1e9)
+        limit_ns = _wall_limit_ns(context, max_wall_time_s)
         # The executor checks the clock itself after each callback (no predicate call).
         executor._run_callbacks(limit_ns, until_clock_ns=target_ns)
         if not reached():
