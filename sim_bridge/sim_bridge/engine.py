@@ -128,6 +128,11 @@ class StepOutput:
     new_room_entries: list[RoomEntry] = field(default_factory=list)
 
 
+def _headings(poses: np.ndarray) -> np.ndarray:
+    """(N, 2) unit vectors cos(yaw), sin(yaw) of (N, 3) poses."""
+    return np.column_stack([np.cos(poses[:, 2]), np.sin(poses[:, 2])])
+
+
 class _Schedule:
     """Due times of a periodic output on a stepped clock."""
 
@@ -247,6 +252,29 @@ class SimEngine:
         self._pump_on[robot] = bool(on)
         self._pump_time_s[robot] = self.time_s
 
+    def set_commands(
+        self, robots: list[int], commands: list[tuple[float, float]], pumps: list[bool]
+    ) -> None:
+        """Record velocity and pump commands of several robots at once: what
+        :meth:`set_velocity_command` and :meth:`set_pump` do for each, in one call.
+
+        Args:
+            robots: K distinct robot indices.
+            commands: per robot, speed [m/s] and yaw rate [rad/s] (non-finite taken as zero).
+            pumps: per robot, pump on.
+        """
+        if not robots:
+            return
+        index = np.asarray(robots, dtype=int)
+        if index.min() < 0 or index.max() >= self.num_robots:
+            bad = next(i for i in robots if not 0 <= i < self.num_robots)
+            self._check_robot(bad)
+        values = np.asarray(commands, dtype=float).reshape(len(robots), 2)
+        self._command[index] = np.where(np.isfinite(values), values, 0.0)
+        self._command_time_s[index] = self.time_s
+        self._pump_on[index] = np.asarray(pumps, dtype=bool)
+        self._pump_time_s[index] = self.time_s
+
     def active_commands(self) -> np.ndarray:
         """(N, 2) commands in force now: stale ones are replaced by zero."""
         fresh = self.time_s - self._command_time_s <= self.config.cmd_vel_timeout_s + 1e-9
@@ -257,15 +285,19 @@ class SimEngine:
         fresh = self.time_s - self._pump_time_s <= self.config.pump_timeout_s + 1e-9
         return self._pump_on & fresh
 
-    def nozzle_positions(self, poses: np.ndarray) -> np.ndarray:
-        """(N, 2) pump nozzle positions [m] behind each robot."""
+    def nozzle_positions(self, poses: np.ndarray, headings: np.ndarray | None = None) -> np.ndarray:
+        """(N, 2) pump nozzle positions [m] behind each robot (``headings``: the poses'
+        :func:`_headings`, when the caller has them)."""
         off = self.config.pump_offset_m
-        return poses[:, :2] - off * np.column_stack([np.cos(poses[:, 2]), np.sin(poses[:, 2])])
+        return poses[:, :2] - off * (_headings(poses) if headings is None else headings)
 
-    def gas_sensor_positions(self, poses: np.ndarray) -> np.ndarray:
-        """(N, 2) gas sensor positions [m] ahead of each robot."""
+    def gas_sensor_positions(
+        self, poses: np.ndarray, headings: np.ndarray | None = None
+    ) -> np.ndarray:
+        """(N, 2) gas sensor positions [m] ahead of each robot (``headings`` as for
+        :meth:`nozzle_positions`)."""
         off = self.config.gas.sensor_offset_m
-        return poses[:, :2] + off * np.column_stack([np.cos(poses[:, 2]), np.sin(poses[:, 2])])
+        return poses[:, :2] + off * (_headings(poses) if headings is None else headings)
 
     def step(self) -> StepOutput:
         """Advance one physics period and return what is due."""
@@ -279,7 +311,9 @@ class SimEngine:
         self.time_s = self._step_index * dt
         poses = self.world.poses
         self.distance_travelled_m += np.hypot(*(poses[:, :2] - before[:, :2]).T)
-        self._depositor.step(pumping, self.nozzle_positions(poses), self.time_s, dt)
+        headings = _headings(poses)
+        if self._depositor.busy(pumping):
+            self._depositor.step(pumping, self.nozzle_positions(poses, headings), self.time_s, dt)
         out = StepOutput(time_s=self.time_s, poses=poses)
         out.new_room_entries = self.coverage.update(poses, self.time_s)
         sched = self._schedules
@@ -288,7 +322,7 @@ class SimEngine:
             out.scans = self.lidar.measure(poses)
         due, elapsed = sched['gas'].due(self.time_s)
         if due and 'gas' in wanted:
-            c = self.scent.concentration(self.gas_sensor_positions(poses), self.time_s)
+            c = self.scent.concentration(self.gas_sensor_positions(poses, headings), self.time_s)
             out.gas_raw = self.gas.update(c, elapsed)
         if sched['bearings'].due(self.time_s)[0] and 'bearings' in wanted:
             out.bearings = self.bearing_model.measure(poses)

@@ -199,15 +199,12 @@ class WallGrid:
         cy = np.clip(cell[:, 1], 0, self._shape[1] - 1)
         return self._table[cx * self._shape[1] + cy]
 
-    def nearest_distance(self, points: np.ndarray) -> np.ndarray:
-        """(K,) distance [m] from each of the (K, 2) points to the nearest wall.
-
-        Exact (the value :func:`point_segment_distance` gives) where it is at most
-        ``reach_m``; elsewhere some larger value, since only the walls near a point's cell
-        are measured.
-        """
-        return nearest_kernel(
-            np.ascontiguousarray(points, dtype=float),
+    def kernel_arguments(
+        self,
+    ) -> tuple[float, float, float, int, int, np.ndarray, np.ndarray, np.ndarray]:
+        """The grid as the compiled kernels take it: origin x, y [m], cell size [m], shape,
+        wall table and the padded walls (see :func:`~sim_bridge.raycast_kernel.nearest_kernel`)."""
+        return (
             float(self._origin[0]),
             float(self._origin[1]),
             self.cell_m,
@@ -217,6 +214,15 @@ class WallGrid:
             self._q,
             self._s,
         )
+
+    def nearest_distance(self, points: np.ndarray) -> np.ndarray:
+        """(K,) distance [m] from each of the (K, 2) points to the nearest wall.
+
+        Exact (the value :func:`point_segment_distance` gives) where it is at most
+        ``reach_m``; elsewhere some larger value, since only the walls near a point's cell
+        are measured.
+        """
+        return nearest_kernel(np.ascontiguousarray(points, dtype=float), *self.kernel_arguments())
 
     def nearest_distance_reference(self, points: np.ndarray) -> np.ndarray:
         """:meth:`nearest_distance` in numpy, the reference of the compiled kernel."""

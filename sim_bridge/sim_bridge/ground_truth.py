@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from sim_bridge.errors import WorldGeometryError
+from sim_bridge.world_kernel import rooms_touched_kernel
 
 __all__ = ['CoverageTracker', 'RoomEntry']
 
@@ -58,6 +59,7 @@ class CoverageTracker:
             raise WorldGeometryError('every room rectangle needs x_max > x_min and y_max > y_min')
         self._rects = rects
         rect_room = np.repeat(np.arange(len(per_room)), [len(r) for r in per_room])
+        self._rect_room = rect_room.astype(np.int64)
         # (R, K) 0/1 matrix: rectangle r belongs to room k.
         self._membership = np.zeros((len(rects), len(per_room)), dtype=np.int32)
         self._membership[np.arange(len(rects)), rect_room] = 1
@@ -93,7 +95,27 @@ class CoverageTracker:
         return self.rooms_covered == self.rooms_total
 
     def inside(self, positions: np.ndarray) -> np.ndarray:
-        """(N, K) bool: robot disc i overlaps the interior of room k."""
+        """(N, K) bool: robot disc i overlaps the interior of room k (compiled rectangle
+        test, equal to :meth:`inside_reference`)."""
+        xy = np.asarray(positions, dtype=float)[:, :2]
+        result = rooms_touched_kernel(
+            np.ascontiguousarray(xy),
+            self._rects,
+            self._rect_room,
+            self._num_rooms,
+            self._radius_m**2,
+        )
+        return self._add_room_lookup(xy, result)
+
+    def _add_room_lookup(self, xy: np.ndarray, result: np.ndarray) -> np.ndarray:
+        if self._room_index_at is not None:
+            index = np.asarray(self._room_index_at(xy), dtype=int)
+            robots = np.flatnonzero((index >= 0) & (index < self._num_rooms))
+            result[robots, index[robots]] = True
+        return result
+
+    def inside_reference(self, positions: np.ndarray) -> np.ndarray:
+        """:meth:`inside` in numpy, the reference of the compiled test."""
         xy = np.asarray(positions, dtype=float)[:, :2]
         r = self._rects
         x, y = xy[:, None, 0], xy[:, None, 1]
@@ -101,11 +123,7 @@ class CoverageTracker:
         dy = np.maximum(np.maximum(r[None, :, 1] - y, y - r[None, :, 3]), 0.0)
         in_rect = dx * dx + dy * dy < self._radius_m**2
         result = (in_rect.astype(np.int32) @ self._membership) > 0
-        if self._room_index_at is not None:
-            index = np.asarray(self._room_index_at(xy), dtype=int)
-            robots = np.flatnonzero((index >= 0) & (index < self._num_rooms))
-            result[robots, index[robots]] = True
-        return result
+        return self._add_room_lookup(xy, result)
 
     def update(self, positions: np.ndarray, time_s: float) -> list[RoomEntry]:
         """Record first entries at ``time_s`` from (N, 2+) robot positions; return the new ones.

@@ -28,7 +28,14 @@ import math
 import numpy as np
 from numba import njit
 
-__all__ = ['scan_kernel']
+__all__ = [
+    'crossings_kernel',
+    'grid_cell',
+    'lidar_noise_kernel',
+    'nearest_kernel',
+    'path_hits',
+    'scan_kernel',
+]
 
 _TWO_PI = 2.0 * math.pi
 
@@ -266,6 +273,34 @@ def scan_kernel(
 
 
 @njit(cache=True)
+def path_hits(
+    px: float, py: float, ex: float, ey: float, walls: np.ndarray, q: np.ndarray, s: np.ndarray
+) -> int:  # pragma: no cover - compiled
+    """How many of the walls ``walls`` (indices into ``q``, ``s``) the path from (px, py)
+    to (ex, ey) properly crosses: ``geometry._count_hits_numpy``'s test, same operations."""
+    rx = ex - px
+    ry = ey - py
+    hits = 0
+    for w in range(walls.shape[0]):
+        m = walls[w]
+        sx = s[m, 0]
+        sy = s[m, 1]
+        denom = rx * sy - ry * sx
+        qpx = q[m, 0] - px
+        qpy = q[m, 1] - py
+        t_num = qpx * sy - qpy * sx
+        u_num = qpx * ry - qpy * rx
+        # The reference multiplies by sign(denom) (-1, 0 or 1) and takes abs(denom).
+        sign = 1.0 if denom > 0.0 else (-1.0 if denom < 0.0 else 0.0)
+        t_s = t_num * sign
+        u_s = u_num * sign
+        d_s = abs(denom)
+        if d_s > 0.0 and t_s >= 0.0 and t_s <= d_s and u_s >= 0.0 and u_s <= d_s:
+            hits += 1
+    return hits
+
+
+@njit(cache=True)
 def crossings_kernel(
     starts: np.ndarray,
     ends: np.ndarray,
@@ -286,29 +321,26 @@ def crossings_kernel(
     k_paths = starts.shape[0]
     counts = np.zeros(k_paths, dtype=np.int64)
     for k in range(k_paths):
-        px = starts[k, 0]
-        py = starts[k, 1]
-        rx = ends[k, 0] - px
-        ry = ends[k, 1] - py
-        hits = 0
-        for w in range(candidates.shape[1]):
-            m = candidates[k, w]
-            sx = s[m, 0]
-            sy = s[m, 1]
-            denom = rx * sy - ry * sx
-            qpx = q[m, 0] - px
-            qpy = q[m, 1] - py
-            t_num = qpx * sy - qpy * sx
-            u_num = qpx * ry - qpy * rx
-            # The reference multiplies by sign(denom) (-1, 0 or 1) and takes abs(denom).
-            sign = 1.0 if denom > 0.0 else (-1.0 if denom < 0.0 else 0.0)
-            t_s = t_num * sign
-            u_s = u_num * sign
-            d_s = abs(denom)
-            if d_s > 0.0 and t_s >= 0.0 and t_s <= d_s and u_s >= 0.0 and u_s <= d_s:
-                hits += 1
-        counts[k] = hits
+        counts[k] = path_hits(
+            starts[k, 0], starts[k, 1], ends[k, 0], ends[k, 1], candidates[k], q, s
+        )
     return counts
+
+
+@njit(cache=True)
+def grid_cell(
+    px: float,
+    py: float,
+    origin_x: float,
+    origin_y: float,
+    cell_m: float,
+    shape_x: int,
+    shape_y: int,
+) -> int:  # pragma: no cover - compiled
+    """Row of ``WallGrid``'s table for the point (px, py): ``WallGrid.candidates``' cell."""
+    cx = min(max(math.floor((px - origin_x) / cell_m), 0), shape_x - 1)
+    cy = min(max(math.floor((py - origin_y) / cell_m), 0), shape_y - 1)
+    return cx * shape_y + cy
 
 
 @njit(cache=True, error_model='numpy')
@@ -343,9 +375,7 @@ def nearest_kernel(
     for k in range(k_points):
         px = points[k, 0]
         py = points[k, 1]
-        cx = min(max(math.floor((px - origin_x) / cell_m), 0), shape_x - 1)
-        cy = min(max(math.floor((py - origin_y) / cell_m), 0), shape_y - 1)
-        row = cx * shape_y + cy
+        row = grid_cell(px, py, origin_x, origin_y, cell_m, shape_x, shape_y)
         best = np.inf
         for w in range(table.shape[1]):
             m = table[row, w]

@@ -20,6 +20,7 @@ import numpy as np
 
 from sim_bridge.errors import ConfigurationError, WorldGeometryError
 from sim_bridge.geometry import WallGrid, as_segments, wrap_angle
+from sim_bridge.world_kernel import world_step_kernel
 
 __all__ = ['BodyConfig', 'World']
 
@@ -80,6 +81,7 @@ class World:
         self._clearance_cache: np.ndarray | None = None
         self._limits = np.array([self.body.max_linear_speed_mps, self.body.max_angular_speed_radps])
         self._walls_near = WallGrid(self.walls, cell_m=0.5, reach_m=2.0 * self._wall_clearance_m)
+        self._no_clearance = np.zeros(len(poses))
 
     def _wall_clearance(self) -> np.ndarray:
         """(N,) distance [m] from each robot centre to the nearest wall centre line (exact
@@ -119,8 +121,32 @@ class World:
 
         The unicycle is integrated exactly (arc of constant curvature). A move that would end
         closer to a wall or another robot than contact distance, and closer than before, is
-        cancelled (the robot still turns).
+        cancelled (the robot still turns). Runs the compiled step
+        (:func:`sim_bridge.world_kernel.world_step_kernel`), bit-identical to
+        :meth:`step_reference`.
         """
+        cmd = np.array(commands, dtype=float).reshape(self.num_robots, 2)
+        cache = self._clearance_cache
+        after, computed = world_step_kernel(
+            self._poses,
+            cmd,
+            float(self._limits[0]),
+            float(self._limits[1]),
+            float(dt_s),
+            self._wall_clearance_m,
+            2.0 * self.body.robot_radius_m,
+            len(self.walls) > 0,
+            self._no_clearance if cache is None else cache,
+            cache is not None,
+            self.collision_count,
+            self._velocities,
+            self._walls_near.kernel_arguments(),
+        )
+        if computed:
+            self._clearance_cache = after
+
+    def step_reference(self, commands: np.ndarray, dt_s: float) -> None:
+        """:meth:`step` in numpy, the reference of the compiled step."""
         cmd = self.clip_commands(commands)
         v = cmd[:, 0]
         w = cmd[:, 1]

@@ -5,6 +5,7 @@ import math
 import numpy as np
 import pytest
 from sim_bridge.errors import ConfigurationError, WorldGeometryError
+from sim_bridge.ground_truth import CoverageTracker
 from sim_bridge.world import BodyConfig, World
 
 WALL_AT_X2 = np.array([[[2.0, -5.0], [2.0, 5.0]]])
@@ -81,3 +82,63 @@ def test_invalid_poses_and_limits_are_rejected():
         World(np.zeros((0, 2, 2)), np.array([[0.0, math.nan, 0.0]]))
     with pytest.raises(ConfigurationError, match='robot_radius_m'):
         BodyConfig(robot_radius_m=0.0)
+
+
+def _random_walls(rng: np.random.Generator, count: int) -> np.ndarray:
+    starts = rng.uniform(-2.0, 2.0, (count, 2))
+    ends = starts + rng.uniform(-1.5, 1.5, (count, 2))
+    box = np.array(
+        [
+            [[-2.5, -2.5], [2.5, -2.5]],
+            [[2.5, -2.5], [2.5, 2.5]],
+            [[2.5, 2.5], [-2.5, 2.5]],
+            [[-2.5, 2.5], [-2.5, -2.5]],
+        ]
+    )
+    return np.concatenate([np.stack([starts, ends], axis=1), box])
+
+
+@pytest.mark.parametrize(('walls', 'robots'), [(0, 1), (0, 12), (6, 3), (15, 20)])
+def test_the_compiled_step_equals_the_numpy_step_bit_for_bit(walls, robots):
+    rng = np.random.default_rng(walls * 100 + robots)
+    segments = _random_walls(rng, walls) if walls else np.zeros((0, 2, 2))
+    # Crowded start poses: robots touch each other and the walls.
+    poses = np.column_stack(
+        [rng.uniform(-1.0, 1.0, (robots, 2)), rng.uniform(-math.pi, math.pi, robots)]
+    )
+    compiled = World(segments, poses)
+    reference = World(segments, poses)
+    collisions = 0
+    for step in range(300):
+        commands = np.column_stack([rng.uniform(-0.8, 0.8, robots), rng.uniform(-3.0, 3.0, robots)])
+        commands[rng.random((robots, 2)) < 0.05] = math.nan
+        commands[rng.random((robots, 2)) < 0.03] = math.inf
+        commands[rng.random((robots, 2)) < 0.1] = 0.0
+        commands[rng.random(robots) < 0.05, 1] = 1e-10  # straight-line branch
+        dt = 0.1 if step % 7 else 0.37
+        compiled.step(commands, dt)
+        reference.step_reference(commands, dt)
+        assert np.array_equal(compiled.poses, reference.poses)
+        assert np.array_equal(compiled.velocities, reference.velocities)
+        assert np.array_equal(compiled.collision_count, reference.collision_count)
+        collisions = int(compiled.collision_count.sum())
+    if walls or robots > 1:
+        assert collisions > 0  # the comparison covered blocked moves
+    if walls:
+        assert np.array_equal(compiled._wall_clearance(), reference._wall_clearance())
+
+
+def test_the_compiled_room_test_equals_the_numpy_one():
+    rng = np.random.default_rng(5)
+    lows = rng.uniform(-3.0, 3.0, (12, 2))
+    rects = np.column_stack([lows, lows + rng.uniform(0.1, 2.0, (12, 2))])
+    rooms = [rects[:3], rects[3:4], rects[4:8], np.zeros((0, 4)), rects[8:]]
+    tracker = CoverageTracker(rooms, 0.1)
+    positions = rng.uniform(-4.0, 5.0, (500, 3))
+    # Discs exactly touching an edge, and inside corners.
+    positions[:12, :2] = rects[:, :2] - [0.1, 0.0]
+    positions[12:24, :2] = rects[:, 2:] + [0.0, 0.1]
+    compiled = tracker.inside(positions)
+    assert np.array_equal(compiled, tracker.inside_reference(positions))
+    assert 20 < np.count_nonzero(compiled) < compiled.size
+    assert not compiled[:, 3].any()

@@ -23,6 +23,7 @@ import numpy as np
 
 from sim_bridge.errors import ConfigurationError
 from sim_bridge.geometry import WallGrid, as_segments
+from sim_bridge.scent_kernel import open_puff_pairs
 
 __all__ = ['PumpDepositor', 'ScentConfig', 'ScentField']
 
@@ -83,6 +84,9 @@ class ScentField:
         reach = config.cutoff_sigmas * config.final_spread_m
         self._cutoff2 = reach**2
         self._grid = WallGrid(self._walls, cell_m=0.5, reach_m=reach) if len(self._walls) else None
+        self._kernel_grid = (
+            self._grid or WallGrid(self._walls, cell_m=0.5, reach_m=reach)
+        ).kernel_arguments()
         self._xy = np.zeros((256, 2))
         self._time_s = np.zeros(256)
         self._mass = np.zeros(256)
@@ -127,7 +131,45 @@ class ScentField:
         return np.sqrt(var)
 
     def concentration(self, points: np.ndarray, time_s: float) -> np.ndarray:
-        """Ethanol concentration [ppm] at (K, 2) points at ``time_s``; returns (K,)."""
+        """Ethanol concentration [ppm] at (K, 2) points at ``time_s``; returns (K,).
+
+        The puffs that reach each point come from the compiled
+        :func:`sim_bridge.scent_kernel.open_puff_pairs`; the result equals
+        :meth:`concentration_reference` bit for bit.
+        """
+        points = np.atleast_2d(np.asarray(points, dtype=float))
+        n = self._count
+        if n == 0:
+            return np.zeros(len(points))
+        q_idx, p_idx, d2 = open_puff_pairs(
+            np.ascontiguousarray(points),
+            self._xy[:n],
+            self._time_s[:n],
+            float(time_s),
+            bool(self._time_s[n - 1] > time_s),
+            self._cutoff2,
+            self.config.walls_block and self._grid is not None,
+            self._kernel_grid,
+        )
+        if len(q_idx) == 0:
+            return np.zeros(len(points))
+        value = self._puff_values(p_idx, d2, time_s)
+        return np.bincount(q_idx, weights=value, minlength=len(points))
+
+    def _puff_values(self, p_idx: np.ndarray, d2: np.ndarray, time_s: float) -> np.ndarray:
+        """Contributions [ppm] of the puffs ``p_idx`` at squared distances ``d2`` [m^2]."""
+        cfg = self.config
+        a = time_s - self._time_s[p_idx]
+        sigma2 = self.spread_m(a) ** 2
+        return (
+            self._mass[p_idx]
+            * np.exp(-a / cfg.decay_time_constant_s)
+            / (2.0 * math.pi * sigma2)
+            * np.exp(-d2 / (2.0 * sigma2))
+        )
+
+    def concentration_reference(self, points: np.ndarray, time_s: float) -> np.ndarray:
+        """:meth:`concentration` in numpy, the reference of the compiled pair search."""
         points = np.atleast_2d(np.asarray(points, dtype=float))
         n = self._count
         if n == 0:
@@ -150,14 +192,7 @@ class ScentField:
             crossed = self._grid.count_crossings(points[q_idx], xy[p_idx], near_walls)
             open_path = crossed == 0
             q_idx, p_idx = q_idx[open_path], p_idx[open_path]
-        a = time_s - self._time_s[p_idx]
-        sigma2 = self.spread_m(a) ** 2
-        value = (
-            self._mass[p_idx]
-            * np.exp(-a / cfg.decay_time_constant_s)
-            / (2.0 * math.pi * sigma2)
-            * np.exp(-d2[q_idx, p_idx] / (2.0 * sigma2))
-        )
+        value = self._puff_values(p_idx, d2[q_idx, p_idx], time_s)
         # Summed in index order, like np.add.at: the same float result.
         return np.bincount(q_idx, weights=value, minlength=len(points))
 
@@ -168,6 +203,11 @@ class PumpDepositor:
     def __init__(self, field: ScentField, num_robots: int) -> None:
         self._field = field
         self._on_time_s = np.zeros(num_robots)
+
+    def busy(self, pump_on: np.ndarray) -> bool:
+        """False when a :meth:`step` with these pump states would do nothing (no pump runs
+        and no puff is pending), so that the caller may skip it."""
+        return bool(np.any(pump_on)) or bool(self._on_time_s.any())
 
     def step(self, pump_on: np.ndarray, nozzle_xy: np.ndarray, time_s: float, dt_s: float) -> None:
         """Account ``dt_s`` seconds of pumping and deposit the puffs that are complete.
