@@ -123,6 +123,27 @@ class ScanFeatureExtractor:
             config.feature_range_m,
         )
 
+    @property
+    def config(self) -> PerceptionConfig:
+        """The perception configuration."""
+        return self._config
+
+    @property
+    def feature_range_m(self) -> float:
+        """Returns farther than this [m] change no feature."""
+        return self._feature_range_m
+
+    def ray_directions(
+        self, scan: LaserScanData, count: int
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(count,) angles [rad] in the robot frame, in [-pi, pi), and their cos and sin.
+
+        Raises:
+            ScanError: the scan's angles are not finite or its increment is zero.
+        """
+        table = self._rays(scan, count)
+        return table.angles_rad, table.cos, table.sin
+
     def _rays(self, scan: LaserScanData, count: int) -> _RayTable:
         angle_min = scan.angle_min_rad + self._config.lidar_yaw_offset_rad
         key = (angle_min, scan.angle_increment_rad, count)
@@ -284,6 +305,20 @@ class ScanFeatureExtractor:
         xs = xs[near]
         ls = ls[near]
         abeam = bool(np.count_nonzero((xs >= -cfg.abeam_behind_m) & (ls <= cfg.abeam_reach_m)))
+        return self.wall_from_points(xs, ls, abeam)
+
+    def wall_from_points(self, xs: np.ndarray, ls: np.ndarray, abeam: bool) -> SideWall:
+        """The wall through the returns of one side's window, nearest band only.
+
+        Args:
+            xs: (K,) forward coordinates of the returns [m], K >= 1.
+            ls: (K,) their distance towards the side [m].
+            abeam: one of them lies abeam (see :class:`SideWall`).
+
+        Returns:
+            The wall with its angle as seen on the left; the caller mirrors the right side.
+        """
+        cfg = self._config
         if xs.size < 3 or xs.max() - xs.min() < 0.05:
             return SideWall(distance_m=float(ls.min()), angle_rad=0.0, abeam=abeam)
         angle, distance = _fit_line(xs, ls)

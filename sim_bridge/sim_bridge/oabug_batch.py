@@ -48,9 +48,10 @@ from oabug_robot.sound import PeerBearings
 from swarm_runtime.builtin._messages import cdr_roundtrip_enabled
 
 from sim_bridge.conversions import yaw_to_quaternion
-from sim_bridge.engine import READINGS, SimEngine, SiteGeometry
+from sim_bridge.engine import READINGS, EngineConfig, SimEngine, SiteGeometry
 from sim_bridge.errors import ConfigurationError
 from sim_bridge.mission import MissionProgress, MissionResult, MissionSpec, StopReason
+from sim_bridge.scan_features_kernel import extract_many
 from sim_bridge.sensors.bearings import PeerBearings as BearingReport
 from sim_bridge.sensors.lidar import LidarConfig
 from sim_bridge.site_geometry import geometry_from_site
@@ -124,6 +125,11 @@ class BatchRobot:
         self._gas = _Held()
         self._bearings: PeerBearings | None = None
 
+    @property
+    def needs_gas(self) -> bool:
+        """The robot's variant reads the gas sensor (it lays scent)."""
+        return self._needs_gas
+
     # Readings, in the order the bridge publishes them within a step.
 
     def receive_scan(self, ranges_m: np.ndarray, now_s: float) -> None:
@@ -146,16 +152,27 @@ class BatchRobot:
         """
         azimuths = np.asarray(report.azimuth_rad, dtype=self._field_type)
         distances = np.asarray(report.distance_m, dtype=self._field_type)
-        if self.own_tag in tag_ids:
-            # The node drops its own tag (the engine never reports it, a user's id might).
-            keep = report.tags != tag_ids.index(self.own_tag)
-            azimuths, distances = azimuths[keep], distances[keep]
+        keep = report.tags != self.own_tag_index(tag_ids)
+        self.hold_bearings(azimuths[keep].astype(float), distances[keep].astype(float), now_s)
+
+    def own_tag_index(self, tag_ids: Sequence[str]) -> int:
+        """Index of the robot's own tag in ``tag_ids``, -1 when it is not there. The node
+        drops its own tag (the engine never reports it, a user's id might)."""
+        return tag_ids.index(self.own_tag) if self.own_tag in tag_ids else -1
+
+    @property
+    def field_type(self) -> type:
+        """The type of the messages' float32 fields as received: np.float32 or np.float64."""
+        return self._field_type
+
+    def hold_bearings(
+        self, azimuths_rad: np.ndarray, distances_m: np.ndarray, now_s: float
+    ) -> None:
+        """Hold a locator cycle already converted as the message carries it (the own tag
+        dropped, float32 fields rounded, then widened); stamped with the yaw held now."""
         yaw = self._yaw.value if math.isfinite(self._yaw.value) else 0.0
         self._bearings = PeerBearings(
-            azimuths_rad=azimuths.astype(float),
-            distances_m=distances.astype(float),
-            stamp_s=now_s,
-            yaw_at_stamp_rad=yaw,
+            azimuths_rad=azimuths_rad, distances_m=distances_m, stamp_s=now_s, yaw_at_stamp_rad=yaw
         )
 
     def receive_imu(self, yaw_rad: float, now_s: float) -> None:
@@ -172,6 +189,27 @@ class BatchRobot:
         return bearings.near_peers_now(
             self._yaw.value, self.config.perception.peer_bearing_max_distance_m
         )
+
+    def pending_scan(
+        self, now_s: float
+    ) -> tuple[LaserScanData, tuple[np.ndarray, np.ndarray], int] | None:
+        """The held scan that this control step turns into features, the near peers' bearings
+        and distances and the side whose wall is wanted; None when there is nothing to do."""
+        scan = self._scan.value
+        if scan is None or not math.isfinite(self._yaw.value):
+            return None
+        return scan, self._near_peers(now_s), self.fsm.memory.wall_side
+
+    def take_features(self, features: ScanFeatures) -> None:
+        """Hold the features of the pending scan (computed for many robots at once)."""
+        self._features = features
+        self._features_time_s = self._scan.time_s
+        self._scan.value = None
+
+    @property
+    def extractor(self) -> ScanFeatureExtractor:
+        """The robot's scan feature extractor."""
+        return self._extractor
 
     def _update_features(self, now_s: float) -> None:
         scan, scan_time = self._scan.value, self._scan.time_s
@@ -243,22 +281,27 @@ def run_oabug_batch(
     wall_start = time.perf_counter()
     site = spec.site
     geometry = site if isinstance(site, SiteGeometry) else geometry_from_site(site)
-    # The OA-Bug node subscribes to no odometry; every other reading is consumed.
+    # The OA-Bug node subscribes to no odometry, and to no gas when its variant lays no
+    # scent; every other reading is consumed.
+    engine_config = spec.engine_config or EngineConfig()
+    if float32_fields is None:
+        float32_fields = cdr_roundtrip_enabled()
+    robots = [
+        BatchRobot(robot.parameters, engine_config.lidar, float32_fields=float32_fields)
+        for robot in spec.robots
+    ]
+    unused = {'odometry'}
+    if not any(robot.needs_gas for robot in robots):
+        unused.add('gas')
     engine = SimEngine(
         geometry,
         np.asarray(spec.initial_poses, dtype=float),
-        spec.engine_config,
-        readings=READINGS - {'odometry'},
+        engine_config,
+        readings=READINGS - unused,
     )
     n = engine.num_robots
     names = tuple(f'r{i}' for i in range(n))
     tag_ids = tuple(name.upper() for name in names)
-    lidar = engine.config.lidar
-    if float32_fields is None:
-        float32_fields = cdr_roundtrip_enabled()
-    robots = [
-        BatchRobot(robot.parameters, lidar, float32_fields=float32_fields) for robot in spec.robots
-    ]
     times = [0.0]
     poses = [engine.world.poses]
     next_sample_s = spec.trajectory_period_s
@@ -326,11 +369,11 @@ def _deliver(
         for robot, raw in zip(robots, out.gas_raw.tolist(), strict=True):
             robot.receive_gas(raw, now_s)
     if out.bearings is not None:
-        for robot, report in zip(robots, out.bearings, strict=True):
-            robot.receive_bearings(report, tag_ids, now_s)
+        _deliver_bearings(robots, out.bearings, tag_ids, now_s)
     if out.imu is not None:
         for robot, yaw in zip(robots, out.imu[0].tolist(), strict=True):
             robot.receive_imu(yaw, now_s)
+    due = []
     for i, robot in enumerate(robots):
         if now_ns < robot.next_control_ns:
             continue
@@ -339,9 +382,59 @@ def _deliver(
         if robot.next_control_ns < now_ns:
             behind = now_ns - robot.next_control_ns
             robot.next_control_ns += (1 + (behind - 1) // period) * period
+        due.append(i)
+    # A robot's control step reads only its own readings and controller, so the scan
+    # features of every robot due can be computed first, all at once.
+    _extract_features([robots[i] for i in due], now_s)
+    velocities: list[tuple[float, float]] = []
+    pumps: list[bool] = []
+    for i in due:
+        robot = robots[i]
         command = robot.control(now_s)
-        engine.set_velocity_command(i, float(command.linear_mps), float(command.angular_radps))
-        engine.set_pump(i, bool(command.pump_on))
+        velocities.append((float(command.linear_mps), float(command.angular_radps)))
+        pumps.append(bool(command.pump_on))
+    engine.set_commands(due, velocities, pumps)
+
+
+def _deliver_bearings(
+    robots: list[BatchRobot], reports: list[BearingReport], tag_ids: tuple[str, ...], now_s: float
+) -> None:
+    """:meth:`BatchRobot.receive_bearings` for every robot, each conversion done once for
+    all (every robot's messages have the same field types)."""
+    field = robots[0].field_type
+    azimuths = np.concatenate([r.azimuth_rad for r in reports]).astype(field).astype(float)
+    distances = np.concatenate([r.distance_m for r in reports]).astype(field).astype(float)
+    counts = [len(r.tags) for r in reports]
+    own = np.repeat([robot.own_tag_index(tag_ids) for robot in robots], counts)
+    keep = np.concatenate([r.tags for r in reports]) != own
+    bounds = np.zeros(len(reports) + 1, dtype=int)
+    np.cumsum(counts, out=bounds[1:])
+    if not keep.all():
+        # Kept before each report's first entry: the bounds in the filtered arrays.
+        bounds = np.concatenate(([0], np.cumsum(keep)))[bounds]
+        azimuths, distances = azimuths[keep], distances[keep]
+    for robot, lo, hi in zip(robots, bounds[:-1].tolist(), bounds[1:].tolist(), strict=True):
+        robot.hold_bearings(azimuths[lo:hi], distances[lo:hi], now_s)
+
+
+def _extract_features(robots: list[BatchRobot], now_s: float) -> None:
+    """Turn the held scans of ``robots`` into features, the robots of one perception
+    configuration in one compiled call (:func:`sim_bridge.scan_features_kernel.extract_many`,
+    equal to each robot's extractor). A robot whose scan the batch cannot take (a
+    :class:`ScanError`) is left to its own extractor in its control step."""
+    groups: dict[Any, list[tuple[BatchRobot, tuple[Any, ...]]]] = {}
+    for robot in robots:
+        pending = robot.pending_scan(now_s)
+        if pending is not None:
+            groups.setdefault(robot.config.perception, []).append((robot, pending))
+    for members in groups.values():
+        scans, peers, sides = zip(*(pending for _, pending in members), strict=True)
+        try:
+            features = extract_many(members[0][0].extractor, scans, peers, sides)
+        except ScanError:
+            continue
+        for (robot, _), robot_features in zip(members, features, strict=True):
+            robot.take_features(robot_features)
 
 
 def run_spawn_batch(

@@ -1,0 +1,344 @@
+"""Scan features of many robots in one compiled call: what
+:meth:`oabug_robot.scan_features.ScanFeatureExtractor.extract` returns for each of them.
+
+Simulation only (numba is a dependency of the simulation install, never of a robot): the
+robots run the numpy extractor, which stays the reference. The batch sweep path
+(:mod:`sim_bridge.oabug_batch`) hands every scan of a physics step to :func:`extract_many`
+instead of calling the extractor once per robot. The features are bit-identical
+(``test_scan_features_kernel.py`` compares them on random scans with NaN and +-inf ranges,
+empty scans and peers with NaN bearings and distances):
+
+* the transcendental functions stay in numpy (``arctan2``, ``sin``, ``cos``), computed for
+  all robots at once: numpy's vectorised ``arctan2`` differs from the C library's in the last
+  place for about 1 % of arguments, and its value of an element does not depend on the
+  array around it;
+* the kernel does only comparisons, products, sums of two terms and minima, in the same
+  order as the numpy code: the ray selection, the peer mask, the front corridor and cone,
+  and the returns of the followed side's window (nearest band, abeam flag);
+* the line fit of the side wall (sums and dot products, whose rounding depends on numpy's
+  and BLAS's summation order) is the extractor's own
+  :meth:`~oabug_robot.scan_features.ScanFeatureExtractor.wall_from_points`.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+import numpy as np
+from numba import njit
+from oabug_robot.errors import ScanError
+from oabug_robot.scan_features import (
+    LaserScanData,
+    ScanFeatureExtractor,
+    ScanFeatures,
+    SideWall,
+)
+
+__all__ = ['extract_many', 'features_kernel']
+
+_TWO_PI = 2.0 * math.pi
+
+
+@njit(cache=True)
+def _in_window(angle: float, direction: float, half_width: float) -> bool:  # pragma: no cover
+    """The ray at ``angle`` lies in the window of a peer bearing ``direction`` [rad]."""
+    offset = abs(angle - direction)
+    return min(offset, _TWO_PI - offset) <= half_width
+
+
+@njit(cache=True)
+def features_kernel(
+    ranges: np.ndarray,
+    half_width: np.ndarray,
+    angles: np.ndarray,
+    cos_t: np.ndarray,
+    sin_t: np.ndarray,
+    bearing_start: np.ndarray,
+    bearing: np.ndarray,
+    bearing_distance: np.ndarray,
+    sides: np.ndarray,
+    params: tuple,
+    front_wall: np.ndarray,
+    front_robot: np.ndarray,
+    near_count: np.ndarray,
+    peer_count: np.ndarray,
+    side_count: np.ndarray,
+    side_x: np.ndarray,
+    side_l: np.ndarray,
+    abeam: np.ndarray,
+) -> None:  # pragma: no cover - compiled
+    """Features of K scans of B rays; the outputs are filled in place.
+
+    Args:
+        ranges: (K, B) ranges [m], -inf already replaced by range_min.
+        half_width: (K, B) angular half width of a peer's window at each range [rad].
+        angles, cos_t, sin_t: (B,) ray directions in the robot frame.
+        bearing_start: (K + 1,) slice bounds of each scan's peers in ``bearing``.
+        bearing: (T,) peer bearings wrapped to [-pi, pi] [rad]; NaN to skip.
+        bearing_distance: (T,) their coarse distances [m]; NaN where unknown.
+        sides: (K,) the side whose wall is wanted: +1 left, -1 right, 0 none.
+        params: range_min, limit, front_half_width, follow_capture, cone_cos,
+            peer_mask_range, robot_radius, peer_distance_factor, side_lookahead,
+            side_window_behind, side_wall_band, abeam_behind, abeam_reach.
+        front_wall, front_robot: (K,) outputs [m].
+        near_count, peer_count: (K,) outputs: returns within range, those of peers.
+        side_count: (K,) number of returns of the wanted side's nearest band.
+        side_x, side_l: (K, B) their forward and lateral coordinates [m].
+        abeam: (K,) one of them lies abeam.
+    """
+    (
+        range_min,
+        limit,
+        front_half_width,
+        follow_capture,
+        cone_cos,
+        peer_mask_range,
+        radius,
+        distance_factor,
+        lookahead,
+        behind,
+        band,
+        abeam_behind,
+        abeam_reach,
+    ) = params
+    body = 2.0 * radius
+    num_scans, num_rays = ranges.shape
+    index = np.empty(num_rays, dtype=np.int64)
+    is_peer = np.empty(num_rays, dtype=np.bool_)
+    xs = np.empty(num_rays)
+    ls = np.empty(num_rays)
+    for k in range(num_scans):
+        front_wall[k] = np.inf
+        front_robot[k] = np.inf
+        peer_count[k] = 0
+        side_count[k] = 0
+        abeam[k] = False
+        kept = 0
+        any_near = False
+        for j in range(num_rays):
+            r = ranges[k, j]
+            if r >= range_min and r <= limit:
+                index[kept] = j
+                is_peer[kept] = False
+                kept += 1
+                if r <= peer_mask_range:
+                    any_near = True
+        near_count[k] = kept
+        if kept == 0:
+            continue
+        # The peer mask, bearing by bearing.
+        if any_near:
+            for b in range(bearing_start[k], bearing_start[k + 1]):
+                direction = bearing[b]
+                if not math.isfinite(direction):
+                    continue
+                nearest = np.inf
+                for m in range(kept):
+                    j = index[m]
+                    r = ranges[k, j]
+                    if (
+                        r <= peer_mask_range
+                        and r < nearest
+                        and _in_window(angles[j], direction, half_width[k, j])
+                    ):
+                        nearest = r
+                if nearest == np.inf:
+                    continue
+                if bearing_distance[b] > distance_factor * (nearest + radius):
+                    continue  # heard far beyond its nearest return: behind a wall
+                reach = nearest + body
+                for m in range(kept):
+                    j = index[m]
+                    r = ranges[k, j]
+                    if (
+                        r <= peer_mask_range
+                        and r <= reach
+                        and _in_window(angles[j], direction, half_width[k, j])
+                    ):
+                        is_peer[m] = True
+        side = sides[k]
+        count = 0
+        for m in range(kept):
+            j = index[m]
+            r = ranges[k, j]
+            c = cos_t[j]
+            x = r * c
+            y = r * sin_t[j]
+            if is_peer[m]:
+                peer_count[k] += 1
+                if c >= cone_cos and r < front_robot[k]:
+                    front_robot[k] = r
+                continue
+            if x > 0.0 and abs(y) <= front_half_width and x < front_wall[k]:
+                front_wall[k] = x
+            if side == 0 or not (r <= follow_capture and x <= lookahead and x >= -behind):
+                continue
+            if side > 0 and y > 0.0:
+                xs[count] = x
+                ls[count] = y
+                count += 1
+            elif side < 0 and y < 0.0:
+                xs[count] = x
+                ls[count] = -y
+                count += 1
+        if count == 0:
+            continue
+        # Only the nearest wall: the returns within the band of the closest one.
+        closest = ls[0]
+        for m in range(1, count):
+            closest = min(closest, ls[m])
+        cut = closest + band
+        kept_side = 0
+        for m in range(count):
+            if ls[m] <= cut:
+                side_x[k, kept_side] = xs[m]
+                side_l[k, kept_side] = ls[m]
+                if xs[m] >= -abeam_behind and ls[m] <= abeam_reach:
+                    abeam[k] = True
+                kept_side += 1
+        side_count[k] = kept_side
+
+
+def _kernel_parameters(
+    extractor: ScanFeatureExtractor, range_min_m: float, range_max_m: float
+) -> tuple[float, ...]:
+    cfg = extractor.config
+    return tuple(
+        float(value)
+        for value in (
+            range_min_m,
+            min(range_max_m, extractor.feature_range_m),
+            cfg.front_half_width_m,
+            cfg.follow_capture_m,
+            math.cos(cfg.robot_cone_half_angle_rad),
+            cfg.peer_mask_range_m,
+            cfg.robot_radius_m,
+            cfg.peer_distance_factor,
+            cfg.side_lookahead_m,
+            cfg.side_window_behind_m,
+            cfg.side_wall_band_m,
+            cfg.abeam_behind_m,
+            cfg.abeam_reach_m,
+        )
+    )
+
+
+def _frame(scan: LaserScanData) -> tuple[float, float, float, float]:
+    return (scan.angle_min_rad, scan.angle_increment_rad, scan.range_min_m, scan.range_max_m)
+
+
+def extract_many(
+    extractor: ScanFeatureExtractor,
+    scans: Sequence[LaserScanData],
+    peers: Sequence[tuple[np.ndarray, np.ndarray]],
+    sides: Sequence[int],
+) -> list[ScanFeatures]:
+    """The features ``extractor.extract`` gives for each scan, computed in one call.
+
+    Args:
+        extractor: the extractor whose configuration (and ray table) every robot shares.
+        scans: K scans with the same angles, limits and number of rays.
+        peers: per scan, the peers' bearings [rad] and coarse distances [m] (NaN where
+            unknown), as passed to ``extract``.
+        sides: per scan, the side whose wall is wanted (+1 left, -1 right, 0 none): the
+            same as ``extract(..., sides=(side,) if side else ())``.
+
+    Raises:
+        ScanError: the scans have no rays or their angles are not finite.
+        ValueError: the scans differ in angles, limits or number of rays, or the
+            argument lengths differ.
+    """
+    if not len(scans) == len(peers) == len(sides):
+        msg = f'{len(scans)} scans, {len(peers)} peer sets and {len(sides)} sides'
+        raise ValueError(msg)
+    if not scans:
+        return []
+    first = scans[0]
+    frame = _frame(first)
+    if any(_frame(scan) != frame for scan in scans[1:]):
+        raise ValueError('the scans must share their angles and range limits')
+    ranges = np.stack([np.asarray(scan.ranges_m, dtype=float) for scan in scans])
+    if ranges.ndim != 2 or ranges.shape[1] == 0:
+        msg = f'scans must have at least one range, got shape {ranges.shape[1:]}'
+        raise ScanError(msg)
+    angles, cos_t, sin_t = extractor.ray_directions(first, ranges.shape[1])
+    cfg = extractor.config
+    range_min = max(float(first.range_min_m), 0.0)
+    # REP 117: -inf means "too close to measure", i.e. an obstacle at range_min.
+    ranges[ranges == -math.inf] = range_min
+    counts = [len(azimuths) for azimuths, _ in peers]
+    bearing_start = np.zeros(len(scans) + 1, dtype=np.int64)
+    np.cumsum(counts, out=bearing_start[1:])
+    if bearing_start[-1]:
+        azimuths = np.concatenate([np.asarray(a, dtype=float) for a, _ in peers])
+        distances = np.concatenate(
+            [
+                np.full(len(a), math.nan) if d is None else np.asarray(d, dtype=float)
+                for a, d in peers
+            ]
+        )
+        finite = np.isfinite(azimuths)
+        bearing = np.full(azimuths.size, math.nan)
+        bearing[finite] = np.arctan2(np.sin(azimuths[finite]), np.cos(azimuths[finite]))
+        half_width = cfg.peer_bearing_tolerance_rad + np.arctan2(cfg.robot_radius_m, ranges)
+    else:
+        bearing = distances = np.zeros(0)
+        half_width = ranges  # not read: no scan has a peer
+    k, num_rays = ranges.shape
+    front_wall = np.empty(k)
+    front_robot = np.empty(k)
+    near_count = np.empty(k, dtype=np.int64)
+    peer_count = np.empty(k, dtype=np.int64)
+    side_count = np.empty(k, dtype=np.int64)
+    side_x = np.empty((k, num_rays))
+    side_l = np.empty((k, num_rays))
+    abeam = np.empty(k, dtype=np.bool_)
+    features_kernel(
+        ranges,
+        half_width,
+        angles,
+        cos_t,
+        sin_t,
+        bearing_start,
+        bearing,
+        distances,
+        np.asarray(sides, dtype=np.int64),
+        _kernel_parameters(extractor, range_min, float(first.range_max_m)),
+        front_wall,
+        front_robot,
+        near_count,
+        peer_count,
+        side_count,
+        side_x,
+        side_l,
+        abeam,
+    )
+    result = []
+    for i, side in enumerate(sides):
+        if near_count[i] == 0:
+            result.append(ScanFeatures())
+            continue
+        left = right = SideWall()
+        if side:
+            n = side_count[i]
+            wall = SideWall()
+            if n:
+                wall = extractor.wall_from_points(
+                    side_x[i, :n].copy(), side_l[i, :n].copy(), bool(abeam[i])
+                )
+            if side > 0:
+                left = wall
+            else:
+                right = SideWall(wall.distance_m, -wall.angle_rad, wall.abeam)
+        result.append(
+            ScanFeatures(
+                front_wall_m=float(front_wall[i]),
+                front_robot_m=float(front_robot[i]),
+                left=left,
+                right=right,
+                near_returns=int(near_count[i]),
+                peer_returns=int(peer_count[i]),
+            )
+        )
+    return result
