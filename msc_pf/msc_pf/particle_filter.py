@@ -19,16 +19,20 @@ Convergence (eqs. 6-7) is tested once per control step by :meth:`end_step`: the 
 most R_conv and each of the last n estimates lies within R_err of their mean. A converged
 filter stays converged (its estimate keeps being refined).
 
-Particle positions are stored as float32 (x and y in separate (targets, N) arrays, the
-millimetre resolution is far below the metre-scale spread), the work arrays are
-preallocated, and a filter's several samples of one step are evaluated together. One step
-of 20 targets x 5041 particles costs about 3 ms of CPU (docs/msc_pf.md, "Benchmark"); most
-of it is the resampling (cumulative sum, copy counts, gather), whose float32 arithmetic is
-kept exactly so that seeded runs stay reproducible across versions.
+Speed (docs/msc_pf.md, "The particle filter"): particle positions are float32 (x and y in
+separate (targets, N) arrays; the millimetre resolution is far below the metre-scale spread),
+every work array is preallocated and written with ``out=``, and a filter's several samples of
+one step are evaluated together. The likelihood is kept as the misfit ``q = -log w`` and
+the weights ``exp(min q - q)`` are never normalised in place: the estimate divides by their
+sum, the resampling scales the cumulative sum. Systematic resampling turns the cumulative
+weights into the number of comb points before each particle's end and the gather index into
+a histogram of those ends and its cumulative sum: no per-particle loop (``np.repeat``), no
+binary search.
 """
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -43,11 +47,15 @@ __all__ = [
     'TargetEstimate',
     'estimates_converged',
     'lattice',
-    'systematic_counts',
+    'systematic_index',
+    'windows_converged',
 ]
 
 # exp(x) of a float64 is 0 or subnormal below this: "all weights zero" in the paper's form.
 _LOG_TINY = math.log(np.finfo(np.float64).tiny)
+# The comb is scaled by slightly less than N / sum(w) so that float32 rounding can never
+# put a comb point past the last particle (relative bias 1e-6, far below one copy).
+_COMB_SHRINK = 1.0 - 2.0**-20
 
 
 @dataclass(frozen=True)
@@ -94,6 +102,25 @@ def lattice(
     return gx.ravel()[keep].astype(np.float32), gy.ravel()[keep].astype(np.float32)
 
 
+def windows_converged(
+    spread_m: np.ndarray, windows_m: np.ndarray, r_conv_m: float, r_err_m: float
+) -> np.ndarray:
+    """Eqs. (6) and (7) for several filters: spread at most R_conv, every estimate near the mean.
+
+    Args:
+        spread_m: (k,) sigma_k of each filter's latest update [m].
+        windows_m: (k, n, 2) each filter's n most recent estimates [m].
+        r_conv_m: R_conv [m].
+        r_err_m: R_err [m].
+
+    Returns:
+        (k,) bool: both conditions hold.
+    """
+    offset = windows_m - windows_m.mean(axis=1, keepdims=True)
+    deviation = np.hypot(offset[..., 0], offset[..., 1])
+    return (spread_m <= r_conv_m) & np.all(deviation <= r_err_m, axis=1)
+
+
 def estimates_converged(
     spread_m: float, window_m: np.ndarray, r_conv_m: float, r_err_m: float
 ) -> bool:
@@ -105,49 +132,63 @@ def estimates_converged(
         r_conv_m: R_conv [m].
         r_err_m: R_err [m].
     """
-    if spread_m > r_conv_m:
-        return False
-    deviation = np.hypot(*(window_m - window_m.mean(axis=0)).T)
-    return bool(np.all(deviation <= r_err_m))
+    spread = np.array([spread_m], dtype=np.float64)
+    return bool(windows_converged(spread, window_m[None], r_conv_m, r_err_m)[0])
 
 
-def systematic_counts(
+def systematic_index(
     weights: np.ndarray,
     offsets: np.ndarray,
     out: np.ndarray | None = None,
     work: np.ndarray | None = None,
+    work_int32: np.ndarray | None = None,
 ) -> np.ndarray:
-    """Copies of each particle under systematic resampling, row by row.
+    """Gather index of systematic resampling, row by row, into the flattened ``weights``.
 
-    Row r draws N points at (u_r + m) / N, m = 0..N-1; particle j is copied as many times as
-    points fall in its slice of the cumulative weights, i.e. ``F_j - F_(j-1)`` with
-    ``F_j = ceil(N c_j - u_r)``. Rounding of the float32 cumulative sum can move a copy
-    between neighbouring particles but never changes the total: c is capped at 1 and the
-    last F is exactly N.
+    Row r draws N comb points at ``(m + u_r) / N``, m = 0..N-1, of its total weight; the
+    point falls on particle j when ``c_(j-1) < (m + u_r) / N <= c_j`` (c: cumulative weights
+    over their sum). With ``e_j`` the number of points at or before the end of particle j,
+    ``e_j = floor(N c_j + 1 - u_r)``, output m of the row is the particle count
+    ``#{j : e_j <= m}``: a histogram of the ends and its cumulative sum, both linear in the
+    number of particles and free of branches. The last end is set to N, so every row draws
+    exactly N points whatever the float32 rounding of its cumulative sum.
 
     Args:
-        weights: (k, N) normalised weights (float32).
+        weights: (k, N) non-negative weights (float32), not necessarily normalised; every row
+            must have a positive finite sum.
         offsets: (k, 1) offsets u_r in [0, 1).
-        out: optional (k, N) int32 array to write the counts to.
+        out: optional (k, N) intp array to write the index to.
         work: optional (k, N) float32 scratch array (saves an allocation).
+        work_int32: optional (k, N) int32 scratch array (saves an allocation).
 
     Returns:
-        (k, N) int32 copy counts, each row summing to N.
+        (k, N) intp: ``out[r, m]`` is the flat index (``r * N + j``) of the particle that
+        output m of row r copies; each row's indices are non-decreasing.
+
+    Raises:
+        ValueError: a row's weights do not have a positive finite sum, or k * N >= 2^31.
     """
     k, n = weights.shape
-    c = np.cumsum(weights, axis=1, dtype=np.float32, out=work)
-    # Rows are non-decreasing, so only rows whose total exceeds 1 need the cap.
-    if c[:, -1].max() > 1.0:
-        for row in np.flatnonzero(c[:, -1] > np.float32(1.0)):
-            np.minimum(c[row], np.float32(1.0), out=c[row])
-    c *= np.float32(n)
-    c -= offsets.astype(np.float32)
-    np.ceil(c, out=c)
-    c[:, -1] = n
-    counts = np.empty((k, n), np.int32) if out is None else out
-    counts[:, 0] = c[:, 0]
-    np.subtract(c[:, 1:], c[:, :-1], out=counts[:, 1:], casting='unsafe')
-    return counts
+    if k * n >= 2**31:
+        raise ValueError('at most 2^31 - 1 particles in all rows together')
+    cumulative = np.cumsum(weights, axis=1, dtype=np.float32, out=work)
+    last = cumulative[:, -1].astype(np.float64)
+    if not (last.min() > 0.0 and last.max() < math.inf):  # NaN fails both
+        raise ValueError('every row of weights needs a positive finite sum')
+    cumulative *= (n * _COMB_SHRINK / last).astype(np.float32)[:, None]
+    cumulative += (1.0 - offsets).astype(np.float32)
+    # float32 -> int32 -> intp: two fast conversions instead of one slow one. Truncation is
+    # the floor here: every value is positive.
+    ends32 = np.empty((k, n), np.int32) if work_int32 is None else work_int32
+    ends32[...] = cumulative
+    ends32[:, -1] = n
+    if k > 1:
+        ends32 += np.arange(0, k * n, n, dtype=np.int32)[:, None]
+    ends = np.empty((k, n), np.intp) if out is None else out
+    ends[...] = ends32
+    histogram = np.bincount(ends.reshape(-1), minlength=k * n + 1)
+    np.cumsum(histogram[: k * n], out=ends.reshape(-1))
+    return ends
 
 
 _CENSOR_STEP_DB = 0.01
@@ -155,25 +196,27 @@ _CENSOR_U_MAX = 6.0  # Phi(6) = 1 - 1e-9: no correction beyond
 _CENSOR_U_MIN = -8.0  # the squared error term dominates beyond
 
 
-def _censoring_table(
-    config: ParticleFilterConfig, radio: RadioConfig, denominator: float
-) -> tuple[np.ndarray, float, float]:
-    """``-log Phi((R - gamma_D) / s)`` tabulated over the path loss ``L = P0 - R`` [dB].
+@functools.lru_cache(maxsize=8)
+def _censoring_table(noise_std_db: float, margin_db: float) -> np.ndarray:
+    """``-log Phi((margin - L) / s)`` over the path loss ``L = P0 - R`` [dB], bin i at i * step.
 
-    ``s = sqrt(denominator / 2)`` is the noise standard deviation the likelihood of eq. (3)
-    implies (sigma / sqrt 2 for the paper's form, sigma for the Gaussian one). Returns the
-    table (empty when the correction is off), the path loss of its first bin and 1 / bin width.
+    ``margin`` is the path loss at which ``R = gamma_D``; ``s`` the noise standard deviation
+    the likelihood of eq. (3) implies. Bin i covers ``[i, i + 1) * step`` and holds the value
+    at its centre; the table ends where ``(margin - L) / s = U_MIN`` (a look-up beyond clips
+    to its last bin). Shared by every bank with the same radio model (read-only).
     """
-    if not config.censored_likelihood:
-        return np.empty(0, np.float32), 0.0, 1.0
-    s = math.sqrt(denominator / 2.0)
-    margin = radio.rssi_at_1m_dbm - radio.detection_threshold_dbm  # L at which R = gamma_D
-    lo = margin - _CENSOR_U_MAX * s
-    count = math.ceil((_CENSOR_U_MAX - _CENSOR_U_MIN) * s / _CENSOR_STEP_DB)
-    loss = lo + (np.arange(count) + 0.5) * _CENSOR_STEP_DB
-    u = (margin - loss) / s
-    table = np.array([-math.log(0.5 * math.erfc(-v / math.sqrt(2.0))) for v in u], np.float32)
-    return table, lo, 1.0 / _CENSOR_STEP_DB
+    count = math.ceil((margin_db - _CENSOR_U_MIN * noise_std_db) / _CENSOR_STEP_DB)
+    loss = (np.arange(count) + 0.5) * _CENSOR_STEP_DB
+    u = (margin_db - loss) / noise_std_db
+    table = np.array(
+        [
+            0.0 if v > _CENSOR_U_MAX else -math.log(0.5 * math.erfc(-v / math.sqrt(2.0)))
+            for v in u.tolist()
+        ],
+        np.float32,
+    )
+    table.flags.writeable = False
+    return table
 
 
 class ParticleFilterBank:
@@ -206,11 +249,18 @@ class ParticleFilterBank:
             if config.init_half_width_m is not None
             else radio.detection_range_m
         )
-        self._denominator = config.noise_variance_db2 * (2.0 if config.gaussian_likelihood else 1.0)
-        self._log_scale = 5.0 * radio.path_loss_exponent  # 10 K log10 d = 5 K log10 d^2
-        self._censor_table, self._censor_lo_db, self._censor_inv_step = _censoring_table(
-            config, radio, self._denominator
-        )
+        denominator = config.noise_variance_db2 * (2.0 if config.gaussian_likelihood else 1.0)
+        # Misfit q = ((P - P0) + 5 K log10 d^2)^2 / denominator = (a log10 d^2 + b)^2.
+        root = 1.0 / math.sqrt(denominator)
+        self._misfit_slope = np.float32(5.0 * radio.path_loss_exponent * root)
+        self._misfit_root = root
+        if config.censored_likelihood:
+            margin = radio.rssi_at_1m_dbm - radio.detection_threshold_dbm  # L at R = gamma_D
+            self._censor_table = _censoring_table(math.sqrt(denominator / 2.0), margin)
+        else:
+            self._censor_table = np.empty(0, np.float32)
+        # Table bin of log10 d^2: L / step = 5 K log10 d^2 / step.
+        self._censor_bins_per_log = np.float32(5.0 * radio.path_loss_exponent / _CENSOR_STEP_DB)
         self._pool = (
             rng.standard_normal(config.noise_pool_size, dtype=np.float32)
             if config.noise_pool_size
@@ -245,20 +295,16 @@ class ParticleFilterBank:
         self._converged = grow(get('_converged'), (capacity,), np.bool_)
         self._updated = grow(get('_updated'), (capacity,), np.bool_)
         self._n_updates = grow(get('_n_updates'), (capacity,), np.int64)
-        # Work buffers, sized for updating every slot at once.
-        self._buf_a = np.empty((capacity, n), np.float32)
-        self._buf_b = np.empty((capacity, n), np.float32)
-        self._buf_c32 = np.empty((capacity, n), np.float32)
-        self._buf_d32 = np.empty((capacity, n), np.float32)
-        self._buf_censor = np.empty((capacity, n), np.float32)
-        self._buf_cum = np.empty((capacity, n), np.float32)
+        # Work arrays, sized for updating every slot at once.
+        shape = (capacity, n)
+        self._w_q, self._w_dx, self._w_dy, self._w_d2, self._w_tmp, self._w_cum = (
+            np.empty(shape, np.float32) for _ in range(6)
+        )
+        self._w_x, self._w_y = np.empty(shape, np.float32), np.empty(shape, np.float32)
+        self._w_index = np.empty(shape, np.intp)  # censoring table bins, resampling index
+        # The new particles (swapped with the storage when every filter was updated).
         self._buf_nx = np.empty((capacity, n), np.float32)
         self._buf_ny = np.empty((capacity, n), np.float32)
-        self._buf_x = np.empty((capacity, n), np.float32)
-        self._buf_y = np.empty((capacity, n), np.float32)
-        self._counts = np.empty(
-            (capacity, n), np.intp
-        )  # index width: no conversion in repeat or take
         self._flat_index = np.arange(capacity * n, dtype=np.intp)
         self._capacity = max(capacity, old)
 
@@ -410,7 +456,7 @@ class ParticleFilterBank:
         first = np.array([samples[slot][0] for slot in slots])
         first[:, 2] -= self._radio.rssi_at_1m_dbm
         # Later samples, level by level (a filter's second samples, then its third...), each
-        # level in row order: the log-likelihoods add up in observation order.
+        # level in row order: the misfits add up in observation order.
         extra: list[tuple[int, float, float, float]] = []
         level = 1
         while True:
@@ -425,48 +471,48 @@ class ParticleFilterBank:
         later[:, 3] -= self._radio.rssi_at_1m_dbm
         return self._update_slots(np.array(slots, dtype=np.int64), first, later)
 
-    def _log_likelihood(self, d2: np.ndarray, excess: np.ndarray, out: np.ndarray) -> np.ndarray:
-        """Eqs. (3)-(4) in log form, -((P - P0) + 5 K log10 d^2)^2 / sigma^2, into ``out``.
+    def _misfit(self, d2: np.ndarray, excess: np.ndarray, out: np.ndarray) -> np.ndarray:
+        """Minus the log-likelihood of eqs. (3)-(4), ``((P - P0) + 5 K log10 d^2)^2 / sigma^2``.
 
-        ``excess`` is the (rows, 1) float32 column of P - P0 [dB].
+        ``d2`` holds the squared distances (float32, at most ``capacity`` rows, unchanged),
+        ``excess`` the (rows, 1) column of P - P0 [dB]; the result goes to ``out`` (float32,
+        the shape of ``d2``).
 
-        With the censoring correction, ``-log Phi((R_j - gamma_D) / s)`` is added, looked up
-        in a table indexed by the path loss ``10 K log10 d``.
+        With the censoring correction, ``log Phi((R_j - gamma_D) / s)`` is added (the
+        likelihood is divided by Phi), looked up in a table indexed by the path loss
+        ``10 K log10 d`` (bins of 0.01 dB from 0 dB).
         """
         np.maximum(d2, np.float32(1.0), out=out)  # d < 1 m counts as 1 m
         np.log10(out, out=out)
-        out *= np.float32(self._log_scale)  # path loss 10 K log10 d = P0 - R_j
         censor = None
         if self._censor_table.size:
             rows, cols = out.shape
-            scaled = self._buf_censor[:rows, :cols]
-            np.subtract(out, np.float32(self._censor_lo_db), out=scaled)
-            scaled *= np.float32(self._censor_inv_step)
-            index = self._counts[:rows, :cols]  # free until resampling
-            index[...] = scaled  # truncation; the path loss is small enough for int32
-            # Clamping the truncated bin equals truncating the clamped value.
-            censor = np.take(self._censor_table, index, out=scaled, mode='clip')
-        out += excess
+            bins = self._w_index[:rows, :cols]  # free until resampling
+            # Truncation: the log is non-negative. Bins past the table clip to its end.
+            np.multiply(out, self._censor_bins_per_log, out=bins, casting='unsafe')
+            censor = np.take(self._censor_table, bins, out=self._w_tmp[:rows, :cols], mode='clip')
+        out *= self._misfit_slope
+        out += (np.asarray(excess, dtype=np.float64) * self._misfit_root).astype(np.float32)
         np.multiply(out, out, out=out)
-        out *= np.float32(-1.0 / self._denominator)
         if censor is not None:
-            out += censor
+            out -= censor
         return out
 
-    def _add_extra_samples(self, a: np.ndarray, x: np.ndarray, y: np.ndarray, extra: np.ndarray):
-        """Add the log-likelihoods of the later samples to ``a`` (rows of the first samples).
+    def _add_extra_samples(self, q: np.ndarray, x: np.ndarray, y: np.ndarray, extra: np.ndarray):
+        """Add the misfits of the later samples to ``q`` (rows of the first samples).
 
         ``extra`` holds (row, observer x, observer y, P - P0) per sample, level by level; the
         samples are evaluated in blocks as large as the work buffers.
         """
-        k = a.shape[0]
+        k = q.shape[0]
         block = self._capacity
         rows_all = extra[:, 0].astype(np.int64)
         for start in range(0, len(extra), block):
             rows = rows_all[start : start + block]
             chunk = extra[start : start + block]
             m = len(rows)
-            ex, ey, ll = self._buf_nx[:m], self._buf_ny[:m], self._buf_cum[:m]
+            # The new-particle buffers are free until the resampling.
+            ex, ey, qe = self._buf_nx[:m], self._buf_ny[:m], self._w_cum[:m]
             chunk32 = chunk.astype(np.float32)
             ox, oy = chunk32[:, 1:2], chunk32[:, 2:3]
             if k == 1:
@@ -478,7 +524,7 @@ class ParticleFilterBank:
             ex *= ex
             ey *= ey
             ex += ey
-            self._log_likelihood(ex, chunk32[:, 3:], out=ll)
+            self._misfit(ex, chunk[:, 3:], out=qe)
             # One level has each row at most once and in order; a row's levels come in order.
             i = 0
             while i < m:
@@ -486,11 +532,11 @@ class ParticleFilterBank:
                 while j < m and rows[j] > rows[j - 1]:
                     j += 1
                 if j - i == k:
-                    a += ll[i:j]
+                    q += qe[i:j]
                 elif j - i == 1:
-                    a[rows[i]] += ll[i]
+                    q[rows[i]] += qe[i]
                 else:
-                    a[rows[i:j]] += ll[i:j]
+                    q[rows[i:j]] += qe[i:j]
                 i = j
 
     def _update_slots(self, slots: np.ndarray, first: np.ndarray, extra: np.ndarray) -> list[int]:
@@ -500,50 +546,61 @@ class ParticleFilterBank:
         the later ones as in :meth:`_add_extra_samples`.
         """
         k = slots.size
-        observers = first[:, :2]
-        first32 = first.astype(np.float32)
+        n = self._n
         contiguous = bool(slots[-1] == k - 1)  # slots are sorted and distinct
         if contiguous:
             x, y = self._x[:k], self._y[:k]
         else:
-            x = np.take(self._x, slots, axis=0, out=self._buf_x[:k])
-            y = np.take(self._y, slots, axis=0, out=self._buf_y[:k])
-        a, dx = self._buf_a[:k], self._buf_b[:k]
-        dy, d2 = self._buf_c32[:k], self._buf_d32[:k]
-
+            x = np.take(self._x, slots, axis=0, out=self._w_x[:k])
+            y = np.take(self._y, slots, axis=0, out=self._w_y[:k])
+        first32 = first.astype(np.float32)
+        q, dx, dy, d2 = self._w_q[:k], self._w_dx[:k], self._w_dy[:k], self._w_d2[:k]
         # Offsets from each filter's first observer; the estimate is accumulated relative to
         # it so float32 keeps millimetres.
         np.subtract(x, first32[:, 0:1], out=dx)
         np.subtract(y, first32[:, 1:2], out=dy)
         np.multiply(dx, dx, out=d2)
-        np.multiply(dy, dy, out=a)
-        d2 += a
-        self._log_likelihood(d2, first32[:, 2:], out=a)
+        np.multiply(dy, dy, out=q)
+        d2 += q
+        self._misfit(d2, first[:, 2:], out=q)
         if len(extra):
-            self._add_extra_samples(a, x, y, extra)
-        peak = a.max(axis=1)
-        degenerate = ~(peak >= _LOG_TINY)  # also catches NaN
-        # Eq. (2): normalised weights exp(l - max) / sum (each row's largest is 1, so the sum
-        # is at least 1); degenerate rows are re-initialised below.
-        a -= peak[:, None]
-        np.exp(a, out=a)
-        total = a.sum(axis=1, dtype=np.float32).astype(np.float64)
-        a *= (1.0 / total).astype(np.float32)[:, None]
-
+            self._add_extra_samples(q, x, y, extra)
+        least = q.min(axis=1)
+        best = q.argmin(axis=1)
+        degenerate = ~(least <= -_LOG_TINY)  # also catches NaN
+        # Eq. (2) up to the normalisation: exp(min q - q); each row's largest weight is 1, so
+        # its sum is at least 1. Degenerate rows are re-initialised below.
+        w = np.subtract(least[:, None], q, out=q)
+        np.exp(w, out=w)
+        total = w.sum(axis=1, dtype=np.float32).astype(np.float64)
         # Eq. (5), the spread and the largest-weight particle (pre-resampling weights).
-        mx = np.einsum('kn,kn->k', a, dx).astype(np.float64)
-        my = np.einsum('kn,kn->k', a, dy).astype(np.float64)
-        spread2 = np.einsum('kn,kn->k', a, d2).astype(np.float64) - (mx * mx + my * my)
-        ex, ey = observers[:, 0] + mx, observers[:, 1] + my
-        best = a.argmax(axis=1)
+        mx = np.einsum('kn,kn->k', w, dx).astype(np.float64) / total
+        my = np.einsum('kn,kn->k', w, dy).astype(np.float64) / total
+        spread2 = np.einsum('kn,kn->k', w, d2).astype(np.float64) / total - (mx * mx + my * my)
         rows = np.arange(k)
-        best_x, best_y = x[rows, best], y[rows, best]
+        self._best[slots] = np.column_stack((x[rows, best], y[rows, best]))
+        self._estimate[slots] = first[:, :2] + np.column_stack((mx, my))
+        self._spread[slots] = np.sqrt(np.maximum(spread2, 0.0))
+        any_degenerate = bool(degenerate.any())
+        if any_degenerate:
+            w[degenerate] = np.float32(1.0)  # re-initialised below; keeps the resampling defined
 
-        if degenerate.any():
-            # Re-initialised below; uniform weights keep the resampling well defined.
-            a[degenerate] = np.float32(1.0 / self._n)
-        new_x, new_y = self._resample(a, x, y, k)
-        self._roughen(new_x, new_y, k)
+        new_x, new_y = self._buf_nx[:k], self._buf_ny[:k]
+        if self._cfg.resampling == 'systematic':
+            offsets = self._rng.random((k, 1), dtype=np.float32)
+            # dx is free now: the int32 scratch.
+            index = systematic_index(
+                w, offsets, self._w_index[:k], self._w_cum[:k], dx.view(np.int32)
+            ).reshape(-1)
+        else:
+            probabilities = w.astype(np.float64)
+            probabilities /= probabilities.sum(axis=1, keepdims=True)
+            counts = self._rng.multinomial(n, probabilities)
+            index = np.repeat(self._flat_index[: k * n], counts.ravel())
+        # 'clip' writes straight to out (the default mode buffers); the index is in range.
+        np.take(x.reshape(-1), index, out=new_x.reshape(-1), mode='clip')
+        np.take(y.reshape(-1), index, out=new_y.reshape(-1), mode='clip')
+        self._roughen(new_x, new_y, *self._jitter_noise(k))
 
         if contiguous and k == len(self._ids):
             # Every filter was updated: the new particles become the storage (no copy).
@@ -555,11 +612,6 @@ class ParticleFilterBank:
         else:
             self._x[slots] = new_x
             self._y[slots] = new_y
-        self._estimate[slots, 0] = ex
-        self._estimate[slots, 1] = ey
-        self._spread[slots] = np.sqrt(np.maximum(spread2, 0.0))
-        self._best[slots, 0] = best_x
-        self._best[slots, 1] = best_y
         self._updated[slots] = True
         self._any_updated = True
         self._n_updates[slots] += 1
@@ -567,48 +619,34 @@ class ParticleFilterBank:
             self._n_updates[slots] += np.bincount(extra[:, 0].astype(np.int64), minlength=k)
 
         reinitialised: list[int] = []
-        if degenerate.any():
+        if any_degenerate:
             for row in np.flatnonzero(degenerate):
                 slot = int(slots[row])
-                self._reinitialise(slot, observers[row])
+                self._reinitialise(slot, first[row, :2])
                 reinitialised.append(self._ids[slot])
         return reinitialised
 
-    def _resample(
-        self, weights: np.ndarray, x: np.ndarray, y: np.ndarray, k: int
-    ) -> tuple[np.ndarray, np.ndarray]:
-        """Draw N particles per row in proportion to ``weights``; return new x, y (k, N)."""
-        n = self._n
-        counts = self._counts[:k]
-        if self._cfg.resampling == 'systematic':
-            offsets = self._rng.random((k, 1), dtype=np.float32)
-            systematic_counts(weights, offsets, out=counts, work=self._buf_cum[:k])
-        else:
-            probabilities = weights.astype(np.float64)
-            probabilities /= probabilities.sum(axis=1, keepdims=True)
-            counts[:] = self._rng.multinomial(n, probabilities)
-        index = np.repeat(self._flat_index[: k * n], counts.ravel())
-        new_x = self._buf_nx[:k]
-        new_y = self._buf_ny[:k]
-        np.take(x.ravel(), index, out=new_x.ravel())
-        np.take(y.ravel(), index, out=new_y.ravel())
-        return new_x, new_y
+    def _jitter_noise(self, k: int) -> tuple[np.ndarray, bool]:
+        """(2, k, N) standard normals for the roughening and whether they come from the pool."""
+        need = 2 * k * self._n
+        if need <= self._pool.size:
+            start = int(self._rng.integers(0, self._pool.size - need + 1))
+            return self._pool[start : start + need].reshape(2, k, self._n), True
+        return self._rng.standard_normal((2, k, self._n), dtype=np.float32), False
 
-    def _roughen(self, x: np.ndarray, y: np.ndarray, k: int) -> None:
-        """Add N(0, sigma_r^2) jitter per coordinate, sigma_r = kappa E N^(-1/2), floored."""
+    def _roughen(self, x: np.ndarray, y: np.ndarray, noise: np.ndarray, bounded: bool) -> None:
+        """Add N(0, sigma_r^2) jitter per coordinate, sigma_r = kappa E N^(-1/2), floored.
+
+        ``noise`` holds (2, rows, N) standard normals; ``bounded``: they come from the pool,
+        whose largest magnitude is known.
+        """
         cfg = self._cfg
         scale = cfg.roughening_kappa / math.sqrt(self._n)
         x_lo, x_hi = x.min(axis=1), x.max(axis=1)  # float32, as the jitter scale
         y_lo, y_hi = y.min(axis=1), y.max(axis=1)
         sx = np.maximum(scale * (x_hi - x_lo), cfg.roughening_floor_m)
         sy = np.maximum(scale * (y_hi - y_lo), cfg.roughening_floor_m)
-        need = 2 * k * self._n
-        if need <= self._pool.size:
-            start = int(self._rng.integers(0, self._pool.size - need + 1))
-            noise = self._pool[start : start + need].reshape(2, k, self._n)
-        else:
-            noise = self._rng.standard_normal((2, k, self._n), dtype=np.float32)
-        b = self._buf_b[:k]
+        b = self._w_tmp[: x.shape[0]]
         np.multiply(noise[0], sx[:, None], out=b)
         x += b
         np.multiply(noise[1], sy[:, None], out=b)
@@ -618,7 +656,7 @@ class ParticleFilterBank:
         field = self._field_size_m
         reach = 1.001 * self._pool_abs_max * max(float(sx.max()), float(sy.max())) + 0.01
         inside = (
-            need <= self._pool.size
+            bounded
             and min(float(x_lo.min()), float(y_lo.min())) - reach >= 0.0
             and max(float(x_hi.max()), float(y_hi.max())) + reach <= field
         )
@@ -633,16 +671,20 @@ class ParticleFilterBank:
             return
         self._any_updated = False
         cfg = self._cfg
-        for slot in np.flatnonzero(self._updated[: len(self._ids)]):
-            window = self._window[slot]
-            count = self._window_count[slot]
-            window[count % cfg.window] = self._estimate[slot]
-            self._window_count[slot] = count + 1
-            self._updated[slot] = False
-            if self._converged[slot] or count + 1 < cfg.window:
-                continue
-            if estimates_converged(float(self._spread[slot]), window, cfg.r_conv_m, cfg.r_err_m):
-                self._converged[slot] = True
+        slots = np.flatnonzero(self._updated[: len(self._ids)])
+        count = self._window_count[slots]
+        self._window[slots, count % cfg.window] = self._estimate[slots]
+        count += 1
+        self._window_count[slots] = count
+        self._updated[slots] = False
+        # Eq. (6) first: most unconverged filters fail it, and it needs no window.
+        ready = (count >= cfg.window) & ~self._converged[slots]
+        test = slots[ready & (self._spread[slots] <= cfg.r_conv_m)]
+        if test.size:
+            ok = windows_converged(
+                self._spread[test], self._window[test], cfg.r_conv_m, cfg.r_err_m
+            )
+            self._converged[test[ok]] = True
 
     # ----------------------------------------------------------------- queries
     def estimate(self, target_id: int) -> TargetEstimate:

@@ -9,7 +9,7 @@ from msc_pf.particle_filter import (
     ParticleFilterBank,
     estimates_converged,
     lattice,
-    systematic_counts,
+    systematic_index,
 )
 from msc_pf.settings import ParticleFilterConfig, RadioConfig
 
@@ -128,16 +128,31 @@ def test_initial_lattice_is_clipped_to_the_field():
 
 def test_systematic_resampling_copies_in_proportion_to_weight():
     n = 5041
-    weights = np.zeros((2, n), np.float32)
+    weights = np.zeros((3, n), np.float32)
     weights[0, [10, 20]] = (0.75, 0.25)
-    weights[1, :] = 1.0 / n
-    counts = systematic_counts(weights, np.array([[0.3], [0.999]]))
-    assert counts.sum(axis=1).tolist() == [n, n]
+    weights[1, :] = 1.0
+    weights[2, :] = np.random.default_rng(0).random(n) ** 4  # unnormalised
+    index = systematic_index(weights, np.array([[0.3], [0.999], [0.0]]))
+    assert np.all(np.diff(index, axis=1) >= 0)
+    rows = index // n
+    assert np.all(rows == np.arange(3)[:, None])
+    counts = np.stack([np.bincount(index[r] - r * n, minlength=n) for r in range(3)])
+    assert counts.sum(axis=1).tolist() == [n, n, n]
     assert abs(int(counts[0, 10]) - 0.75 * n) <= 1
     assert abs(int(counts[0, 20]) - 0.25 * n) <= 1
-    assert counts.min() >= 0
+    assert counts[0].sum() == counts[0, 10] + counts[0, 20]
     # Uniform weights: every particle survives once (up to float32 rounding of the sum).
     assert np.count_nonzero(counts[1] == 1) > 0.99 * n
+    # Systematic resampling: each particle gets floor or ceil of its expected copies.
+    expected = n * weights[2].astype(np.float64) / weights[2].sum(dtype=np.float64)
+    assert np.all(np.abs(counts[2] - expected) < 1.0 + 1e-3)
+
+
+def test_systematic_resampling_rejects_rows_without_weight():
+    weights = np.ones((2, 8), np.float32)
+    weights[1] = 0.0
+    with pytest.raises(ValueError, match='positive'):
+        systematic_index(weights, np.zeros((2, 1)))
 
 
 def test_forgetting_a_target_leaves_the_other_filters_intact():
@@ -245,8 +260,8 @@ def test_censored_likelihood_divides_by_the_chance_of_being_heard(gaussian):
     plain = make_bank(gaussian_likelihood=gaussian, censored_likelihood=False)
     distances = np.array([[1.0, 100.0, 200.0, 260.0, 292.0, 330.0, 380.0]])
     d2 = (distances**2).astype(np.float32)
-    got = censored._log_likelihood(d2, np.array([-100.0]), np.empty_like(d2))
-    uncorrected = plain._log_likelihood(d2, np.array([-100.0]), np.empty_like(d2))
+    got = -censored._misfit(d2, np.array([-100.0]), np.empty_like(d2))
+    uncorrected = -plain._misfit(d2, np.array([-100.0]), np.empty_like(d2))
     s = math.sqrt((2.0 if gaussian else 1.0) / 2.0)
     mean = RADIO.rssi_at_1m_dbm - 30.0 * np.log10(distances)
     heard = np.array([0.5 * math.erfc(-u / math.sqrt(2.0)) for u in ((mean - -101.0) / s)[0]])
@@ -290,3 +305,41 @@ def test_degenerate_filter_reinitialises_under_either_resampling(resampling):
     assert bank.estimate(4).n_updates == 0
     assert bank.estimate(5).n_updates == 1
     assert np.all(np.isfinite(bank.particles(4)))
+
+
+@pytest.mark.filterwarnings('ignore:invalid value')
+def test_filter_with_non_finite_particles_reinitialises_and_says_so():
+    # Positions are validated, so non-finite weights can only come from corrupted particles;
+    # the filter must not pass NaN on to the resampling or the estimate.
+    bank = make_bank()
+    bank.track(1, (1000.0, 1000.0))
+    bank.track(2, (1200.0, 1000.0))
+    bank._x[bank._slot_of[1], :] = np.nan
+    observer = np.array([1100.0, 1000.0])
+    assert bank.update(observer, [1, 2], [-80.0, -80.0]) == [1]
+    assert np.allclose(bank.particles(1).mean(axis=0), observer, atol=1.0)
+    assert bank.estimate(1).n_updates == 0
+    assert np.all(np.isfinite(bank.estimate(1).position_m))
+    assert bank.estimate(2).n_updates == 1
+    assert np.all(np.isfinite(bank.particles(2)))
+
+
+def test_end_step_tests_each_filter_on_its_own_window():
+    # Target 1 is circled by three observers and converges; target 2 is heard only from one
+    # fixed point, so its filter keeps a ring of possible positions and must not converge.
+    bank = make_bank(4)
+    rng = np.random.default_rng(8)
+    near, far = np.array([1000.0, 1040.0]), np.array([1100.0, 1150.0])
+    still = np.array([1000.0, 1000.0])
+    for step in range(60):
+        angle = 0.2 * step
+        observations = [(still, [2], [noisy_rssi(still, far, rng)])]
+        for phase in (0.0, 2.1, 4.2):
+            observer = still + 30.0 * np.array([math.cos(angle + phase), math.sin(angle + phase)])
+            observations.append((observer, [1], [noisy_rssi(observer, near, rng)]))
+        bank.update_joint(observations)
+        bank.end_step()
+    assert bank.is_converged(1)
+    assert np.hypot(*(bank.estimate(1).position_m - near)) < 10.0
+    assert not bank.is_converged(2)
+    assert bank.estimate(2).spread_m > ParticleFilterConfig().r_conv_m
