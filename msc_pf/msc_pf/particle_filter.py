@@ -261,6 +261,13 @@ class ParticleFilterBank:
             self._censor_table = np.empty(0, np.float32)
         # Table bin of log10 d^2: L / step = 5 K log10 d^2 / step.
         self._censor_bins_per_log = np.float32(5.0 * radio.path_loss_exponent / _CENSOR_STEP_DB)
+        # Below this log10 d^2 every table entry is 0 (Phi > 1 - 1e-9): no look-up needed.
+        nonzero_bins = np.flatnonzero(self._censor_table)
+        self._censor_from_log = (
+            float(nonzero_bins[0]) / float(self._censor_bins_per_log)
+            if nonzero_bins.size
+            else math.inf
+        )
         self._pool = (
             rng.standard_normal(config.noise_pool_size, dtype=np.float32)
             if config.noise_pool_size
@@ -485,7 +492,8 @@ class ParticleFilterBank:
         np.maximum(d2, np.float32(1.0), out=out)  # d < 1 m counts as 1 m
         np.log10(out, out=out)
         censor = None
-        if self._censor_table.size:
+        # Skipped when no particle is far enough for the correction (all bins hold 0).
+        if self._censor_table.size and not out.max() < self._censor_from_log:
             rows, cols = out.shape
             bins = self._w_index[:rows, :cols]  # free until resampling
             # Truncation: the log is non-negative. Bins past the table clip to its end.

@@ -343,3 +343,15 @@ def test_end_step_tests_each_filter_on_its_own_window():
     assert np.hypot(*(bank.estimate(1).position_m - near)) < 10.0
     assert not bank.is_converged(2)
     assert bank.estimate(2).spread_m > ParticleFilterConfig().r_conv_m
+
+
+def test_censoring_is_exactly_zero_well_inside_the_detection_range():
+    # Phi((R - gamma_D) / s) > 1 - 1e-9 up to ~184 m: the correction (and its look-up) vanishes.
+    censored = make_bank()
+    plain = make_bank(censored_likelihood=False)
+    for far_m in (180.0, 300.0):
+        d2 = (np.array([[1.0, 50.0, 120.0, far_m]]) ** 2).astype(np.float32)
+        got = censored._misfit(d2, np.array([-90.0]), np.empty_like(d2))
+        uncorrected = plain._misfit(d2, np.array([-90.0]), np.empty_like(d2))
+        np.testing.assert_array_equal(got[0, :3], uncorrected[0, :3])
+        assert (got[0, 3] == uncorrected[0, 3]) == (far_m < 184.0)
