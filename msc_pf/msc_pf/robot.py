@@ -129,6 +129,7 @@ class RobotController:
         self._last_heard_s: dict[int, float] = {}
         self._captured: set[int] = set()
         self._samples: dict[int, deque[tuple[float, float, float, float]]] = {}
+        self._last_sampled_s: dict[int, float] = {}
         self._pbest: deque[tuple[np.ndarray, float]] = deque(maxlen=config.msc.pbest_window)
         self._pbest_target = NO_TARGET
         self._velocity = np.zeros(2)
@@ -186,6 +187,7 @@ class RobotController:
             self._rssi.pop(target, None)
             self._samples.pop(target, None)
             self._last_heard_s.pop(target, None)
+            self._last_sampled_s.pop(target, None)
             if self._bank is not None:
                 self._bank.forget(target)
         return new
@@ -306,6 +308,7 @@ class RobotController:
                 if target in self._captured or not math.isfinite(value):
                     continue
                 self._samples.setdefault(target, deque()).append((now_s, x, y, value))
+                self._last_sampled_s[target] = now_s
         for samples in self._samples.values():
             while samples and samples[0][0] <= horizon:
                 samples.popleft()
@@ -368,7 +371,19 @@ class RobotController:
             )
             if value > best_value:
                 best, best_value = target, value
+        if best == NO_TARGET and self._keeps_converged(self.target_id):
+            return self.target_id
         return best
+
+    def _keeps_converged(self, target: int) -> bool:
+        """True when a lost ``target`` is still pursued on its converged estimate."""
+        return (
+            self.config.phases.keep_converged_target
+            and self._bank is not None
+            and target != NO_TARGET
+            and target not in self._captured
+            and self._bank.is_converged(target)
+        )
 
     def _evaluation(self, target: int, now_s: float) -> float:
         mean = self.smoothed_rssi(target, now_s)
@@ -398,12 +413,23 @@ class RobotController:
             if e.converged and e.target_id not in self._captured
         ]
         neighbours = np.array([p.position_m for p in self._peers.values()]).reshape(-1, 2)
-        choice = select_retarget(
-            candidates, position, neighbours, self.config.radio, self.config.phases
-        )
+        phases = self.config.phases
+        choice = select_retarget(candidates, position, neighbours, self.config.radio, phases)
+        kind = 'its estimate'
+        if choice is None and phases.retarget_unconverged:
+            oldest = now_s - phases.recorded_max_age_s
+            recorded = [
+                Candidate(e.target_id, e.best_particle_m, self.smoothed_rssi(e.target_id, now_s))
+                for e in self._bank.estimates()
+                if not e.converged
+                and e.target_id not in self._captured
+                and self._last_sampled_s.get(e.target_id, -math.inf) >= oldest
+            ]
+            choice = select_retarget(recorded, position, neighbours, self.config.radio, phases)
+            kind = 'its unconverged filter'
         if choice is not None:
             self._committed = choice
-            events.append(f'target {captured} captured: re-targets {choice} from its estimate')
+            events.append(f'target {captured} captured: re-targets {choice} from {kind}')
 
     def _abandon(self, target: int, *, heard: bool) -> None:
         """Forget ``target``'s filter (it restarts from the next sample of the target).
@@ -462,6 +488,12 @@ class RobotController:
             if mean is None:
                 return Phase.SEARCH
         if scheme.uses_far_formation and bank is not None and bank.is_tracked(target):
+            if mean is None:
+                # A recorded (unconverged) estimate approached without hearing the target.
+                best = bank.estimate(target).best_particle_m
+                if float(np.hypot(*(best - position))) < phases.unheard_give_up_m:
+                    self._abandon(target, heard=False)
+                    return Phase.SEARCH
             far_below = phases.gamma1_dbm - (
                 0.0 if previous == Phase.FAR_LOCALISATION else hysteresis
             )

@@ -315,6 +315,24 @@ class PhaseConfig:
         task_area_m: D_th; eq. (8) uses alpha_inside within this distance of the goal.
         work_timeout_s: a robot that worked this long without a capture resumes (b-3).
         work_block_s: after such a timeout the robot may not stop to work again for this long.
+        keep_converged_target: PF schemes: a robot whose selected target's estimate has
+            converged keeps approaching it with eq. (8) when the signal drops out (the paper:
+            "each swarm can directly approach the searching target once its location
+            estimation is converged"). Off by default: MSC+PF filters often converge at the
+            detection edge on a wrong point, and following such an estimate after the signal
+            is gone cost MSC+PF seed 0 (10 targets) 13419 s of CCT instead of 4888 s; off, the
+            robot searches again once nothing is heard.
+        retarget_unconverged: proposed scheme, (c-2) without a converged candidate: choose
+            among the targets whose filters are tracked but not converged (the "recorded
+            information on location estimation" of targets heard on the way) by the same
+            R * N_r rule, taking the largest-weight particle as the estimate, and approach it
+            with (b-1). False searches again (or takes a target heard now).
+        recorded_max_age_s: only unconverged filters that got a sample (own or a neighbour's)
+            within this time are candidates [s]: older ones are mostly of targets other
+            robots captured meanwhile, out of radio range (capture IDs spread by contact).
+        unheard_give_up_m: a robot that approaches an unconverged recorded estimate and does
+            not hear the target within this distance of it drops that filter [m]; about a third
+            of the 292 m detection range, so an estimate 100-200 m off still gets heard.
     """
 
     gamma1_dbm: float = -78.0
@@ -328,6 +346,10 @@ class PhaseConfig:
     task_area_m: float = 5.0
     work_timeout_s: float = 30.0
     work_block_s: float = 10.0
+    keep_converged_target: bool = False
+    retarget_unconverged: bool = True
+    recorded_max_age_s: float = 600.0
+    unheard_give_up_m: float = 100.0
 
     def __post_init__(self) -> None:
         _require_finite(self)
@@ -339,6 +361,8 @@ class PhaseConfig:
         _require(self.retarget_penalty < 0.0, 'retarget_penalty R must be negative')
         _require(self.task_area_m > 0.0, 'task_area_m must be positive')
         _require(self.work_timeout_s > 0.0, 'work_timeout_s must be positive')
+        _require(self.unheard_give_up_m > 0.0, 'unheard_give_up_m must be positive')
+        _require(self.recorded_max_age_s >= 0.0, 'recorded_max_age_s must be non-negative')
 
 
 @dataclass(frozen=True)

@@ -88,28 +88,37 @@ def test_messages_from_itself_and_stale_duplicates_are_ignored():
     assert out.status.phase is Phase.FORMING
 
 
-def run_capture_scenario(scheme: str):
+TARGET_2 = np.array([1150.0, 1000.0])
+SPOTS = [np.array([1100.0, 1060.0]), np.array([1100.0, 940.0]), np.array([1210.0, 1000.0])]
+
+
+def neighbours_hearing_target_2(step: int, rng: np.random.Generator) -> list[PeerInfo]:
+    """Three neighbours around target 2, each with one noisy sample of it."""
+    peers = []
+    for i, spot in enumerate(SPOTS):
+        where = spot + np.array([0.0, 0.5 * step])
+        value = RADIO.mean_rssi_dbm(float(np.hypot(*(TARGET_2 - where)))) + rng.normal()
+        peers.append(observer(i + 1, float(step), where, [(2, value)]))
+    return peers
+
+
+def run_capture_scenario(
+    scheme: str, *, sampled_steps: int = 39, phases: PhaseConfig | None = None
+):
     """Robot 0 works on target 1 while neighbours localise target 2, which robot 0 never hears.
 
-    Three neighbours sample target 2 from around it until its filter (in robot 0) converges;
-    then target 1 is captured.
+    Three neighbours sample target 2 from around it during the first ``sampled_steps`` steps
+    (39: until its filter in robot 0 converges); then target 1 is captured.
     """
-    target_2 = np.array([1150.0, 1000.0])
     rng = np.random.default_rng(4)
-    config = MscPfConfig(scheme=scheme, phases=PhaseConfig(work_timeout_s=100.0))
-    robot = RobotController(0, config, seed=2)
-    spots = [np.array([1100.0, 1060.0]), np.array([1100.0, 940.0]), np.array([1210.0, 1000.0])]
+    phases = PhaseConfig(work_timeout_s=100.0) if phases is None else phases
+    robot = RobotController(0, MscPfConfig(scheme=scheme, phases=phases), seed=2)
     out = None
     for step in range(1, 40):
-        t = float(step)
-        peers = []
-        for i, spot in enumerate(spots):
-            where = spot + np.array([0.0, 0.5 * step])
-            value = RADIO.mean_rssi_dbm(float(np.hypot(*(target_2 - where)))) + rng.normal()
-            peers.append(observer(i + 1, t, where, [(2, value)]))
-        out = robot.step(t, HOME, {1: -40.0 + rng.normal(0.0, 0.3)}, peers)
+        peers = neighbours_hearing_target_2(step, rng) if step <= sampled_steps else []
+        out = robot.step(float(step), HOME, {1: -40.0 + rng.normal(0.0, 0.3)}, peers)
     assert out.status.phase is Phase.WORK
-    assert robot.filters.is_converged(2)
+    assert robot.filters.is_converged(2) == (sampled_steps == 39)
     return robot, robot.step(40.0, HOME, {}, [], captured_ids=[1])
 
 
@@ -160,3 +169,65 @@ def test_robot_does_not_keep_a_converged_estimate_that_contradicts_what_it_hears
     assert not robot.filters.is_converged(2)
     assert out.status.phase is not Phase.DIRECT_APPROACH
     assert any('re-initialised' in e or 'restarted' in e for e in out.events)
+
+
+def test_proposed_robot_heads_for_an_unconverged_recorded_estimate_after_a_capture():
+    robot, out = run_capture_scenario('proposed', sampled_steps=3)
+    assert robot.filters.is_tracked(2)
+    assert out.status.target_id == 2
+    assert out.status.phase is Phase.FAR_LOCALISATION
+    best = robot.filters.estimate(2).best_particle_m
+    heading = out.displacement_m / np.hypot(*out.displacement_m)
+    assert heading @ ((best - HOME) / np.hypot(*(best - HOME))) > 0.95
+    assert any('unconverged filter' in e for e in out.events)
+
+
+def test_unconverged_recorded_estimates_are_not_used_when_old_switched_off_or_by_msc_pf():
+    off = PhaseConfig(work_timeout_s=100.0, retarget_unconverged=False)
+    # Target 2 was last sampled at t = 3 s, the capture comes at t = 40 s.
+    old = PhaseConfig(work_timeout_s=100.0, recorded_max_age_s=30.0)
+    for scheme, phases in (('proposed', off), ('proposed', old), ('msc_pf', None)):
+        _, out = run_capture_scenario(scheme, sampled_steps=3, phases=phases)
+        assert out.status.target_id == NO_TARGET
+        assert out.status.phase is Phase.SEARCH
+
+
+def test_robot_drops_an_unconverged_estimate_it_does_not_hear_near_its_best_particle():
+    robot, out = run_capture_scenario('proposed', sampled_steps=3)
+    best = robot.filters.estimate(2).best_particle_m
+    give_up = PhaseConfig().unheard_give_up_m
+    # Far from the best particle the robot keeps going; within the give-up radius it stops.
+    away = best + np.array([0.0, give_up + 20.0])
+    assert robot.step(41.0, away, {}).status.phase is Phase.FAR_LOCALISATION
+    near = best + np.array([0.0, give_up - 20.0])
+    out = robot.step(42.0, near, {})
+    assert out.status.phase is Phase.SEARCH
+    assert not robot.filters.is_tracked(2)
+
+
+def converge_on_target_2_then_lose_it(phases: PhaseConfig) -> list:
+    """An MSC+PF robot at HOME hears target 2 (150 m away) with three neighbours until its
+    filter converges, then hears nothing for five steps; returns the last step's output."""
+    rng = np.random.default_rng(5)
+    robot = RobotController(0, MscPfConfig(scheme='msc_pf', phases=phases), seed=3)
+    own = RADIO.mean_rssi_dbm(150.0)
+    step, out = 0, None
+    while step < 200 and not robot.filters.is_converged(2):
+        step += 1
+        peers = neighbours_hearing_target_2(step, rng)
+        out = robot.step(float(step), HOME, {2: own + rng.normal()}, peers)
+    assert robot.filters.is_converged(2)
+    assert out.status.target_id == 2
+    for _ in range(5):
+        step += 1
+        out = robot.step(float(step), HOME, {})
+    return out
+
+
+def test_a_lost_converged_target_is_approached_only_with_keep_converged_target():
+    out = converge_on_target_2_then_lose_it(PhaseConfig(keep_converged_target=True))
+    assert out.status.target_id == 2
+    assert out.status.phase is Phase.DIRECT_APPROACH
+    off = converge_on_target_2_then_lose_it(PhaseConfig())
+    assert off.status.target_id == NO_TARGET
+    assert off.status.phase is Phase.SEARCH
