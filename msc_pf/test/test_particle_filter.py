@@ -355,3 +355,25 @@ def test_censoring_is_exactly_zero_well_inside_the_detection_range():
         uncorrected = plain._misfit(d2, np.array([-90.0]), np.empty_like(d2))
         np.testing.assert_array_equal(got[0, :3], uncorrected[0, :3])
         assert (got[0, 3] == uncorrected[0, 3]) == (far_m < 184.0)
+
+
+def test_bank_grown_past_its_capacity_updates_like_a_large_one():
+    # Tracking a ninth target reallocates the arrays; the filters must come through intact.
+    grown = ParticleFilterBank(ParticleFilterConfig(), RADIO, FIELD_M, np.random.default_rng(6))
+    large = ParticleFilterBank(
+        ParticleFilterConfig(), RADIO, FIELD_M, np.random.default_rng(6), capacity=16
+    )
+    rng = np.random.default_rng(2)
+    targets = rng.uniform(900.0, 1100.0, (12, 2))
+    for step in range(3):
+        observer = np.array([1000.0 + 10.0 * step, 1000.0])
+        rssi = [noisy_rssi(observer, t, rng) for t in targets]
+        for bank in (grown, large):
+            bank.update(observer, list(range(12)), rssi)
+            bank.end_step()
+    for tid in range(12):
+        np.testing.assert_array_equal(grown.particles(tid), large.particles(tid))
+        np.testing.assert_array_equal(
+            grown.estimate(tid).position_m, large.estimate(tid).position_m
+        )
+        assert grown.estimate(tid).n_updates == 3
