@@ -12,7 +12,9 @@ leave) and FOLLOWING_WALL. Triggers, checked every control step in this order:
   unless the place smells visited, in which case they count the revisit, switch to
   JUST_STARTED and leave at the *next* outer corner, towards the preferred direction
   flipped by 180 deg once the revisit count reaches ``revisit_flip_count``, otherwise
-  (Gas+Sound) towards the sound direction.
+  (Gas+Sound) towards the sound direction. Going round the end of a thin wall is one outer
+  corner: its end face, reached within ``wall_end_face_m`` after a wrap, is wrapped round
+  without a new decision.
 
 Random is the blank control: straight legs, a new uniform heading on every hit and, after
 each ``random_step_m`` driven, with probability ``random_turn_probability``.
@@ -118,6 +120,8 @@ class FsmMemory:
     wrap_start_yaw_rad: float = 0.0
     previous_yaw_rad: float | None = None
     arc_without_wall_rad: float = 0.0
+    driven_since_wrap_m: float = math.inf
+    last_linear_mps: float = 0.0
     leave_at_next_corner: bool = False
     visit_count: int = 0
     flip_count: int = 0
@@ -180,13 +184,14 @@ class OABugFsm:
         if self._config.variant is Variant.RANDOM:
             twist = self._step_random(snapshot, min(max(dt, 0.0), _MAX_STEP_S))
         else:
-            twist = self._step_bug(snapshot)
+            twist = self._step_bug(snapshot, min(max(dt, 0.0), _MAX_STEP_S))
+        mem.last_linear_mps = twist.linear_mps
         pump = self._config.variant.uses_scent and self._pump.update(
             snapshot.time_s, twist.linear_mps
         )
         return Command(float(twist.linear_mps), float(twist.angular_radps), bool(pump))
 
-    def _step_bug(self, snap: SensorSnapshot) -> Twist2D:
+    def _step_bug(self, snap: SensorSnapshot, dt_s: float) -> Twist2D:
         mem = self._memory
         cfg = self._config
         scan = snap.scan
@@ -195,6 +200,7 @@ class OABugFsm:
         if mem.previous_yaw_rad is not None:
             yaw_change = angle_difference(snap.yaw_rad, mem.previous_yaw_rad)
         mem.previous_yaw_rad = snap.yaw_rad
+        mem.driven_since_wrap_m += mem.last_linear_mps * max(dt_s, 0.0)
         # Only a robot that drives can hit another: not while it turns on the spot (to a
         # heading, or away from a wall at an inner corner).
         driving = mem.mode is not Mode.TURN and not (mem.mode is Mode.FOLLOW and front_blocked)
@@ -215,16 +221,22 @@ class OABugFsm:
             wrap_blocked = scan.front_wall_m <= cfg.perception.wrap_stop_distance_m
             if wrap_blocked or turned >= math.pi / 2 - cfg.motion.heading_tolerance_rad:
                 mem.mode = Mode.FOLLOW
+                mem.driven_since_wrap_m = 0.0
             else:
                 return wrap_corner(mem.wall_side, cfg.motion)
         elif front_blocked:
             # Turning away from an inner corner swings the old wall out of the abeam strip
             # before the new one comes in: that is no outer corner.
             self._corners.reset()
+            mem.driven_since_wrap_m = math.inf
             if mem.state is FsmState.JUST_STARTED and cfg.inner_corner_resumes_following:
                 self._on_inner_corner_after_revisit()
         elif self._corners.update(scan.side(mem.wall_side)):
-            self._on_outer_corner(snap)
+            if mem.driven_since_wrap_m <= cfg.wall_end_face_m:
+                # The end face of a thin wall: still the same wall end, keep wrapping.
+                self._wrap(snap)
+            else:
+                self._on_outer_corner(snap)
             if mem.mode is Mode.TURN:
                 error = angle_difference(mem.target_yaw_rad, snap.yaw_rad)
                 return turn_in_place(error, cfg.motion)
@@ -289,6 +301,7 @@ class OABugFsm:
         mem.wall_side = side
         mem.leave_at_next_corner = False
         mem.arc_without_wall_rad = 0.0
+        mem.driven_since_wrap_m = math.inf
         self._corners.reset()
         self._record(Event.HIT_WALL)
 
@@ -362,6 +375,7 @@ class OABugFsm:
         """Keep following: arc round the end of the wall."""
         mem = self._memory
         mem.mode = Mode.WRAP
+        mem.driven_since_wrap_m = math.inf
         mem.wrap_start_yaw_rad = snap.yaw_rad
         mem.arc_without_wall_rad = 0.0
         self._corners.reset()
@@ -378,6 +392,7 @@ class OABugFsm:
         mem.target_yaw_rad = wrap_angle(heading_rad)
         mem.wall_side = 0
         mem.arc_without_wall_rad = 0.0
+        mem.driven_since_wrap_m = math.inf
         mem.leave_at_next_corner = False
 
     def _sound_direction(self, snap: SensorSnapshot) -> float | None:

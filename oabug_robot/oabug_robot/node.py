@@ -101,6 +101,11 @@ PARAMETERS: tuple[tuple[str, Any, str], ...] = (
         _DEFAULTS.inner_corner_resumes_following,
         'an inner corner after a revisit returns to Following Wall (paper Fig. 3)',
     ),
+    (
+        'wall_end_face_m',
+        _DEFAULTS.wall_end_face_m,
+        'an outer corner this soon after a wrap is the same wall end: keep wrapping [m]',
+    ),
     ('fixed_turn', _DEFAULTS.fixed_turn.value, 'left or right: turn at walls and robots'),
     (
         'robot_hit_repeat_s',
@@ -188,6 +193,7 @@ def config_from_parameters(values: dict[str, Any]) -> OABugConfig:
         revisit_flip_count=int(values['revisit_flip_count']),
         visit_count_resets_on_fresh_corner=bool(values['visit_count_resets_on_fresh_corner']),
         inner_corner_resumes_following=bool(values['inner_corner_resumes_following']),
+        wall_end_face_m=float(values['wall_end_face_m']),
         fixed_turn=_parse(TurnDirection, 'fixed_turn', str(values['fixed_turn'])),
         robot_hit_repeat_s=float(values['robot_hit_repeat_s']),
         sound_turn_rule=_parse(SoundTurnRule, 'sound_turn_rule', str(values['sound_turn_rule'])),

@@ -268,6 +268,16 @@ class OABugConfig:
             still on its wall after a revisit (Just Started) takes it back to Following Wall,
             as paper Fig. 3 and the authors' simulator do, so the next outer corner is
             checked for scent again; False keeps the departure for the next outer corner.
+        wall_end_face_m: an outer corner reached within this distance driven after the
+            robot finished wrapping round a corner is the end face of the same thin wall:
+            it keeps wrapping without a new decision (no scent check, no departure), so
+            going round a wall end is one outer corner, as for the paper's walls, curves
+            with two endpoints (Sec. II-A). The authors' grid gives a 2.5 cm thick wall end
+            two corners, and a robot that revisited one door jamb left the wall in the
+            doorway; 0 does the same here [m]. 0.15 m lies between a wall's end face
+            (2.5 cm, the robot passes its second corner about 0.1 m after the wrap) and the
+            shortest face between two convex corners of the generated sites (one cell,
+            0.27 m).
         fixed_turn: side turned to at a first wall contact without sound, and after hitting
             another robot (paper: "all turn right").
         robot_hit_repeat_s: a robot hit this soon after the previous one turns to a random
@@ -300,6 +310,7 @@ class OABugConfig:
     revisit_flip_count: int = 3
     visit_count_resets_on_fresh_corner: bool = True
     inner_corner_resumes_following: bool = True
+    wall_end_face_m: float = 0.15
     fixed_turn: TurnDirection = TurnDirection.RIGHT
     robot_hit_repeat_s: float = 4.0
     sound_turn_rule: SoundTurnRule = SoundTurnRule.TOWARD
@@ -326,7 +337,12 @@ class OABugConfig:
             f'gas_threshold must be on the 10-bit scale 0..1023, got {self.gas_threshold}',
         )
         _require(self.revisit_flip_count >= 1, 'revisit_flip_count must be >= 1')
-        for name in ('scent_window_s', 'bearing_timeout_s', 'robot_hit_repeat_s'):
+        for name in (
+            'scent_window_s',
+            'bearing_timeout_s',
+            'robot_hit_repeat_s',
+            'wall_end_face_m',
+        ):
             value = getattr(self, name)
             _require(math.isfinite(value) and value >= 0.0, f'{name} must be >= 0')
         _require(

@@ -316,13 +316,18 @@ def test_scented_outer_corner_switches_to_just_started_and_leaves_at_the_next_on
     assert fsm.memory.target_yaw_rad == pytest.approx(fsm.memory.preferred_direction_rad)
 
 
-def revisit(script: Script, follow_steps: int = 8) -> None:
-    """Hit a wall, pass a scented outer corner and finish the arc round it (Just Started)."""
+def scented_corner(script: Script) -> None:
+    """Hit a wall, follow it and pass a scented outer corner (on the left)."""
     reach_wall(script)
     script.follow_straight(1)
     script.gas_raw = 400
     script.pass_outer_corner(1)
     script.gas_raw = 0
+
+
+def revisit(script: Script, follow_steps: int = 8) -> None:
+    """Hit a wall, pass a scented outer corner and finish the arc round it (Just Started)."""
+    scented_corner(script)
     script.finish_wrap(1)
     script.follow_straight(1, steps=follow_steps)
 
@@ -364,6 +369,55 @@ def test_with_inner_corners_kept_the_robot_leaves_at_the_next_outer_corner() -> 
     script.pass_outer_corner(1)
     assert fsm.memory.event is Event.LEAVE_WALL
     assert fsm.memory.mode is Mode.TURN
+
+
+def pass_thin_wall_end(script: Script, side: int) -> None:
+    """Just round the first corner of a thin wall's end: its end face is abeam, then gone."""
+    script.finish_wrap(side)
+    script.step(side_wall(side, abeam=True))
+    script.pass_outer_corner(side)
+
+
+@pytest.mark.parametrize('variant', [Variant.GAS, Variant.GAS_SOUND])
+def test_a_thin_wall_end_is_one_outer_corner_after_a_revisit(variant: Variant) -> None:
+    """Paper Sec. II-A: a wall is a curve with two endpoints; going round one is one corner."""
+    fsm = make(variant, robot_count=1)
+    script = Script(fsm)
+    scented_corner(script)
+    assert fsm.memory.event is Event.REVISIT
+    pass_thin_wall_end(script, 1)
+    assert fsm.memory.mode is Mode.WRAP, 'round the end face: still the same wall end'
+    assert fsm.memory.state is FsmState.JUST_STARTED
+    assert fsm.memory.leave_at_next_corner
+    assert fsm.memory.counts.get(Event.LEAVE_WALL, 0) == 0
+    script.finish_wrap(1)
+    script.follow_straight(1, steps=10)
+    script.pass_outer_corner(1)
+    assert fsm.memory.event is Event.LEAVE_WALL, 'the next wall end is a new corner'
+
+
+def test_with_wall_end_faces_as_corners_the_robot_leaves_at_the_end_face() -> None:
+    """wall_end_face_m = 0: the authors' grid, where a jamb's end face is a second corner."""
+    fsm = make(Variant.GAS, robot_count=1, wall_end_face_m=0.0)
+    script = Script(fsm)
+    scented_corner(script)
+    pass_thin_wall_end(script, 1)
+    assert fsm.memory.event is Event.LEAVE_WALL
+    assert fsm.memory.mode is Mode.TURN
+
+
+def test_a_thin_wall_end_is_not_checked_twice_for_scent() -> None:
+    fsm = make(Variant.GAS, robot_count=1)
+    script = Script(fsm)
+    reach_wall(script)
+    script.follow_straight(1)
+    script.pass_outer_corner(1)
+    assert fsm.memory.event is Event.OUTER_CORNER
+    script.gas_raw = 400
+    pass_thin_wall_end(script, 1)
+    assert fsm.memory.mode is Mode.WRAP
+    assert fsm.memory.state is FsmState.FOLLOWING_WALL
+    assert fsm.memory.visit_count == 0, 'no new decision at the end face'
 
 
 @pytest.mark.parametrize('variant', BUG_VARIANTS)
