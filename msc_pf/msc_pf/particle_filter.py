@@ -24,10 +24,9 @@ separate (targets, N) arrays; the millimetre resolution is far below the metre-s
 every work array is preallocated and written with ``out=``, and a filter's several samples of
 one step are evaluated together. The likelihood is kept as the misfit ``q = -log w`` and
 the weights ``exp(min q - q)`` are never normalised in place: the estimate divides by their
-sum, the resampling scales the cumulative sum. Systematic resampling turns the cumulative
-weights into the number of comb points before each particle's end and the gather index into
-a histogram of those ends and its cumulative sum: no per-particle loop (``np.repeat``), no
-binary search.
+sum, the resampling scales the cumulative sum. Systematic resampling counts the comb points
+up to each particle's end and takes the gather index as the cumulative sum of a histogram of
+those counts: no per-particle loop (``np.repeat``), no binary search.
 """
 
 from __future__ import annotations
