@@ -107,13 +107,13 @@ def count_crossings(
     """
     if len(segments) == 0 or len(starts) == 0:
         return np.zeros(len(starts), dtype=int)
-    q, s = _padded_walls(segments)
+    q, s = padded_walls(segments)
     if candidates is None:
         candidates = np.broadcast_to(np.arange(len(segments)), (len(starts), len(segments)))
     return _count_hits(starts, ends, q, s, candidates)
 
 
-def _padded_walls(segments: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def padded_walls(segments: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Wall start points (M + 1, 2) and direction vectors (M + 1, 2) [m]; row M is a
     zero-length "wall" far away that stands for the padding index M."""
     q = np.append(segments[:, 0], [[_FAR, _FAR]], axis=0)
@@ -125,7 +125,7 @@ def _count_hits(
     starts: np.ndarray, ends: np.ndarray, q: np.ndarray, s: np.ndarray, candidates: np.ndarray
 ) -> np.ndarray:
     """Crossings of the (K, 2) paths with their (K, W) candidate walls (``q``, ``s`` as
-    :func:`_padded_walls` gives them), counted by the compiled kernel."""
+    :func:`padded_walls` gives them), counted by the compiled kernel."""
     return crossings_kernel(
         np.ascontiguousarray(starts, dtype=float),
         np.ascontiguousarray(ends, dtype=float),
@@ -171,7 +171,7 @@ class WallGrid:
         segments = as_segments(segments)
         self.cell_m = float(cell_m)
         self.num_segments = len(segments)
-        self._q, self._s = _padded_walls(segments)
+        self._q, self._s = padded_walls(segments)
         if len(segments) == 0:
             self._origin = np.zeros(2)
             self._shape = (1, 1)

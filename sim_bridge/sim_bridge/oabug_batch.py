@@ -109,6 +109,8 @@ class BatchRobot:
         self.next_control_ns = self.control_period_ns
         self.own_tag = str(values['own_tag_id']).strip().upper()
         self.fsm = OABugFsm(self.config)
+        # Robots of one group have equal perception settings (set by the batch runner).
+        self.perception_group = 0
         self._extractor = ScanFeatureExtractor(self.config.perception)
         # Fields of the messages: float32 after serialization, else the Python float.
         self._field_type = np.float32 if float32_fields else np.float64
@@ -290,6 +292,12 @@ def run_oabug_batch(
         BatchRobot(robot.parameters, engine_config.lidar, float32_fields=float32_fields)
         for robot in spec.robots
     ]
+    # Robots with equal perception settings share one compiled feature call per step.
+    perception_groups: dict[Any, int] = {}
+    for robot in robots:
+        robot.perception_group = perception_groups.setdefault(
+            robot.config.perception, len(perception_groups)
+        )
     unused = {'odometry'}
     if not any(robot.needs_gas for robot in robots):
         unused.add('gas')
@@ -422,11 +430,11 @@ def _extract_features(robots: list[BatchRobot], now_s: float) -> None:
     configuration in one compiled call (:func:`sim_bridge.scan_features_kernel.extract_many`,
     equal to each robot's extractor). A robot whose scan the batch cannot take (a
     :class:`ScanError`) is left to its own extractor in its control step."""
-    groups: dict[Any, list[tuple[BatchRobot, tuple[Any, ...]]]] = {}
+    groups: dict[int, list[tuple[BatchRobot, tuple[Any, ...]]]] = {}
     for robot in robots:
         pending = robot.pending_scan(now_s)
         if pending is not None:
-            groups.setdefault(robot.config.perception, []).append((robot, pending))
+            groups.setdefault(robot.perception_group, []).append((robot, pending))
     for members in groups.values():
         scans, peers, sides = zip(*(pending for _, pending in members), strict=True)
         try:

@@ -437,3 +437,45 @@ def lidar_noise_kernel(
             r = -np.inf
         flat[f] = r
     return noisy
+
+
+@njit(cache=True)
+def sight_lines_kernel(
+    points: np.ndarray, range_m: float, q: np.ndarray, s: np.ndarray, walls: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:  # pragma: no cover
+    """Every ordered pair of distinct points (receiver i, transmitter j) in row-major order,
+    with the same operations as ``BearingModel.measure_reference``.
+
+    Args:
+        points: (N, 2+) positions [m].
+        range_m: walls are counted only on lines up to this long [m].
+        q: (M + 1, 2) wall start points, s: (M + 1, 2) wall directions (padded walls).
+        walls: (W,) the walls to count (empty: none).
+
+    Returns:
+        (L,) receivers, (L,) transmitters, (L, 2) offsets j - i [m], (L,) distances [m] and
+        (L,) walls crossed (0 beyond ``range_m``), L = N (N - 1).
+    """
+    n = points.shape[0]
+    pairs = n * (n - 1)
+    receiver = np.empty(pairs, dtype=np.int64)
+    transmitter = np.empty(pairs, dtype=np.int64)
+    delta = np.empty((pairs, 2))
+    distance = np.empty(pairs)
+    crossed = np.zeros(pairs, dtype=np.int64)
+    k = 0
+    for i in range(n):
+        for j in range(n):
+            if i == j:
+                continue
+            receiver[k] = i
+            transmitter[k] = j
+            delta[k, 0] = points[j, 0] - points[i, 0]
+            delta[k, 1] = points[j, 1] - points[i, 1]
+            distance[k] = math.hypot(delta[k, 0], delta[k, 1])
+            if walls.shape[0] and distance[k] <= range_m:
+                crossed[k] = path_hits(
+                    points[i, 0], points[i, 1], points[j, 0], points[j, 1], walls, q, s
+                )
+            k += 1
+    return receiver, transmitter, delta, distance, crossed

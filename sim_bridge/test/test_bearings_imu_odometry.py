@@ -103,3 +103,30 @@ def test_noisy_odometry_drifts_away_from_the_truth():
         pose = pose + np.array([[0.05, 0.0, 0.0]])
         est, _ = odom.update(pose, 0.1)
     assert abs(est[0, 0] - pose[0, 0]) > 1e-3
+
+
+@pytest.mark.parametrize(('robots', 'with_walls'), [(1, True), (2, False), (10, True), (25, True)])
+def test_compiled_sight_lines_give_the_numpy_reports_bit_for_bit(robots, with_walls):
+    rng = np.random.default_rng(robots)
+    walls = np.zeros((0, 2, 2))
+    if with_walls:
+        starts = rng.uniform(0.0, 30.0, (60, 2))
+        walls = np.stack([starts, starts + rng.uniform(-4.0, 4.0, (60, 2))], axis=1)
+    config = BearingConfig(range_m=25.0, wall_range_factor=0.6)
+    compiled = BearingModel(robots, config, np.random.default_rng(3), walls)
+    reference = BearingModel(robots, config, np.random.default_rng(3), walls)
+    heard = set()
+    for _ in range(40):
+        poses = np.column_stack(
+            [rng.uniform(-5.0, 35.0, (robots, 2)), rng.uniform(-4.0, 4.0, robots)]
+        )
+        for got, want in zip(
+            compiled.measure(poses), reference.measure_reference(poses), strict=True
+        ):
+            assert got.receiver == want.receiver
+            for field in ('tags', 'azimuth_rad', 'elevation_rad', 'distance_m', 'sequence'):
+                assert np.array_equal(getattr(got, field), getattr(want, field))
+            heard.add(got.tags.size)
+    if robots > 2:
+        # Some peers were heard and some lost (to range, walls or dropouts).
+        assert len(heard) > 2

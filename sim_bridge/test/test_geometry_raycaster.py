@@ -198,12 +198,12 @@ def test_compiled_scan_handles_no_walls_and_no_robots():
 
 
 def test_compiled_crossing_counts_equal_the_numpy_reference():
-    from sim_bridge.geometry import _count_hits, _count_hits_numpy, _padded_walls
+    from sim_bridge.geometry import _count_hits, _count_hits_numpy, padded_walls
 
     rng = np.random.default_rng(5)
     walls = np.concatenate([_random_walls(rng, 40), BOX * 2.0])
     grid = WallGrid(walls, cell_m=0.5, reach_m=1.0)
-    q, s = _padded_walls(walls)
+    q, s = padded_walls(walls)
     starts = rng.uniform(-0.5, 8.5, (4000, 2))
     # Paths of every length, some along a wall or ending on one.
     ends = starts + rng.normal(0.0, 1.0, (4000, 2)) * rng.choice([0.0, 0.1, 1.0, 5.0], (4000, 1))

@@ -18,7 +18,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from sim_bridge.errors import ConfigurationError
-from sim_bridge.geometry import as_segments, count_crossings, wrap_angle
+from sim_bridge.geometry import as_segments, count_crossings, padded_walls, wrap_angle
+from sim_bridge.raycast_kernel import sight_lines_kernel
 
 __all__ = ['BearingConfig', 'BearingModel', 'PeerBearings']
 
@@ -98,6 +99,8 @@ class BearingModel:
         self._rng = rng
         self._walls = as_segments(walls if walls is not None else np.zeros((0, 2, 2)))
         self._sequence = np.zeros((num_robots, num_robots), dtype=np.int64)
+        q, s = padded_walls(self._walls)
+        self._padded_walls = (q, s, np.arange(len(self._walls), dtype=np.int64))
 
     def effective_range_m(self, walls_crossed: np.ndarray) -> np.ndarray:
         """Range [m] left after crossing the given numbers of walls."""
@@ -112,16 +115,40 @@ class BearingModel:
         Returns:
             N reports, one per receiving robot, in robot order.
         """
-        cfg = self.config
+        rx, tx, delta, dist, walls = sight_lines_kernel(
+            np.ascontiguousarray(poses, dtype=float), self.config.range_m, *self._padded_walls
+        )
+        return self._reports(poses, rx, tx, delta, dist, walls)
+
+    def measure_reference(self, poses: np.ndarray) -> list[PeerBearings]:
+        """:meth:`measure` with the sight lines in numpy, the reference of the compiled
+        :func:`~sim_bridge.raycast_kernel.sight_lines_kernel` (the same reports from the
+        same random state)."""
         n = len(poses)
         rx, tx = np.nonzero(~np.eye(n, dtype=bool))
         delta = poses[tx, :2] - poses[rx, :2]
         dist = np.hypot(delta[:, 0], delta[:, 1])
-        in_los_range = dist <= cfg.range_m
+        in_los_range = dist <= self.config.range_m
         walls = np.zeros(len(rx), dtype=int)
         if len(self._walls) and in_los_range.any():
             idx = np.flatnonzero(in_los_range)
             walls[idx] = count_crossings(poses[rx[idx], :2], poses[tx[idx], :2], self._walls)
+        return self._reports(poses, rx, tx, delta, dist, walls)
+
+    def _reports(
+        self,
+        poses: np.ndarray,
+        rx: np.ndarray,
+        tx: np.ndarray,
+        delta: np.ndarray,
+        dist: np.ndarray,
+        walls: np.ndarray,
+    ) -> list[PeerBearings]:
+        """The reports from the sight lines: receivers, transmitters, offsets [m],
+        distances [m] and walls crossed of every ordered pair."""
+        cfg = self.config
+        n = len(poses)
+        in_los_range = dist <= cfg.range_m
         heard = in_los_range & (dist <= self.effective_range_m(walls))
         if cfg.dropout_probability > 0.0:
             heard &= self._rng.random(len(rx)) >= cfg.dropout_probability
