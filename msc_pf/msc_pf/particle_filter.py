@@ -525,6 +525,9 @@ class ParticleFilterBank:
             if k == 1:
                 np.subtract(x[0], ox, out=ex)
                 np.subtract(y[0], oy, out=ey)
+            elif m == k and rows[0] == 0 and rows[-1] == k - 1 and np.all(rows[1:] > rows[:-1]):
+                np.subtract(x, ox, out=ex)  # one sample for every row, in order: no gather
+                np.subtract(y, oy, out=ey)
             else:
                 np.subtract(np.take(x, rows, axis=0, out=ex), ox, out=ex)
                 np.subtract(np.take(y, rows, axis=0, out=ey), oy, out=ey)

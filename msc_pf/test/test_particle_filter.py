@@ -377,3 +377,23 @@ def test_bank_grown_past_its_capacity_updates_like_a_large_one():
             grown.estimate(tid).position_m, large.estimate(tid).position_m
         )
         assert grown.estimate(tid).n_updates == 3
+
+
+def test_joint_update_of_a_full_bank_multiplies_every_sample():
+    # Eight filters fill the bank's eight rows and every observer hears all of them: each
+    # block of later samples is one whole level, evaluated without gathering rows.
+    bank = make_bank(5, censored_likelihood=False)
+    rng = np.random.default_rng(12)
+    truth = rng.uniform(900.0, 1100.0, (8, 2))
+    observers = [np.array([1000.0 + 15.0 * i, 990.0 + 9.0 * i]) for i in range(3)]
+    observations, samples = [], {tid: [] for tid in range(8)}
+    for observer in observers:
+        rssi = [noisy_rssi(observer, target, rng) for target in truth]
+        observations.append((observer, list(range(8)), rssi))
+        for tid, value in enumerate(rssi):
+            samples[tid].append((observer, value))
+    assert bank.update_joint(observations) == []
+    for tid in range(8):
+        expected = lattice_posterior_mean(observers[0], samples[tid], gaussian=True)
+        np.testing.assert_allclose(bank.estimate(tid).position_m, expected, atol=0.05)
+        assert bank.estimate(tid).n_updates == 3
