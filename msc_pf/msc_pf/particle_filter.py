@@ -27,6 +27,11 @@ the weights ``exp(min q - q)`` are never normalised in place: the estimate divid
 sum, the resampling scales the cumulative sum. Systematic resampling counts the comb points
 up to each particle's end and takes the gather index as the cumulative sum of a histogram of
 those counts: no per-particle loop (``np.repeat``), no binary search.
+
+Backends (``ParticleFilterConfig.backend``): this numpy code is the reference and runs
+everywhere; where numba can be imported, :mod:`msc_pf.pf_kernel` computes the distances, the
+misfits, the resampling and the roughening in compiled loops with bit-identical results
+('auto', the default, picks it then).
 """
 
 from __future__ import annotations
@@ -35,10 +40,11 @@ import functools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from types import ModuleType
 
 import numpy as np
 
-from msc_pf.errors import ObservationError
+from msc_pf.errors import ConfigError, ObservationError
 from msc_pf.settings import ParticleFilterConfig, RadioConfig
 
 __all__ = [
@@ -46,6 +52,7 @@ __all__ = [
     'TargetEstimate',
     'estimates_converged',
     'lattice',
+    'resolve_backend',
     'systematic_index',
     'windows_converged',
 ]
@@ -190,6 +197,42 @@ def systematic_index(
     return ends
 
 
+@functools.lru_cache(maxsize=1)
+def _compiled_kernel() -> tuple[ModuleType | None, str]:
+    """:mod:`msc_pf.pf_kernel`, or None and why numba cannot be imported here."""
+    try:
+        import numba  # noqa: F401  (missing, or installed against another numpy)
+    except ImportError as exc:
+        return None, f'{type(exc).__name__}: {exc}'
+    from msc_pf import pf_kernel
+
+    return pf_kernel, ''
+
+
+def resolve_backend(backend: str) -> str:
+    """The backend ``particle_filter.backend`` selects on this machine: 'numpy' or 'numba'.
+
+    Raises:
+        ConfigError: ``backend`` is not 'auto', 'numpy' or 'numba', or it is 'numba' and numba
+            cannot be imported.
+    """
+    if backend == 'numpy':
+        return 'numpy'
+    if backend not in ('auto', 'numba'):
+        raise ConfigError(
+            f"particle_filter.backend must be 'auto', 'numpy' or 'numba', got {backend!r}"
+        )
+    kernel, why_not = _compiled_kernel()
+    if kernel is not None:
+        return 'numba'
+    if backend == 'numba':
+        raise ConfigError(
+            "particle_filter.backend 'numba' needs the numba package, which cannot be imported"
+            f" here ({why_not}); install numba or use backend 'numpy' or 'auto'"
+        )
+    return 'numpy'
+
+
 _CENSOR_STEP_DB = 0.01
 _CENSOR_U_MAX = 6.0  # Phi(6) = 1 - 1e-9: no correction beyond
 _CENSOR_U_MIN = -8.0  # the squared error term dominates beyond
@@ -237,7 +280,14 @@ class ParticleFilterBank:
             field_size_m: the field is [0, field_size_m]^2; particles are kept inside.
             rng: the bank's own random generator (resampling offsets, roughening).
             capacity: initial number of target slots (at least 8; grows as needed).
+
+        Raises:
+            ConfigError: ``config.backend`` is 'numba' and numba cannot be imported.
         """
+        self._backend = resolve_backend(config.backend)
+        self._kernel = _compiled_kernel()[0] if self._backend == 'numba' else None
+        if self._kernel is not None:
+            self._kernel.warm_up()
         self._cfg = config
         self._radio = radio
         self._field_size_m = float(field_size_m)
@@ -258,6 +308,7 @@ class ParticleFilterBank:
             self._censor_table = _censoring_table(math.sqrt(denominator / 2.0), margin)
         else:
             self._censor_table = np.empty(0, np.float32)
+            self._censor_table.flags.writeable = False  # as the shared tables (one kernel type)
         # Table bin of log10 d^2: L / step = 5 K log10 d^2 / step.
         self._censor_bins_per_log = np.float32(5.0 * radio.path_loss_exponent / _CENSOR_STEP_DB)
         # Below this log10 d^2 every table entry is 0 (Phi > 1 - 1e-9): no look-up needed.
@@ -267,6 +318,8 @@ class ParticleFilterBank:
             if nonzero_bins.size
             else math.inf
         )
+        # float32 as numpy compares the float32 logs with it
+        self._censor_from_log32 = np.float32(self._censor_from_log)
         self._pool = (
             rng.standard_normal(config.noise_pool_size, dtype=np.float32)
             if config.noise_pool_size
@@ -312,7 +365,16 @@ class ParticleFilterBank:
         self._buf_nx = np.empty((capacity, n), np.float32)
         self._buf_ny = np.empty((capacity, n), np.float32)
         self._flat_index = np.arange(capacity * n, dtype=np.intp)
+        self._row_numbers = np.arange(capacity, dtype=np.int64)
+        self._no_offsets = np.zeros((capacity, 1), np.float32)  # kernel arguments of the
+        self._no_counts = np.zeros((0, 0), np.int64)  # resampling scheme not in use
+        self._starts = np.empty(n + 1, np.int32)  # kernel scratch
         self._capacity = max(capacity, old)
+
+    @property
+    def backend(self) -> str:
+        """'numpy' or 'numba': how this bank computes its updates."""
+        return self._backend
 
     @property
     def tracked_ids(self) -> tuple[int, ...]:
@@ -563,18 +625,21 @@ class ParticleFilterBank:
         else:
             x = np.take(self._x, slots, axis=0, out=self._w_x[:k])
             y = np.take(self._y, slots, axis=0, out=self._w_y[:k])
-        first32 = first.astype(np.float32)
         q, dx, dy, d2 = self._w_q[:k], self._w_dx[:k], self._w_dy[:k], self._w_d2[:k]
         # Offsets from each filter's first observer; the estimate is accumulated relative to
         # it so float32 keeps millimetres.
-        np.subtract(x, first32[:, 0:1], out=dx)
-        np.subtract(y, first32[:, 1:2], out=dy)
-        np.multiply(dx, dx, out=d2)
-        np.multiply(dy, dy, out=q)
-        d2 += q
-        self._misfit(d2, first[:, 2:], out=q)
-        if len(extra):
-            self._add_extra_samples(q, x, y, extra)
+        if self._kernel is not None:
+            self._misfits_compiled(x, y, first, extra, q, dx, dy, d2)
+        else:
+            first32 = first.astype(np.float32)
+            np.subtract(x, first32[:, 0:1], out=dx)
+            np.subtract(y, first32[:, 1:2], out=dy)
+            np.multiply(dx, dx, out=d2)
+            np.multiply(dy, dy, out=q)
+            d2 += q
+            self._misfit(d2, first[:, 2:], out=q)
+            if len(extra):
+                self._add_extra_samples(q, x, y, extra)
         least = q.min(axis=1)
         best = q.argmin(axis=1)
         degenerate = ~(least <= -_LOG_TINY)  # also catches NaN
@@ -596,21 +661,36 @@ class ParticleFilterBank:
             w[degenerate] = np.float32(1.0)  # re-initialised below; keeps the resampling defined
 
         new_x, new_y = self._buf_nx[:k], self._buf_ny[:k]
-        if self._cfg.resampling == 'systematic':
-            offsets = self._rng.random((k, 1), dtype=np.float32)
-            # dx is free now: the int32 scratch.
-            index = systematic_index(
-                w, offsets, self._w_index[:k], self._w_cum[:k], dx.view(np.int32)
-            ).reshape(-1)
+        offsets, counts = self._resampling_draws(w)
+        if self._kernel is not None:
+            cfg = self._cfg
+            self._kernel.resample_roughen(
+                w,
+                self._no_offsets if offsets is None else offsets,
+                self._no_counts if counts is None else counts,
+                x,
+                y,
+                self._jitter_noise(k)[0],
+                np.float32(cfg.roughening_kappa / math.sqrt(n)),
+                np.float32(cfg.roughening_floor_m),
+                np.float32(self._field_size_m),
+                self._w_cum[0],
+                self._starts,
+                new_x,
+                new_y,
+            )
         else:
-            probabilities = w.astype(np.float64)
-            probabilities /= probabilities.sum(axis=1, keepdims=True)
-            counts = self._rng.multinomial(n, probabilities)
-            index = np.repeat(self._flat_index[: k * n], counts.ravel())
-        # 'clip' writes straight to out (the default mode buffers); the index is in range.
-        np.take(x.reshape(-1), index, out=new_x.reshape(-1), mode='clip')
-        np.take(y.reshape(-1), index, out=new_y.reshape(-1), mode='clip')
-        self._roughen(new_x, new_y, *self._jitter_noise(k))
+            if offsets is not None:
+                # dx is free now: the int32 scratch.
+                index = systematic_index(
+                    w, offsets, self._w_index[:k], self._w_cum[:k], dx.view(np.int32)
+                ).reshape(-1)
+            else:
+                index = np.repeat(self._flat_index[: k * n], counts.ravel())
+            # 'clip' writes straight to out (the default mode buffers); the index is in range.
+            np.take(x.reshape(-1), index, out=new_x.reshape(-1), mode='clip')
+            np.take(y.reshape(-1), index, out=new_y.reshape(-1), mode='clip')
+            self._roughen(new_x, new_y, *self._jitter_noise(k))
 
         if contiguous and k == len(self._ids):
             # Every filter was updated: the new particles become the storage (no copy).
@@ -635,6 +715,53 @@ class ParticleFilterBank:
                 self._reinitialise(slot, first[row, :2])
                 reinitialised.append(self._ids[slot])
         return reinitialised
+
+    def _resampling_draws(self, w: np.ndarray) -> tuple[np.ndarray | None, np.ndarray | None]:
+        """The random draws of the resampling of the rows of ``w``: (k, 1) float32 offsets
+        (systematic) or (k, N) copy counts (multinomial), the other None."""
+        if self._cfg.resampling == 'systematic':
+            return self._rng.random((w.shape[0], 1), dtype=np.float32), None
+        probabilities = w.astype(np.float64)
+        probabilities /= probabilities.sum(axis=1, keepdims=True)
+        return None, self._rng.multinomial(self._n, probabilities)
+
+    def _misfits_compiled(
+        self,
+        x: np.ndarray,
+        y: np.ndarray,
+        first: np.ndarray,
+        extra: np.ndarray,
+        q: np.ndarray,
+        dx: np.ndarray,
+        dy: np.ndarray,
+        d2: np.ndarray,
+    ) -> None:
+        """:meth:`_misfit` of the first samples and :meth:`_add_extra_samples`, bit for bit,
+        with :mod:`msc_pf.pf_kernel`; the first samples' offsets and squared distances go to
+        ``dx``, ``dy``, ``d2``. ``log10`` stays numpy's (one call per block of samples)."""
+        kernel = self._kernel
+        k = x.shape[0]
+        # q holds the first samples' logs until their misfits replace them, element by element.
+        blocks = [(self._row_numbers[:k], first[:, 0], first[:, 1], first[:, 2], q)]
+        for start in range(0, len(extra), self._capacity):
+            chunk = extra[start : start + self._capacity]
+            rows = chunk[:, 0].astype(np.int64)
+            blocks.append((rows, chunk[:, 1], chunk[:, 2], chunk[:, 3], self._w_cum[: len(rows)]))
+        for i, (rows, ox, oy, excess, logs) in enumerate(blocks):
+            ox32, oy32 = ox.astype(np.float32), oy.astype(np.float32)
+            kernel.squared_distances(x, y, rows, ox32, oy32, logs, dx, dy, d2, i == 0)
+            np.log10(logs, out=logs)
+            kernel.add_misfit(
+                logs,
+                rows,
+                (excess * self._misfit_root).astype(np.float32),
+                self._misfit_slope,
+                self._censor_table,
+                self._censor_bins_per_log,
+                self._censor_from_log32,
+                q,
+                i == 0,
+            )
 
     def _jitter_noise(self, k: int) -> tuple[np.ndarray, bool]:
         """(2, k, N) standard normals for the roughening and whether they come from the pool."""

@@ -1,23 +1,32 @@
-"""Particle filter: convergence, its two tests at their thresholds, resampling, degeneracy."""
+"""Particle filter: convergence, its two tests at their thresholds, resampling, degeneracy.
 
+These test the numpy code, the reference (``backend='numpy'``); test_pf_kernel.py checks
+that the compiled backend gives the same results.
+"""
+
+import importlib.util
 import math
 
 import numpy as np
 import pytest
-from msc_pf.errors import ObservationError
+from msc_pf.errors import ConfigError, ObservationError
 from msc_pf.particle_filter import (
     ParticleFilterBank,
     estimates_converged,
     lattice,
+    resolve_backend,
     systematic_index,
 )
 from msc_pf.settings import ParticleFilterConfig, RadioConfig
+
+from msc_pf import particle_filter
 
 RADIO = RadioConfig()
 FIELD_M = 2000.0
 
 
 def make_bank(seed: int = 0, **overrides) -> ParticleFilterBank:
+    overrides.setdefault('backend', 'numpy')
     return ParticleFilterBank(
         ParticleFilterConfig(**overrides), RADIO, FIELD_M, np.random.default_rng(seed)
     )
@@ -27,15 +36,22 @@ def noisy_rssi(observer: np.ndarray, target: np.ndarray, rng: np.random.Generato
     return RADIO.mean_rssi_dbm(float(np.hypot(*(target - observer)))) + rng.normal()
 
 
+NEEDS_NUMBA = pytest.mark.skipif(
+    importlib.util.find_spec('numba') is None, reason='numba is not installed'
+)
+
+
+@pytest.mark.parametrize('backend', ['numpy', pytest.param('numba', marks=NEEDS_NUMBA)])
 @pytest.mark.parametrize('seed', [0, 1, 2])
-def test_filter_converges_on_static_target_from_moving_observers(seed):
+def test_filter_converges_on_static_target_from_moving_observers(seed, backend):
     # Three robots abreast 20 m apart (the (b-1) formation) drive past a target ~190 m away.
     # The ring ambiguity of one RSSI sample is resolved after a few tens of metres of
     # baseline; the roughening keeps the spread above R_conv for a while longer, and eq. (7)
     # needs a window of 10 steps: expect 50-75 steps, allow 150.
     target = np.array([1150.0, 1120.0])
     rng = np.random.default_rng(100 + seed)
-    bank = make_bank(seed)
+    bank = make_bank(seed, backend=backend)
+    assert bank.backend == backend
     offsets = np.array([[0.0, 0.0], [0.0, 20.0], [0.0, -20.0]])
     for step in range(1, 151):
         for offset in offsets:
@@ -359,10 +375,9 @@ def test_censoring_is_exactly_zero_well_inside_the_detection_range():
 
 def test_bank_grown_past_its_capacity_updates_like_a_large_one():
     # Tracking a ninth target reallocates the arrays; the filters must come through intact.
-    grown = ParticleFilterBank(ParticleFilterConfig(), RADIO, FIELD_M, np.random.default_rng(6))
-    large = ParticleFilterBank(
-        ParticleFilterConfig(), RADIO, FIELD_M, np.random.default_rng(6), capacity=16
-    )
+    config = ParticleFilterConfig(backend='numpy')
+    grown = ParticleFilterBank(config, RADIO, FIELD_M, np.random.default_rng(6))
+    large = ParticleFilterBank(config, RADIO, FIELD_M, np.random.default_rng(6), capacity=16)
     rng = np.random.default_rng(2)
     targets = rng.uniform(900.0, 1100.0, (12, 2))
     for step in range(3):
@@ -397,3 +412,23 @@ def test_joint_update_of_a_full_bank_multiplies_every_sample():
         expected = lattice_posterior_mean(observers[0], samples[tid], gaussian=True)
         np.testing.assert_allclose(bank.estimate(tid).position_m, expected, atol=0.05)
         assert bank.estimate(tid).n_updates == 3
+
+
+def test_unknown_backend_is_rejected():
+    with pytest.raises(ConfigError, match="backend 'fortran' not in"):
+        ParticleFilterConfig(backend='fortran')
+    with pytest.raises(ConfigError, match="'auto', 'numpy' or 'numba', got 'fortran'"):
+        resolve_backend('fortran')
+
+
+def test_backend_without_numba(monkeypatch):
+    # A robot without numba: 'auto' runs numpy, 'numba' is refused at construction, saying why.
+    monkeypatch.setattr(
+        particle_filter,
+        '_compiled_kernel',
+        lambda: (None, "ModuleNotFoundError: No module named 'numba'"),
+    )
+    assert make_bank(backend='auto').backend == 'numpy'
+    assert make_bank(backend='numpy').backend == 'numpy'
+    with pytest.raises(ConfigError, match=r"'numba' needs the numba package.*named 'numba'"):
+        make_bank(backend='numba')
