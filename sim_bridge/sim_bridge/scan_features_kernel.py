@@ -72,7 +72,8 @@ def features_kernel(
 
     Args:
         ranges: (K, B) ranges [m], -inf already replaced by range_min.
-        half_width: (K, B) angular half width of a peer's window at each range [rad].
+        half_width: (K, B) angular half width of a peer's window at each range [rad], read
+            only where the range is within the peer mask range.
         angles, cos_t, sin_t: (B,) ray directions in the robot frame.
         bearing_start: (K + 1,) slice bounds of each scan's peers in ``bearing``.
         bearing: (T,) peer bearings wrapped to [-pi, pi] [rad]; NaN to skip.
@@ -281,7 +282,13 @@ def extract_many(
         finite = np.isfinite(azimuths)
         bearing = np.full(azimuths.size, math.nan)
         bearing[finite] = np.arctan2(np.sin(azimuths[finite]), np.cos(azimuths[finite]))
-        half_width = cfg.peer_bearing_tolerance_rad + np.arctan2(cfg.robot_radius_m, ranges)
+        # The kernel reads a ray's window only where it may be a peer's: within the peer
+        # mask range (numpy's arctan2 of an element does not depend on the array around it).
+        half_width = np.full(ranges.shape, math.nan)
+        maskable = ranges <= cfg.peer_mask_range_m
+        half_width[maskable] = cfg.peer_bearing_tolerance_rad + np.arctan2(
+            cfg.robot_radius_m, ranges[maskable]
+        )
     else:
         bearing = distances = np.zeros(0)
         half_width = ranges  # not read: no scan has a peer
