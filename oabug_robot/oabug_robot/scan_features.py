@@ -322,9 +322,12 @@ class ScanFeatureExtractor:
         if xs.size < 3 or xs.max() - xs.min() < 0.05:
             return SideWall(distance_m=float(ls.min()), angle_rad=0.0, abeam=abeam)
         angle, distance = _fit_line(xs, ls)
-        # Once more without the returns off that line (a corner inside the window).
-        residual = np.abs(xs * math.sin(angle) - ls * math.cos(angle) + distance)
-        on_line = residual <= cfg.side_wall_fit_tolerance_m
+        # Once more without the returns off that line (a corner inside the window). The
+        # residual |x sin - l cos + distance| is formed in place (the same operations).
+        residual = xs * math.sin(angle)
+        residual -= ls * math.cos(angle)
+        residual += distance
+        on_line = np.abs(residual, out=residual) <= cfg.side_wall_fit_tolerance_m
         if 3 <= np.count_nonzero(on_line) < xs.size:
             angle, distance = _fit_line(xs[on_line], ls[on_line])
         return SideWall(distance_m=distance, angle_rad=angle, abeam=abeam)
