@@ -192,7 +192,9 @@ def run(
         outcomes = [run_job(job) for job in jobs]
     else:
         context = multiprocessing.get_context('spawn')
-        with context.Pool(workers, maxtasksperchild=20) as pool:
+        # Each worker lives for the whole sweep: a new process pays about 1.5 s of CPU for
+        # the imports and the compiled kernels' cache load (docs/simulation.md), once.
+        with context.Pool(workers) as pool:
             outcomes = []
             for outcome in pool.imap_unordered(run_job, jobs, chunksize=1):
                 outcomes.append(outcome)
