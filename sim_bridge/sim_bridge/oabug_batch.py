@@ -51,7 +51,7 @@ from sim_bridge.conversions import yaw_to_quaternion
 from sim_bridge.engine import READINGS, EngineConfig, SimEngine, SiteGeometry
 from sim_bridge.errors import ConfigurationError
 from sim_bridge.mission import MissionProgress, MissionResult, MissionSpec, StopReason
-from sim_bridge.scan_features_kernel import extract_many
+from sim_bridge.scan_features_kernel import extract_many_flat
 from sim_bridge.sensors.bearings import PeerBearings as BearingReport
 from sim_bridge.sensors.lidar import LidarConfig
 from sim_bridge.site_geometry import geometry_from_site
@@ -192,15 +192,28 @@ class BatchRobot:
             self._yaw.value, self.config.perception.peer_bearing_max_distance_m
         )
 
-    def pending_scan(
-        self, now_s: float
-    ) -> tuple[LaserScanData, tuple[np.ndarray, np.ndarray], int] | None:
-        """The held scan that this control step turns into features, the near peers' bearings
-        and distances and the side whose wall is wanted; None when there is nothing to do."""
+    def pending_scan(self, now_s: float) -> tuple[LaserScanData, int] | None:
+        """The held scan that this control step turns into features and the side whose wall
+        is wanted; None when there is nothing to do."""
         scan = self._scan.value
         if scan is None or not math.isfinite(self._yaw.value):
             return None
-        return scan, self._near_peers(now_s), self.fsm.memory.wall_side
+        return scan, self.fsm.memory.wall_side
+
+    def peer_bearings(self, now_s: float) -> tuple[np.ndarray, np.ndarray, float] | None:
+        """The bearings the control step at ``now_s`` reads, before the near-peer selection:
+        the held azimuths [rad] and distances [m] and the rotation since they were heard
+        (``yaw_at_stamp - yaw`` [rad], added to the azimuths as
+        :meth:`~oabug_robot.sound.PeerBearings.near_peers_now` does); None when none are
+        held or they are older than the bearing timeout."""
+        bearings = self._bearings
+        if bearings is None or now_s - bearings.stamp_s > self.config.bearing_timeout_s:
+            return None
+        return (
+            bearings.azimuths_rad,
+            bearings.distances_m,
+            bearings.yaw_at_stamp_rad - self._yaw.value,
+        )
 
     def take_features(self, features: ScanFeatures) -> None:
         """Hold the features of the pending scan (computed for many robots at once)."""
@@ -430,19 +443,54 @@ def _extract_features(robots: list[BatchRobot], now_s: float) -> None:
     configuration in one compiled call (:func:`sim_bridge.scan_features_kernel.extract_many`,
     equal to each robot's extractor). A robot whose scan the batch cannot take (a
     :class:`ScanError`) is left to its own extractor in its control step."""
-    groups: dict[int, list[tuple[BatchRobot, tuple[Any, ...]]]] = {}
+    groups: dict[int, list[tuple[BatchRobot, LaserScanData, int]]] = {}
     for robot in robots:
         pending = robot.pending_scan(now_s)
         if pending is not None:
-            groups.setdefault(robot.perception_group, []).append((robot, pending))
+            groups.setdefault(robot.perception_group, []).append((robot, *pending))
     for members in groups.values():
-        scans, peers, sides = zip(*(pending for _, pending in members), strict=True)
+        extractor = members[0][0].extractor
+        scans = [scan for _, scan, _ in members]
+        sides = [side for _, _, side in members]
+        bearing_start, azimuths, distances = _near_peers(
+            [robot.peer_bearings(now_s) for robot, _, _ in members],
+            extractor.config.peer_bearing_max_distance_m,
+        )
         try:
-            features = extract_many(members[0][0].extractor, scans, peers, sides)
+            features = extract_many_flat(
+                extractor, scans, bearing_start, azimuths, distances, sides
+            )
         except ScanError:
             continue
-        for (robot, _), robot_features in zip(members, features, strict=True):
+        for (robot, _, _), robot_features in zip(members, features, strict=True):
             robot.take_features(robot_features)
+
+
+def _near_peers(
+    held: list[tuple[np.ndarray, np.ndarray, float] | None], max_distance_m: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:meth:`oabug_robot.sound.PeerBearings.near_peers_now` of several robots at once (the
+    same element-wise operations): the slice bounds of each robot's near peers, their
+    bearings at the robots' current yaws [rad] and their distances [m].
+
+    Args:
+        held: per robot, what :meth:`BatchRobot.peer_bearings` returns.
+        max_distance_m: peers farther than this (by their known distance) are left out.
+    """
+    counts = [0 if h is None else len(h[0]) for h in held]
+    bounds = np.zeros(len(held) + 1, dtype=np.int64)
+    np.cumsum(counts, out=bounds[1:])
+    if not bounds[-1]:
+        return bounds, np.zeros(0), np.zeros(0)
+    present = [h for h in held if h is not None]
+    rotation = np.repeat([h[2] for h in present], [len(h[0]) for h in present])
+    azimuths = np.concatenate([h[0] for h in present]) + rotation
+    distances = np.concatenate([h[1] for h in present])
+    near = ~(distances > max_distance_m)  # NaN (unknown) distances are kept
+    if not near.all():
+        bounds = np.concatenate(([0], np.cumsum(near)))[bounds]
+        azimuths, distances = azimuths[near], distances[near]
+    return bounds, azimuths, distances
 
 
 def run_spawn_batch(

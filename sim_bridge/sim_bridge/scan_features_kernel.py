@@ -35,7 +35,7 @@ from oabug_robot.scan_features import (
     SideWall,
 )
 
-__all__ = ['extract_many', 'features_kernel']
+__all__ = ['extract_many', 'extract_many_flat', 'features_kernel']
 
 _TWO_PI = 2.0 * math.pi
 
@@ -253,6 +253,50 @@ def extract_many(
     if not len(scans) == len(peers) == len(sides):
         msg = f'{len(scans)} scans, {len(peers)} peer sets and {len(sides)} sides'
         raise ValueError(msg)
+    counts = [len(azimuths) for azimuths, _ in peers]
+    bearing_start = np.zeros(len(scans) + 1, dtype=np.int64)
+    np.cumsum(counts, out=bearing_start[1:])
+    azimuths = distances = np.zeros(0)
+    if bearing_start[-1]:
+        azimuths = np.concatenate([np.asarray(a, dtype=float) for a, _ in peers])
+        distances = np.concatenate(
+            [
+                np.full(len(a), math.nan) if d is None else np.asarray(d, dtype=float)
+                for a, d in peers
+            ]
+        )
+    return extract_many_flat(extractor, scans, bearing_start, azimuths, distances, sides)
+
+
+def extract_many_flat(
+    extractor: ScanFeatureExtractor,
+    scans: Sequence[LaserScanData],
+    bearing_start: np.ndarray,
+    azimuths: np.ndarray,
+    distances: np.ndarray,
+    sides: Sequence[int],
+) -> list[ScanFeatures]:
+    """:func:`extract_many` with the peers of all scans in flat arrays.
+
+    Args:
+        extractor: as for :func:`extract_many`.
+        scans: K scans, as for :func:`extract_many`.
+        bearing_start: (K + 1,) int64 slice bounds of each scan's peers in the arrays below.
+        azimuths: (T,) the peers' bearings [rad] (NaN entries skipped).
+        distances: (T,) their coarse distances [m], NaN where unknown.
+        sides: per scan, the side whose wall is wanted (+1 left, -1 right, 0 none).
+
+    Raises:
+        ScanError: the scans have no rays or their angles are not finite.
+        ValueError: the scans differ in angles, limits or number of rays, or the
+            argument lengths differ.
+    """
+    if len(bearing_start) != len(scans) + 1 or len(sides) != len(scans):
+        msg = f'{len(scans)} scans, {len(bearing_start) - 1} peer sets and {len(sides)} sides'
+        raise ValueError(msg)
+    if len(azimuths) != bearing_start[-1] or len(distances) != bearing_start[-1]:
+        msg = f'{bearing_start[-1]} peers, {len(azimuths)} azimuths, {len(distances)} distances'
+        raise ValueError(msg)
     if not scans:
         return []
     first = scans[0]
@@ -268,17 +312,9 @@ def extract_many(
     range_min = max(float(first.range_min_m), 0.0)
     # REP 117: -inf means "too close to measure", i.e. an obstacle at range_min.
     ranges[ranges == -math.inf] = range_min
-    counts = [len(azimuths) for azimuths, _ in peers]
-    bearing_start = np.zeros(len(scans) + 1, dtype=np.int64)
-    np.cumsum(counts, out=bearing_start[1:])
     if bearing_start[-1]:
-        azimuths = np.concatenate([np.asarray(a, dtype=float) for a, _ in peers])
-        distances = np.concatenate(
-            [
-                np.full(len(a), math.nan) if d is None else np.asarray(d, dtype=float)
-                for a, d in peers
-            ]
-        )
+        azimuths = np.asarray(azimuths, dtype=float)
+        distances = np.asarray(distances, dtype=float)
         finite = np.isfinite(azimuths)
         bearing = np.full(azimuths.size, math.nan)
         bearing[finite] = np.arctan2(np.sin(azimuths[finite]), np.cos(azimuths[finite]))
@@ -307,7 +343,7 @@ def extract_many(
         angles,
         cos_t,
         sin_t,
-        bearing_start,
+        np.asarray(bearing_start, dtype=np.int64),
         bearing,
         distances,
         np.asarray(sides, dtype=np.int64),

@@ -10,7 +10,7 @@ import pytest
 from oabug_robot.errors import ScanError
 from oabug_robot.scan_features import LaserScanData, ScanFeatureExtractor, ScanFeatures
 from oabug_robot.settings import PerceptionConfig
-from sim_bridge.scan_features_kernel import extract_many
+from sim_bridge.scan_features_kernel import extract_many, extract_many_flat
 
 
 def _scan(
@@ -139,3 +139,25 @@ def test_bad_batches_are_refused() -> None:
         extract_many(extractor, [good, other], [(np.zeros(0), None)] * 2, [0, 0])
     with pytest.raises(ValueError, match='sides'):
         extract_many(extractor, [good], [(np.zeros(0), None)], [0, 1])
+    with pytest.raises(ValueError, match='peers'):
+        extract_many_flat(extractor, [good], np.array([0, 2]), np.zeros(1), np.zeros(2), [0])
+    with pytest.raises(ValueError, match='sides'):
+        extract_many_flat(extractor, [good], np.array([0]), np.zeros(0), np.zeros(0), [0])
+
+
+def test_flat_peers_give_the_features_of_the_per_scan_peers() -> None:
+    """extract_many_flat (the batch path's call) with the peers of all scans in one array."""
+    rng = np.random.default_rng(11)
+    extractor = ScanFeatureExtractor(PerceptionConfig())
+    for _ in range(40):
+        k = int(rng.integers(1, 12))
+        scans = [_scan(_room_ranges(rng, 360)) for _ in range(k)]
+        peers = [_peers(rng) for _ in range(k)]
+        sides = [int(s) for s in rng.integers(-1, 2, k)]
+        start = np.concatenate(([0], np.cumsum([len(a) for a, _ in peers])))
+        azimuths = np.concatenate([a for a, _ in peers])
+        distances = np.concatenate(
+            [np.full(len(a), math.nan) if d is None else d for a, d in peers]
+        )
+        flat = extract_many_flat(extractor, scans, start, azimuths, distances, sides)
+        assert [_exact(f) for f in flat] == _numpy_features(extractor, scans, peers, sides)
