@@ -130,3 +130,35 @@ def test_compiled_sight_lines_give_the_numpy_reports_bit_for_bit(robots, with_wa
     if robots > 2:
         # Some peers were heard and some lost (to range, walls or dropouts).
         assert len(heard) > 2
+
+
+@pytest.mark.parametrize(
+    'config',
+    [
+        ImuConfig(),
+        ImuConfig(residual_bias_std_radps=0.01, bias_random_walk_radps_per_sqrt_s=0.002),
+        ImuConfig(noise_density_radps_per_sqrt_hz=0.0),
+    ],
+)
+def test_compiled_gyro_integration_gives_the_numpy_yaw_bit_for_bit(config):
+    """Same yaw and rates from the same random state, across the +-pi seam, with NaN and
+    +-inf yaw changes and varied dt."""
+    rng = np.random.default_rng(4)
+    start = rng.uniform(-math.pi, math.pi, 10)
+    start[0] = math.pi
+    compiled = GyroYawModel(start, config, np.random.default_rng(6))
+    reference = GyroYawModel(start, config, np.random.default_rng(6))
+    for step in range(300):
+        change = rng.normal(0.0, 0.5, 10) * rng.choice([1.0, 1e-9, 10.0], 10)
+        if step % 50 == 7:
+            change[rng.integers(0, 10)] = rng.choice([math.nan, math.inf, -math.inf])
+        dt = 0.1 if step % 4 else float(rng.uniform(0.01, 1.0))
+        yaw, rate = compiled.update(change.copy(), dt)
+        with np.errstate(invalid='ignore'):  # an infinite change makes the yaw NaN
+            want_yaw, want_rate = reference.update_reference(change.copy(), dt)
+        assert yaw.tobytes() == want_yaw.tobytes()
+        assert rate.tobytes() == want_rate.tobytes()
+        if step % 50 == 7:  # a NaN yaw stays NaN: start both again from clean yaws
+            clean = np.nan_to_num(want_yaw).clip(-3.0, 3.0)
+            compiled = GyroYawModel(clean, config, np.random.default_rng(step))
+            reference = GyroYawModel(clean, config, np.random.default_rng(step))

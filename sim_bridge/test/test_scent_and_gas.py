@@ -145,3 +145,35 @@ def test_the_compiled_pair_search_gives_the_numpy_concentration_bit_for_bit(with
     assert checked > 20
     # With walls, some vapour paths are blocked (the wall test was exercised).
     assert blocked == with_walls
+
+
+@pytest.mark.parametrize(
+    'config',
+    [
+        GasSensorConfig(),
+        GasSensorConfig(noise_std_raw=0.0, baseline_raw=0.0),
+        GasSensorConfig(rise_time_constant_s=0.05, fall_time_constant_s=40.0, noise_std_raw=30.0),
+    ],
+)
+def test_the_compiled_gas_update_gives_the_numpy_readings_bit_for_bit(config):
+    """Same readings and lagged concentrations from the same random state, on concentrations
+    from clean air to saturation, with NaN, +-inf, negative and -0.0 values and varied dt."""
+    rng = np.random.default_rng(3)
+    compiled = Mp503Model(12, config, np.random.default_rng(9))
+    reference = Mp503Model(12, config, np.random.default_rng(9))
+    for step in range(400):
+        c = rng.choice([0.0, 1.0, 50.0, 400.0, 1e4, 1e300], 12) * rng.random(12)
+        special = rng.random(12)
+        c[special < 0.05] = math.nan
+        c[(special >= 0.05) & (special < 0.08)] = math.inf
+        c[(special >= 0.08) & (special < 0.1)] = -math.inf
+        c[(special >= 0.1) & (special < 0.15)] = -3.0
+        c[(special >= 0.15) & (special < 0.2)] = -0.0
+        dt = 0.1 if step % 3 else float(rng.uniform(0.01, 2.0))
+        got = compiled.update(c.copy(), dt)
+        with np.errstate(over='ignore'):  # saturated sensors
+            want = reference.update_reference(c.copy(), dt)
+        assert got.dtype.kind == want.dtype.kind == 'i'
+        assert got.tolist() == want.tolist()
+        assert compiled.sensed_ppm.tobytes() == reference.sensed_ppm.tobytes()
+    assert 0 < int(want.max()) <= RAW_MAX

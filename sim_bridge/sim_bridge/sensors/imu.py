@@ -15,6 +15,7 @@ import numpy as np
 
 from sim_bridge.errors import ConfigurationError
 from sim_bridge.geometry import wrap_angle
+from sim_bridge.sensors_kernel import imu_update_kernel
 
 __all__ = ['GyroYawModel', 'ImuConfig']
 
@@ -69,6 +70,18 @@ class GyroYawModel:
         """(N,) current yaw estimates [rad] in (-pi, pi]."""
         return self._yaw.copy()
 
+    def _draw_rate_noise(self, dt_s: float) -> np.ndarray:
+        """Advance the bias random walk over ``dt_s`` and draw the (N,) rate noise
+        [rad/s], in this order."""
+        cfg = self.config
+        n = len(self._yaw)
+        if cfg.bias_random_walk_radps_per_sqrt_s > 0.0:
+            self._bias += self._rng.normal(
+                0.0, cfg.bias_random_walk_radps_per_sqrt_s * math.sqrt(dt_s), n
+            )
+        noise_std = cfg.noise_density_radps_per_sqrt_hz * math.sqrt(1.0 / dt_s)
+        return self._rng.normal(0.0, noise_std, n)
+
     def update(self, true_yaw_change_rad: np.ndarray, dt_s: float) -> tuple[np.ndarray, np.ndarray]:
         """Integrate one IMU period.
 
@@ -79,14 +92,20 @@ class GyroYawModel:
         Returns:
             (N,) yaw estimates [rad] and (N,) measured, bias-corrected yaw rates [rad/s].
         """
-        cfg = self.config
         n = len(self._yaw)
-        if cfg.bias_random_walk_radps_per_sqrt_s > 0.0:
-            self._bias += self._rng.normal(
-                0.0, cfg.bias_random_walk_radps_per_sqrt_s * math.sqrt(dt_s), n
-            )
-        noise_std = cfg.noise_density_radps_per_sqrt_hz * math.sqrt(1.0 / dt_s)
+        noise = self._draw_rate_noise(dt_s)
+        change = np.asarray(true_yaw_change_rad, dtype=float).reshape(n)
+        rate = imu_update_kernel(self._yaw, change, float(dt_s), self._bias, noise)
+        return self._yaw.copy(), rate
+
+    def update_reference(
+        self, true_yaw_change_rad: np.ndarray, dt_s: float
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`update` in numpy, the reference of the compiled
+        :func:`sim_bridge.sensors_kernel.imu_update_kernel` (the same values from the same
+        random state)."""
+        noise = self._draw_rate_noise(dt_s)
         rate = np.asarray(true_yaw_change_rad, dtype=float) / dt_s
-        rate = rate + self._bias + self._rng.normal(0.0, noise_std, n)
+        rate = rate + self._bias + noise
         self._yaw = np.asarray(wrap_angle(self._yaw + rate * dt_s), dtype=float)
         return self._yaw.copy(), rate
