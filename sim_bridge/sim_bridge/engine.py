@@ -311,8 +311,10 @@ class SimEngine:
         self.time_s = self._step_index * dt
         poses = self.world.poses
         self.distance_travelled_m += np.hypot(*(poses[:, :2] - before[:, :2]).T)
-        headings = _headings(poses)
+        # The headings serve the nozzles and the gas sensors: computed once, when needed.
+        headings = None
         if self._depositor.busy(pumping):
+            headings = _headings(poses)
             self._depositor.step(pumping, self.nozzle_positions(poses, headings), self.time_s, dt)
         out = StepOutput(time_s=self.time_s, poses=poses)
         out.new_room_entries = self.coverage.update(poses, self.time_s)
@@ -322,6 +324,8 @@ class SimEngine:
             out.scans = self.lidar.measure(poses)
         due, elapsed = sched['gas'].due(self.time_s)
         if due and 'gas' in wanted:
+            if headings is None:
+                headings = _headings(poses)
             c = self.scent.concentration(self.gas_sensor_positions(poses, headings), self.time_s)
             out.gas_raw = self.gas.update(c, elapsed)
         if sched['bearings'].due(self.time_s)[0] and 'bearings' in wanted:
