@@ -4,7 +4,6 @@ These test the numpy code, the reference (``backend='numpy'``); test_pf_kernel.p
 that the compiled backend gives the same results.
 """
 
-import importlib.util
 import math
 
 import numpy as np
@@ -37,7 +36,7 @@ def noisy_rssi(observer: np.ndarray, target: np.ndarray, rng: np.random.Generato
 
 
 NEEDS_NUMBA = pytest.mark.skipif(
-    importlib.util.find_spec('numba') is None, reason='numba is not installed'
+    resolve_backend('auto') != 'numba', reason='numba cannot be imported here'
 )
 
 
