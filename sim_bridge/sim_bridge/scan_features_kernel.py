@@ -357,18 +357,22 @@ def extract_many_flat(
         side_l,
         abeam,
     )
+    # The outputs as Python numbers once (the same values), not element by element.
+    walls_ahead, robots_ahead = front_wall.tolist(), front_robot.tolist()
+    nears, peer_counts = near_count.tolist(), peer_count.tolist()
+    side_counts, abeams = side_count.tolist(), abeam.tolist()
     result = []
     for i, side in enumerate(sides):
-        if near_count[i] == 0:
+        if nears[i] == 0:
             result.append(ScanFeatures())
             continue
         left = right = SideWall()
         if side:
-            n = side_count[i]
+            n = side_counts[i]
             wall = SideWall()
             if n:
                 wall = extractor.wall_from_points(
-                    side_x[i, :n].copy(), side_l[i, :n].copy(), bool(abeam[i])
+                    side_x[i, :n].copy(), side_l[i, :n].copy(), abeams[i]
                 )
             if side > 0:
                 left = wall
@@ -376,12 +380,12 @@ def extract_many_flat(
                 right = SideWall(wall.distance_m, -wall.angle_rad, wall.abeam)
         result.append(
             ScanFeatures(
-                front_wall_m=float(front_wall[i]),
-                front_robot_m=float(front_robot[i]),
+                front_wall_m=walls_ahead[i],
+                front_robot_m=robots_ahead[i],
                 left=left,
                 right=right,
-                near_returns=int(near_count[i]),
-                peer_returns=int(peer_count[i]),
+                near_returns=nears[i],
+                peer_returns=peer_counts[i],
             )
         )
     return result
