@@ -262,18 +262,26 @@ class SimEngine:
             robots: K distinct robot indices.
             commands: per robot, speed [m/s] and yaw rate [rad/s] (non-finite taken as zero).
             pumps: per robot, pump on.
+
+        Raises:
+            WorldGeometryError: a robot index is out of range (nothing is recorded).
+            ValueError: the three lists differ in length.
         """
-        if not robots:
-            return
-        index = np.asarray(robots, dtype=int)
-        if index.min() < 0 or index.max() >= self.num_robots:
-            bad = next(i for i in robots if not 0 <= i < self.num_robots)
-            self._check_robot(bad)
-        values = np.asarray(commands, dtype=float).reshape(len(robots), 2)
-        self._command[index] = np.where(np.isfinite(values), values, 0.0)
-        self._command_time_s[index] = self.time_s
-        self._pump_on[index] = np.asarray(pumps, dtype=bool)
-        self._pump_time_s[index] = self.time_s
+        if not len(robots) == len(commands) == len(pumps):
+            msg = f'{len(robots)} robots, {len(commands)} commands and {len(pumps)} pump states'
+            raise ValueError(msg)
+        for robot in robots:
+            self._check_robot(robot)
+        # Element by element: cheaper than array operations for a few robots.
+        command, pump_on = self._command, self._pump_on
+        command_time, pump_time = self._command_time_s, self._pump_time_s
+        now = self.time_s
+        for robot, (v, w), on in zip(robots, commands, pumps, strict=True):
+            command[robot, 0] = v if math.isfinite(v) else 0.0
+            command[robot, 1] = w if math.isfinite(w) else 0.0
+            command_time[robot] = now
+            pump_on[robot] = bool(on)
+            pump_time[robot] = now
 
     def active_commands(self) -> np.ndarray:
         """(N, 2) commands in force now: stale ones are replaced by zero."""

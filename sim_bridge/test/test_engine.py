@@ -151,3 +151,34 @@ def test_leaving_a_reading_out_changes_none_of_the_others():
             ]
     with pytest.raises(ConfigurationError, match='sonar'):
         outputs(readings=frozenset({'scan', 'sonar'}))
+
+
+def test_commands_set_together_equal_commands_set_one_by_one():
+    """set_commands (the batch path's call) records what set_velocity_command and set_pump
+    record robot by robot, non-finite values included; a bad index records nothing."""
+    rng = np.random.default_rng(8)
+    poses = [[1.0 + 0.5 * i, 1.5, 0.0] for i in range(5)]
+    together, one_by_one = make_engine(poses), make_engine(poses)
+    for _ in range(30):
+        robots = sorted(rng.choice(5, int(rng.integers(0, 6)), replace=False).tolist())
+        commands = [
+            (float(v), float(w))
+            for v, w in rng.choice(
+                [0.2, -0.1, math.nan, math.inf, -math.inf, 0.0], (len(robots), 2)
+            )
+        ]
+        pumps = [bool(p) for p in rng.random(len(robots)) < 0.5]
+        together.set_commands(robots, commands, pumps)
+        for robot, command, pump in zip(robots, commands, pumps, strict=True):
+            one_by_one.set_velocity_command(robot, *command)
+            one_by_one.set_pump(robot, pump)
+        assert together.active_commands().tobytes() == one_by_one.active_commands().tobytes()
+        assert together.pumps_running().tolist() == one_by_one.pumps_running().tolist()
+        together.step()
+        one_by_one.step()
+    before = together.active_commands()
+    with pytest.raises(WorldGeometryError, match='out of range'):
+        together.set_commands([0, 7], [(0.3, 0.0), (0.3, 0.0)], [True, True])
+    assert together.active_commands().tobytes() == before.tobytes()
+    with pytest.raises(ValueError, match='pump states'):
+        together.set_commands([0], [(0.3, 0.0)], [])
