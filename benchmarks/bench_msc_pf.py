@@ -36,7 +36,7 @@ from dataclasses import dataclass  # noqa: E402
 from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
-from msc_pf.particle_filter import ParticleFilterBank  # noqa: E402
+from msc_pf.particle_filter import ParticleFilterBank, resolve_backend  # noqa: E402
 from msc_pf.schemes import Scheme  # noqa: E402
 from msc_pf.settings import ParticleFilterConfig, RadioConfig  # noqa: E402
 from sim_bridge.msc_pf_batch import BatchScenario, run_batch  # noqa: E402
@@ -292,18 +292,20 @@ def read_outcomes(path: Path) -> list[RunOutcome]:
     return outcomes
 
 
-def pf_table() -> list[str]:
-    """Particle-filter step times (markdown lines)."""
-    uncensored = ParticleFilterConfig(censored_likelihood=False)
+def pf_table(backend: str = 'auto') -> list[str]:
+    """Particle-filter step times (markdown lines) with ``particle_filter.backend`` ``backend``."""
+    plain = ParticleFilterConfig(backend=backend)
+    uncensored = ParticleFilterConfig(censored_likelihood=False, backend=backend)
     cases = [
-        ('one observation of 20 targets', pf_update_time_ms(20)),
+        ('one observation of 20 targets', pf_update_time_ms(20, config=plain)),
         ('the same, censoring correction off', pf_update_time_ms(20, config=uncensored)),
-        ('fused: 3 observers x 20 targets', pf_update_time_ms(20, observers=3)),
-        ('one observation of 1 target', pf_update_time_ms(1)),
-        ('fused: 9 observers x 1 target', pf_update_time_ms(1, observers=9)),
+        ('fused: 3 observers x 20 targets', pf_update_time_ms(20, observers=3, config=plain)),
+        ('one observation of 1 target', pf_update_time_ms(1, config=plain)),
+        ('fused: 9 observers x 1 target', pf_update_time_ms(1, observers=9, config=plain)),
     ]
     return [
-        '## Particle-filter step time (5041 particles per target)',
+        '## Particle-filter step time (5041 particles per target, '
+        f'{resolve_backend(backend)} backend)',
         '',
         '| step (update + convergence test) | wall ms, median | CPU ms, median | CPU ms, least |',
         '|---|---|---|---|',
@@ -326,6 +328,7 @@ def run(
     first_seed: int = 0,
     workers: int = 1,
     csv_path: Path | None = None,
+    pf_backends: tuple[str, ...] = ('auto',),
 ) -> tuple[str, list[RunOutcome]]:
     """Run the experiments; return the report (markdown) and every run's outcome.
 
@@ -354,7 +357,8 @@ def run(
         outcomes += sweep
         lines += robot_table(sweep, sweep_targets, schemes)
     if 'pf' in experiments:
-        lines += pf_table()
+        for backend in pf_backends:
+            lines += pf_table(backend)
     return '\n'.join(lines), outcomes
 
 
@@ -374,6 +378,13 @@ def main() -> None:
     parser.add_argument('--workers', type=int, default=1, help='processes (one core each)')
     parser.add_argument(
         '--out', type=Path, help='write the report here and every run to <out>.csv as it ends'
+    )
+    parser.add_argument(
+        '--pf-backend',
+        nargs='+',
+        choices=('auto', 'numpy', 'numba'),
+        default=['auto'],
+        help="particle_filter.backend of the pf experiment ('auto': numba if installed)",
     )
     parser.add_argument(
         '--table-from', type=Path, help='only print the tables of a CSV of finished runs'
@@ -401,6 +412,7 @@ def main() -> None:
         first_seed=args.first_seed,
         workers=args.workers,
         csv_path=args.out.with_suffix('.csv') if args.out is not None else None,
+        pf_backends=tuple(args.pf_backend),
     )
     report += f'\nTotal wall time: {time.perf_counter() - start:.0f} s'
     if outcomes:
