@@ -295,7 +295,8 @@ class OABugFsm:
             if theta is not None:
                 if self._config.sound_memory is SoundMemory.STORED:
                     mem.preferred_direction_rad = theta
-                side = self._side_from_sound(theta, snap.yaw_rad, side)
+                if self._config.sound_picks_wall_side:
+                    side = self._side_from_sound(theta, snap.yaw_rad, side)
         mem.state = FsmState.FOLLOWING_WALL
         mem.mode = Mode.FOLLOW
         mem.wall_side = side

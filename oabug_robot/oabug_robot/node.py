@@ -117,6 +117,11 @@ PARAMETERS: tuple[tuple[str, Any, str], ...] = (
         _DEFAULTS.sound_turn_rule.value,
         "toward (authors' simulator) or away (authors' robot)",
     ),
+    (
+        'sound_picks_wall_side',
+        _DEFAULTS.sound_picks_wall_side,
+        'sound variants pick the wall side from theta_opp (paper); false: fixed_turn',
+    ),
     ('sound_weighting', _DEFAULTS.sound_weighting.value, 'distance (paper) or unit'),
     (
         'sound_memory',
@@ -197,6 +202,7 @@ def config_from_parameters(values: dict[str, Any]) -> OABugConfig:
         fixed_turn=_parse(TurnDirection, 'fixed_turn', str(values['fixed_turn'])),
         robot_hit_repeat_s=float(values['robot_hit_repeat_s']),
         sound_turn_rule=_parse(SoundTurnRule, 'sound_turn_rule', str(values['sound_turn_rule'])),
+        sound_picks_wall_side=bool(values['sound_picks_wall_side']),
         sound_weighting=_parse(SoundWeighting, 'sound_weighting', str(values['sound_weighting'])),
         sound_memory=_parse(SoundMemory, 'sound_memory', str(values['sound_memory'])),
         sound_updates_at_corner=bool(values['sound_updates_at_corner']),

@@ -284,6 +284,11 @@ class OABugConfig:
             heading instead of right, to break jams of two robots (0 disables) [s].
         sound_turn_rule: see SoundTurnRule; the paper does not say which (default: toward,
             as in the authors' simulator that produced the paper's figures).
+        sound_picks_wall_side: the sound variants pick the wall-following side at a wall
+            contact from theta_opp (sound_turn_rule), as Table I says ("turns left or right
+            according to its direction"); False turns the fixed way (fixed_turn) as Minimum
+            and Gas do, and theta_opp is used only for leaving walls. Not the paper; kept as
+            an option because it measured better here (docs/oabug.md, Results).
         sound_weighting: see SoundWeighting (paper: distance).
         sound_memory: see SoundMemory; the paper's text says stored, its 180 deg flip
             ("an area symmetrical ... with respect to the departure point") only makes sense
@@ -314,6 +319,7 @@ class OABugConfig:
     fixed_turn: TurnDirection = TurnDirection.RIGHT
     robot_hit_repeat_s: float = 4.0
     sound_turn_rule: SoundTurnRule = SoundTurnRule.TOWARD
+    sound_picks_wall_side: bool = True
     sound_weighting: SoundWeighting = SoundWeighting.DISTANCE
     sound_memory: SoundMemory = SoundMemory.ONCE
     sound_updates_at_corner: bool = True

@@ -720,3 +720,27 @@ def test_commands_are_python_floats_and_bools() -> None:
     assert type(command.linear_mps) is float
     assert type(command.angular_radps) is float
     assert type(command.pump_on) is bool
+
+
+@pytest.mark.parametrize(('picks', 'expected_side'), [(True, -1), (False, 1)])
+@pytest.mark.parametrize('variant', [Variant.SOUND, Variant.GAS_SOUND])
+def test_sound_picks_wall_side_off_turns_the_fixed_way(
+    variant: Variant, picks: bool, expected_side: int
+) -> None:
+    """sound_picks_wall_side false: the fixed turn (right) whatever the peers' side."""
+    fsm = make(
+        variant,
+        robot_count=2,
+        fixed_turn=TurnDirection.RIGHT,
+        sound_turn_rule=SoundTurnRule.TOWARD,
+        sound_picks_wall_side=picks,
+    )
+    script = Script(fsm, yaw_rad=0.0)
+    script.step(free(), yaw_rad=fsm.memory.preferred_direction_rad)
+    script.step(free(), yaw_rad=0.0)
+    script.hear([90.0])  # the peer on the left: toward it keeps the wall on the right
+    command = script.step(wall_ahead())
+    assert fsm.memory.state is FsmState.FOLLOWING_WALL
+    assert fsm.memory.wall_side == expected_side
+    assert math.copysign(1.0, command.angular_radps) == -expected_side
+
