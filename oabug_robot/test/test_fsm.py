@@ -743,4 +743,3 @@ def test_sound_picks_wall_side_off_turns_the_fixed_way(
     assert fsm.memory.state is FsmState.FOLLOWING_WALL
     assert fsm.memory.wall_side == expected_side
     assert math.copysign(1.0, command.angular_radps) == -expected_side
-
