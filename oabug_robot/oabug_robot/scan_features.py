@@ -27,6 +27,9 @@ from oabug_robot.settings import PerceptionConfig
 __all__ = ['LaserScanData', 'ScanFeatureExtractor', 'ScanFeatures', 'SideWall']
 
 _NO_ANGLES = np.zeros(0)
+# Returns spread less than this along the robot [m] give no line fit: the side wall is then
+# taken parallel at the nearest return.
+MIN_FIT_SPREAD_M = 0.05
 
 
 @dataclass(frozen=True)
@@ -319,7 +322,7 @@ class ScanFeatureExtractor:
             The wall with its angle as seen on the left; the caller mirrors the right side.
         """
         cfg = self._config
-        if xs.size < 3 or xs.max() - xs.min() < 0.05:
+        if xs.size < 3 or xs.max() - xs.min() < MIN_FIT_SPREAD_M:
             return SideWall(distance_m=float(ls.min()), angle_rad=0.0, abeam=abeam)
         angle, distance = _fit_line(xs, ls)
         # Once more without the returns off that line (a corner inside the window). The
@@ -338,10 +341,12 @@ def _fit_line(xs: np.ndarray, ls: np.ndarray) -> tuple[float, float]:
 
     The direction is in (-pi/2, pi/2] from the x axis; the distance is from the origin.
     """
-    # sum / size is what mean() computes, without its Python-level overhead.
+    # sum / size is what mean() computes, without its Python-level overhead. Every sum is
+    # numpy's (pairwise) sum, no BLAS dot product, so that a compiled copy (the simulator's
+    # batch path) can add in the same order and get the same line.
     mx = float(xs.sum()) / xs.size
     ml = float(ls.sum()) / ls.size
     dx = xs - mx
     dl = ls - ml
-    angle = math.atan2(float(dx @ dl), float(dx @ dx))
+    angle = math.atan2(float((dx * dl).sum()), float((dx * dx).sum()))
     return angle, abs(mx * math.sin(angle) - ml * math.cos(angle))

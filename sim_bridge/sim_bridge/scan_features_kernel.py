@@ -15,9 +15,11 @@ empty scans and peers with NaN bearings and distances):
 * the kernel does only comparisons, products, sums of two terms and minima, in the same
   order as the numpy code: the ray selection, the peer mask, the front corridor and cone,
   and the returns of the followed side's window (nearest band, abeam flag);
-* the line fit of the side wall (sums and dot products, whose rounding depends on numpy's
-  and BLAS's summation order) is the extractor's own
-  :meth:`~oabug_robot.scan_features.ScanFeatureExtractor.wall_from_points`.
+* the line fit of the side wall
+  (:meth:`~oabug_robot.scan_features.ScanFeatureExtractor.wall_from_points`) is done here
+  too: its sums are numpy's pairwise sums (the extractor uses no BLAS dot product), which
+  :func:`pairwise_sum` reproduces addition by addition, and its ``atan2``, ``sin`` and
+  ``cos`` are the C library's (``math``) in both.
 """
 
 from __future__ import annotations
@@ -29,13 +31,14 @@ import numpy as np
 from numba import njit
 from oabug_robot.errors import ScanError
 from oabug_robot.scan_features import (
+    MIN_FIT_SPREAD_M,
     LaserScanData,
     ScanFeatureExtractor,
     ScanFeatures,
     SideWall,
 )
 
-__all__ = ['extract_many', 'extract_many_flat', 'features_kernel']
+__all__ = ['extract_many', 'extract_many_flat', 'features_kernel', 'pairwise_sum', 'side_wall_fit']
 
 _TWO_PI = 2.0 * math.pi
 
@@ -45,6 +48,137 @@ def _in_window(angle: float, direction: float, half_width: float) -> bool:  # pr
     """The ray at ``angle`` lies in the window of a peer bearing ``direction`` [rad]."""
     offset = abs(angle - direction)
     return min(offset, _TWO_PI - offset) <= half_width
+
+
+# numpy's pairwise summation: blocks up to this many elements are added with 8 accumulators.
+_PAIRWISE_BLOCK = 128
+
+
+@njit(cache=True)
+def _block_sum(a: np.ndarray, lo: int, n: int) -> float:  # pragma: no cover - compiled
+    """numpy's sum of ``a[lo:lo + n]`` for ``n <= 128``: fewer than 8 values one after the
+    other from 0.0, else 8 interleaved partial sums combined as
+    ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7)), then the rest one by one."""
+    if n < 8:
+        total = 0.0
+        for i in range(lo, lo + n):
+            total += a[i]
+        return total
+    r0, r1, r2, r3 = a[lo], a[lo + 1], a[lo + 2], a[lo + 3]
+    r4, r5, r6, r7 = a[lo + 4], a[lo + 5], a[lo + 6], a[lo + 7]
+    i = 8
+    while i < n - n % 8:
+        b = lo + i
+        r0 += a[b]
+        r1 += a[b + 1]
+        r2 += a[b + 2]
+        r3 += a[b + 3]
+        r4 += a[b + 4]
+        r5 += a[b + 5]
+        r6 += a[b + 6]
+        r7 += a[b + 7]
+        i += 8
+    total = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
+    for b in range(lo + i, lo + n):
+        total += a[b]
+    return total
+
+
+@njit(cache=True)
+def pairwise_sum(a: np.ndarray, lo: int, n: int) -> float:  # pragma: no cover - compiled
+    """``np.sum(a[lo:lo + n])`` of float64 values, added in numpy's order: blocks of up to
+    128 values as :func:`_block_sum`, longer runs split in two halves (the first a multiple
+    of 8 long) whose sums are added. numpy recurses; here the recursion runs on an explicit
+    stack (numba's on-disk cache does not load recursive functions reliably)."""
+    if n <= _PAIRWISE_BLOCK:
+        return _block_sum(a, lo, n)
+    # Pending ranges: start, length and how far they are (0 new, 1 left half pushed, 2 both).
+    depth = 2 * 64
+    starts = np.empty(depth, dtype=np.int64)
+    lengths = np.empty(depth, dtype=np.int64)
+    stages = np.empty(depth, dtype=np.int64)
+    sums = np.empty(depth)
+    top = 0
+    starts[0], lengths[0], stages[0] = lo, n, 0
+    done = 0
+    while top >= 0:
+        start, length, stage = starts[top], lengths[top], stages[top]
+        half = length // 2
+        half -= half % 8
+        if length <= _PAIRWISE_BLOCK:
+            sums[done] = _block_sum(a, start, length)
+            done += 1
+            top -= 1
+        elif stage == 0:
+            stages[top] = 1
+            top += 1
+            starts[top], lengths[top], stages[top] = start, half, 0
+        elif stage == 1:
+            stages[top] = 2
+            top += 1
+            starts[top], lengths[top], stages[top] = start + half, length - half, 0
+        else:
+            done -= 1
+            sums[done - 1] = sums[done - 1] + sums[done]
+            top -= 1
+    return sums[0]
+
+
+@njit(cache=True)
+def _fit_line(
+    xs: np.ndarray, ls: np.ndarray, n: int, dx: np.ndarray, dl: np.ndarray
+) -> tuple:  # pragma: no cover - compiled
+    """``oabug_robot.scan_features._fit_line`` of the first ``n`` points: (direction [rad],
+    distance [m]); ``dx`` and ``dl`` are scratch of at least ``n`` values."""
+    mx = pairwise_sum(xs, 0, n) / n
+    ml = pairwise_sum(ls, 0, n) / n
+    for m in range(n):
+        dx[m] = xs[m] - mx
+        dl[m] = ls[m] - ml
+    for m in range(n):
+        xs_m = dx[m]
+        dx[m] = xs_m * xs_m
+        dl[m] = xs_m * dl[m]
+    angle = math.atan2(pairwise_sum(dl, 0, n), pairwise_sum(dx, 0, n))
+    return angle, abs(mx * math.sin(angle) - ml * math.cos(angle))
+
+
+@njit(cache=True)
+def side_wall_fit(
+    xs: np.ndarray,
+    ls: np.ndarray,
+    n: int,
+    tolerance: float,
+    min_spread: float,
+    scratch: np.ndarray,
+) -> tuple:  # pragma: no cover - compiled
+    """:meth:`~oabug_robot.scan_features.ScanFeatureExtractor.wall_from_points` of the first
+    ``n >= 1`` points, without the abeam flag: (distance [m], angle [rad]). ``scratch`` is
+    (4, >= n) float64 work space."""
+    lo = xs[0]
+    hi = xs[0]
+    nearest = ls[0]
+    for m in range(1, n):
+        lo = min(lo, xs[m])
+        hi = max(hi, xs[m])
+        nearest = min(nearest, ls[m])
+    if n < 3 or hi - lo < min_spread:
+        return nearest, 0.0
+    angle, distance = _fit_line(xs, ls, n, scratch[0], scratch[1])
+    # Once more without the returns off that line, as the extractor does.
+    sa = math.sin(angle)
+    ca = math.cos(angle)
+    kept_x = scratch[2]
+    kept_l = scratch[3]
+    kept = 0
+    for m in range(n):
+        if abs(xs[m] * sa - ls[m] * ca + distance) <= tolerance:
+            kept_x[kept] = xs[m]
+            kept_l[kept] = ls[m]
+            kept += 1
+    if 3 <= kept < n:
+        angle, distance = _fit_line(kept_x, kept_l, kept, scratch[0], scratch[1])
+    return distance, angle
 
 
 @njit(cache=True)
@@ -67,6 +201,8 @@ def features_kernel(
     side_x: np.ndarray,
     side_l: np.ndarray,
     abeam: np.ndarray,
+    wall_distance: np.ndarray,
+    wall_angle: np.ndarray,
 ) -> None:  # pragma: no cover - compiled
     """Features of K scans of B rays; the outputs are filled in place.
 
@@ -87,6 +223,8 @@ def features_kernel(
         side_count: (K,) number of returns of the wanted side's nearest band.
         side_x, side_l: (K, B) their forward and lateral coordinates [m].
         abeam: (K,) one of them lies abeam.
+        wall_distance, wall_angle: (K,) the side wall fitted to those returns (distance [m]
+            and angle [rad] as seen on the left; read only where ``side_count`` > 0).
     """
     (
         range_min,
@@ -102,6 +240,8 @@ def features_kernel(
         band,
         abeam_behind,
         abeam_reach,
+        fit_tolerance,
+        min_spread,
     ) = params
     body = 2.0 * radius
     num_scans, num_rays = ranges.shape
@@ -109,6 +249,7 @@ def features_kernel(
     is_peer = np.empty(num_rays, dtype=np.bool_)
     xs = np.empty(num_rays)
     ls = np.empty(num_rays)
+    scratch = np.empty((4, num_rays))
     for k in range(num_scans):
         front_wall[k] = np.inf
         front_robot[k] = np.inf
@@ -199,6 +340,9 @@ def features_kernel(
                     abeam[k] = True
                 kept_side += 1
         side_count[k] = kept_side
+        wall_distance[k], wall_angle[k] = side_wall_fit(
+            side_x[k], side_l[k], kept_side, fit_tolerance, min_spread, scratch
+        )
 
 
 def _kernel_parameters(
@@ -221,6 +365,8 @@ def _kernel_parameters(
             cfg.side_wall_band_m,
             cfg.abeam_behind_m,
             cfg.abeam_reach_m,
+            cfg.side_wall_fit_tolerance_m,
+            MIN_FIT_SPREAD_M,
         )
     )
 
@@ -337,6 +483,8 @@ def extract_many_flat(
     side_x = np.empty((k, num_rays))
     side_l = np.empty((k, num_rays))
     abeam = np.empty(k, dtype=np.bool_)
+    wall_distance = np.empty(k)
+    wall_angle = np.empty(k)
     features_kernel(
         ranges,
         half_width,
@@ -356,11 +504,14 @@ def extract_many_flat(
         side_x,
         side_l,
         abeam,
+        wall_distance,
+        wall_angle,
     )
     # The outputs as Python numbers once (the same values), not element by element.
     walls_ahead, robots_ahead = front_wall.tolist(), front_robot.tolist()
     nears, peer_counts = near_count.tolist(), peer_count.tolist()
     side_counts, abeams = side_count.tolist(), abeam.tolist()
+    wall_distances, wall_angles = wall_distance.tolist(), wall_angle.tolist()
     result = []
     for i, side in enumerate(sides):
         if nears[i] == 0:
@@ -368,12 +519,9 @@ def extract_many_flat(
             continue
         left = right = SideWall()
         if side:
-            n = side_counts[i]
             wall = SideWall()
-            if n:
-                wall = extractor.wall_from_points(
-                    side_x[i, :n].copy(), side_l[i, :n].copy(), abeams[i]
-                )
+            if side_counts[i]:
+                wall = SideWall(wall_distances[i], wall_angles[i], abeams[i])
             if side > 0:
                 left = wall
             else:

@@ -8,9 +8,19 @@ import math
 import numpy as np
 import pytest
 from oabug_robot.errors import ScanError
-from oabug_robot.scan_features import LaserScanData, ScanFeatureExtractor, ScanFeatures
+from oabug_robot.scan_features import (
+    MIN_FIT_SPREAD_M,
+    LaserScanData,
+    ScanFeatureExtractor,
+    ScanFeatures,
+)
 from oabug_robot.settings import PerceptionConfig
-from sim_bridge.scan_features_kernel import extract_many, extract_many_flat
+from sim_bridge.scan_features_kernel import (
+    extract_many,
+    extract_many_flat,
+    pairwise_sum,
+    side_wall_fit,
+)
 
 
 def _scan(
@@ -161,3 +171,62 @@ def test_flat_peers_give_the_features_of_the_per_scan_peers() -> None:
         )
         flat = extract_many_flat(extractor, scans, start, azimuths, distances, sides)
         assert [_exact(f) for f in flat] == _numpy_features(extractor, scans, peers, sides)
+
+
+def test_the_pairwise_sum_adds_in_numpys_order() -> None:
+    """Bit for bit numpy's sum, on lengths across its unrolled (8) and split (128) limits,
+    with magnitudes far apart (where the order of the additions shows) and signed zeros."""
+    rng = np.random.default_rng(5)
+    differs_from_sequential = 0
+    for n in [*range(0, 40), 127, 128, 129, 135, 255, 256, 257, 300, 777]:
+        for _ in range(20):
+            values = rng.standard_normal(n) * 10.0 ** rng.integers(-8, 9, n)
+            lo = int(rng.integers(0, 3))
+            padded = np.concatenate((rng.standard_normal(lo), values, [1e300]))
+            expected = float(np.sum(values))
+            assert repr(pairwise_sum(padded, lo, n)) == repr(expected)
+            differs_from_sequential += sum(values.tolist()) != expected
+    assert differs_from_sequential > 0  # the test inputs do tell the orders apart
+    assert repr(pairwise_sum(np.array([-0.0, -0.0]), 0, 2)) == repr(float(np.sum([-0.0, -0.0])))
+
+
+def _wall_points(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+    """Side window returns: a noisy straight wall, a corner (a second wall through the
+    window), a short wall or a few scattered returns."""
+    kind = int(rng.integers(0, 4))
+    n = int(rng.integers(1, 6)) if kind == 3 else int(rng.integers(3, 140))
+    xs = np.sort(rng.uniform(-0.3, 0.6, n))
+    if kind == 2:
+        xs = rng.uniform(0.0, MIN_FIT_SPREAD_M * 1.2, n)
+    ls = rng.uniform(0.1, 0.8) + math.tan(rng.uniform(-1.2, 1.2)) * xs
+    if kind == 1:
+        corner = xs > rng.uniform(0.0, 0.5)
+        if corner.any():
+            ls[corner] += rng.uniform(-2.0, 2.0) * (xs[corner] - xs[corner].min())
+    ls += rng.normal(0.0, rng.choice([0.0, 0.003, 0.03]), n)
+    return xs, np.abs(ls)
+
+
+def test_the_compiled_wall_fit_gives_the_extractors_wall() -> None:
+    """side_wall_fit equals ScanFeatureExtractor.wall_from_points bit for bit, including the
+    refit without the returns off the first line and the windows too short to fit."""
+    rng = np.random.default_rng(11)
+    extractor = ScanFeatureExtractor(PerceptionConfig())
+    tolerance = extractor.config.side_wall_fit_tolerance_m
+    refits = unfitted = 0
+    for _ in range(3000):
+        xs, ls = _wall_points(rng)
+        n = xs.size
+        expected = extractor.wall_from_points(xs.copy(), ls.copy(), False)
+        scratch = np.full((4, n + 3), np.nan)
+        padded_x = np.concatenate((xs, [7.0, 8.0, 9.0]))
+        padded_l = np.concatenate((ls, [7.0, 8.0, 9.0]))
+        distance, angle = side_wall_fit(padded_x, padded_l, n, tolerance, MIN_FIT_SPREAD_M, scratch)
+        assert repr((distance, angle)) == repr((expected.distance_m, expected.angle_rad))
+        unfitted += angle == 0.0
+        if n >= 3 and xs.max() - xs.min() >= MIN_FIT_SPREAD_M:
+            # Returns off the final line: the first fit's outliers, left out of a refit.
+            residual = np.abs(xs * math.sin(angle) - ls * math.cos(angle) + distance)
+            refits += bool(np.count_nonzero(residual > tolerance))
+    assert unfitted > 100
+    assert refits > 100
