@@ -23,7 +23,7 @@ import numpy as np
 from sim_bridge.errors import ConfigurationError, WorldGeometryError
 from sim_bridge.geometry import RayCaster, wrap_angle
 from sim_bridge.ground_truth import CoverageTracker, RoomEntry
-from sim_bridge.sensors.bearings import BearingConfig, BearingModel, PeerBearings
+from sim_bridge.sensors.bearings import BearingConfig, BearingCycle, BearingModel, PeerBearings
 from sim_bridge.sensors.gas_sensor import GasSensorConfig, Mp503Model
 from sim_bridge.sensors.imu import GyroYawModel, ImuConfig
 from sim_bridge.sensors.lidar import LidarConfig, LidarModel
@@ -111,6 +111,8 @@ class StepOutput:
         scans: (N, B) lidar ranges [m].
         gas_raw: (N,) gas readings on the 10-bit scale.
         bearings: one :class:`PeerBearings` per robot.
+        bearing_cycle: the same reports in flat arrays, instead of ``bearings`` when the
+            engine was built with ``bearing_cycles=True``.
         imu: (N,) integrated yaw [rad] and (N,) yaw rate [rad/s].
         odometry: (N, 3) odometry poses and (N, 2) speed [m/s] / yaw rate [rad/s].
         ground_truth_due: True when the true poses should be published.
@@ -122,6 +124,7 @@ class StepOutput:
     scans: np.ndarray | None = None
     gas_raw: np.ndarray | None = None
     bearings: list[PeerBearings] | None = None
+    bearing_cycle: BearingCycle | None = None
     imu: tuple[np.ndarray, np.ndarray] | None = None
     odometry: tuple[np.ndarray, np.ndarray] | None = None
     ground_truth_due: bool = False
@@ -162,6 +165,7 @@ class SimEngine:
         config: EngineConfig | None = None,
         *,
         readings: frozenset[str] = READINGS,
+        bearing_cycles: bool = False,
     ) -> None:
         """Build the world and its models.
 
@@ -172,6 +176,9 @@ class SimEngine:
             readings: the readings to produce (all by default). Each model draws from its
                 own random stream, so leaving one out changes none of the others; a caller
                 that consumes no odometry (the OA-Bug batch path) saves its cost.
+            bearing_cycles: hand the bearings over as one :class:`BearingCycle` of flat
+                arrays (``StepOutput.bearing_cycle``) instead of a report per robot (the
+                same values and random draws).
 
         Raises:
             ConfigurationError: an unknown reading is named.
@@ -181,6 +188,7 @@ class SimEngine:
             msg = f'unknown readings {sorted(unknown)}; choose from {sorted(READINGS)}'
             raise ConfigurationError(msg)
         self.readings = frozenset(readings)
+        self._bearing_cycles = bearing_cycles
         self.config = config or EngineConfig()
         cfg = self.config
         self.site = site
@@ -337,7 +345,10 @@ class SimEngine:
             c = self.scent.concentration(self.gas_sensor_positions(poses, headings), self.time_s)
             out.gas_raw = self.gas.update(c, elapsed)
         if sched['bearings'].due(self.time_s)[0] and 'bearings' in wanted:
-            out.bearings = self.bearing_model.measure(poses)
+            if self._bearing_cycles:
+                out.bearing_cycle = self.bearing_model.measure_cycle(poses)
+            else:
+                out.bearings = self.bearing_model.measure(poses)
         due, elapsed = sched['imu'].due(self.time_s)
         if due and 'imu' in wanted:
             change = np.asarray(wrap_angle(poses[:, 2] - self._imu_last_yaw), dtype=float)

@@ -52,8 +52,10 @@ from sim_bridge.engine import READINGS, EngineConfig, SimEngine, SiteGeometry
 from sim_bridge.errors import ConfigurationError
 from sim_bridge.mission import MissionProgress, MissionResult, MissionSpec, StopReason
 from sim_bridge.scan_features_kernel import extract_many_flat
+from sim_bridge.sensors.bearings import BearingCycle
 from sim_bridge.sensors.bearings import PeerBearings as BearingReport
 from sim_bridge.sensors.lidar import LidarConfig
+from sim_bridge.sensors_kernel import imu_message_yaw_kernel
 from sim_bridge.site_geometry import geometry_from_site
 from sim_bridge.spawn import SpawnConfig, SpawnResult, run
 
@@ -179,7 +181,12 @@ class BatchRobot:
 
     def receive_imu(self, yaw_rad: float, now_s: float) -> None:
         """An IMU reading arrives; its yaw goes through the message's quaternion."""
-        self._yaw.value = yaw_from_quaternion(*yaw_to_quaternion(yaw_rad))
+        self.hold_yaw(yaw_from_quaternion(*yaw_to_quaternion(yaw_rad)), now_s)
+
+    def hold_yaw(self, yaw_rad: float, now_s: float) -> None:
+        """Hold an IMU yaw already read back from the message's quaternion
+        (:func:`sim_bridge.sensors_kernel.imu_message_yaw_kernel`)."""
+        self._yaw.value = yaw_rad
         self._yaw.time_s = now_s
 
     # The control step.
@@ -319,10 +326,13 @@ def run_oabug_batch(
         np.asarray(spec.initial_poses, dtype=float),
         engine_config,
         readings=READINGS - unused,
+        bearing_cycles=True,
     )
     n = engine.num_robots
     names = tuple(f'r{i}' for i in range(n))
     tag_ids = tuple(name.upper() for name in names)
+    # Per robot, its own tag's index (-1: none); the node drops that tag's bearings.
+    own_tags = np.array([robot.own_tag_index(tag_ids) for robot in robots], dtype=np.int64)
     times = [0.0]
     poses = [engine.world.poses]
     next_sample_s = spec.trajectory_period_s
@@ -352,7 +362,7 @@ def run_oabug_batch(
             if stop is not None and stop(report):
                 reason = StopReason.PREDICATE
                 break
-        _deliver(engine, out, robots, tag_ids)
+        _deliver(engine, out, robots, own_tags)
 
     final = snapshot()
     if progress is not None:
@@ -374,11 +384,10 @@ def run_oabug_batch(
     )
 
 
-def _deliver(
-    engine: SimEngine, out: Any, robots: list[BatchRobot], tag_ids: tuple[str, ...]
-) -> None:
+def _deliver(engine: SimEngine, out: Any, robots: list[BatchRobot], own_tags: np.ndarray) -> None:
     """Hand one step's readings to the robots and apply the commands of those whose
-    control timer is due (what the executor does between two bridge ticks)."""
+    control timer is due (what the executor does between two bridge ticks). ``own_tags``:
+    per robot, the index of its own tag (-1 for none)."""
     now_ns = _stamp_ns(out.time_s)
     now_s = now_ns * 1e-9
     if out.scans is not None:
@@ -389,11 +398,18 @@ def _deliver(
     if out.gas_raw is not None:
         for robot, raw in zip(robots, out.gas_raw.tolist(), strict=True):
             robot.receive_gas(raw, now_s)
-    if out.bearings is not None:
-        _deliver_bearings(robots, out.bearings, tag_ids, now_s)
+    if out.bearing_cycle is not None:
+        _deliver_bearings(robots, out.bearing_cycle, own_tags, now_s)
     if out.imu is not None:
-        for robot, yaw in zip(robots, out.imu[0].tolist(), strict=True):
-            robot.receive_imu(yaw, now_s)
+        # The quaternion round trip of every robot's message in one call.
+        yaws = out.imu[0]
+        for robot, yaw, held in zip(
+            robots, yaws.tolist(), imu_message_yaw_kernel(yaws).tolist(), strict=True
+        ):
+            if math.isnan(held):
+                robot.receive_imu(yaw, now_s)  # no orientation: raises as the node does
+            else:
+                robot.hold_yaw(held, now_s)
     due = []
     for i, robot in enumerate(robots):
         if now_ns < robot.next_control_ns:
@@ -418,23 +434,20 @@ def _deliver(
 
 
 def _deliver_bearings(
-    robots: list[BatchRobot], reports: list[BearingReport], tag_ids: tuple[str, ...], now_s: float
+    robots: list[BatchRobot], cycle: BearingCycle, own_tags: np.ndarray, now_s: float
 ) -> None:
     """:meth:`BatchRobot.receive_bearings` for every robot, each conversion done once for
-    all (every robot's messages have the same field types)."""
+    all (every robot's messages have the same field types) on the cycle's flat arrays."""
     field = robots[0].field_type
-    azimuths = np.concatenate([r.azimuth_rad for r in reports]).astype(field).astype(float)
-    distances = np.concatenate([r.distance_m for r in reports]).astype(field).astype(float)
-    counts = [len(r.tags) for r in reports]
-    own = np.repeat([robot.own_tag_index(tag_ids) for robot in robots], counts)
-    keep = np.concatenate([r.tags for r in reports]) != own
-    bounds = np.zeros(len(reports) + 1, dtype=int)
-    np.cumsum(counts, out=bounds[1:])
+    azimuths = cycle.azimuth_rad.astype(field).astype(float)
+    distances = cycle.distance_m.astype(field).astype(float)
+    bounds = cycle.bounds
+    keep = cycle.tags != own_tags[cycle.receivers]
     if not keep.all():
         # Kept before each report's first entry: the bounds in the filtered arrays.
-        bounds = np.concatenate(([0], np.cumsum(keep)))[bounds]
+        bounds = np.concatenate(([0], np.cumsum(keep)))[bounds].tolist()
         azimuths, distances = azimuths[keep], distances[keep]
-    for robot, lo, hi in zip(robots, bounds[:-1].tolist(), bounds[1:].tolist(), strict=True):
+    for robot, lo, hi in zip(robots, bounds[:-1], bounds[1:], strict=True):
         robot.hold_bearings(azimuths[lo:hi], distances[lo:hi], now_s)
 
 

@@ -17,7 +17,7 @@ from numba import njit
 
 from sim_bridge.raycast_kernel import _wrap
 
-__all__ = ['gas_update_kernel', 'imu_update_kernel']
+__all__ = ['gas_update_kernel', 'imu_message_yaw_kernel', 'imu_update_kernel']
 
 _FLOAT_MAX = np.finfo(np.float64).max
 
@@ -94,3 +94,24 @@ def imu_update_kernel(
         rate[i] = r
         yaw_rad[i] = _wrap(yaw_rad[i] + r * dt_s)
     return rate
+
+
+@njit(cache=True)
+def imu_message_yaw_kernel(yaw_rad: np.ndarray) -> np.ndarray:  # pragma: no cover - compiled
+    """The yaw a node reads back from each IMU message: ``oabug_robot.heading.
+    yaw_from_quaternion(*sim_bridge.conversions.yaw_to_quaternion(yaw))`` for every yaw, with
+    their operations (the zero x and y terms included: they turn -0.0 into 0.0). NaN where
+    the quaternion has no orientation (the node's function raises there)."""
+    out = np.empty(yaw_rad.shape[0])
+    x = 0.0
+    y = 0.0
+    for i in range(yaw_rad.shape[0]):
+        half = 0.5 * yaw_rad[i]
+        z = math.sin(half)
+        w = math.cos(half)
+        norm_sq = x * x + y * y + z * z + w * w
+        if not norm_sq > 0.0 or not math.isfinite(norm_sq):
+            out[i] = math.nan
+            continue
+        out[i] = math.atan2(2.0 * (w * z + x * y), w * w + x * x - y * y - z * z)
+    return out

@@ -4,10 +4,13 @@ import math
 
 import numpy as np
 import pytest
+from oabug_robot.heading import yaw_from_quaternion
+from sim_bridge.conversions import yaw_to_quaternion
 from sim_bridge.errors import ConfigurationError
 from sim_bridge.sensors.bearings import BearingConfig, BearingModel
 from sim_bridge.sensors.imu import GyroYawModel, ImuConfig
 from sim_bridge.sensors.odometry import OdometryConfig, WheelOdometry
+from sim_bridge.sensors_kernel import imu_message_yaw_kernel
 
 
 def test_bearing_is_the_peer_direction_in_the_receiver_frame_with_a_few_degrees_of_noise():
@@ -162,3 +165,27 @@ def test_compiled_gyro_integration_gives_the_numpy_yaw_bit_for_bit(config):
             clean = np.nan_to_num(want_yaw).clip(-3.0, 3.0)
             compiled = GyroYawModel(clean, config, np.random.default_rng(step))
             reference = GyroYawModel(clean, config, np.random.default_rng(step))
+
+
+def test_compiled_imu_message_yaw_is_the_nodes_quaternion_round_trip_bit_for_bit():
+    """imu_message_yaw_kernel equals yaw_from_quaternion(*yaw_to_quaternion(yaw)) on yaws
+    across and beyond +-pi, signed zeros, tiny and huge values; NaN where the node raises."""
+    rng = np.random.default_rng(9)
+    yaws = np.concatenate(
+        (
+            rng.uniform(-4.0, 4.0, 5000),
+            rng.normal(0.0, 1e-12, 200),
+            [0.0, -0.0, math.pi, -math.pi, 2 * math.pi, 1e300, -1e-320, 5e-324],
+        )
+    )
+    held = imu_message_yaw_kernel(yaws)
+    changed = 0
+    for yaw, got in zip(yaws.tolist(), held.tolist(), strict=True):
+        want = yaw_from_quaternion(*yaw_to_quaternion(yaw))
+        assert repr(got) == repr(want)
+        changed += got != yaw
+    assert changed > 100  # the round trip does change yaws: the test can tell them apart
+    for bad in (math.nan, math.inf):
+        assert math.isnan(imu_message_yaw_kernel(np.array([bad]))[0])
+        with pytest.raises(ValueError, match=r'orientation|domain'):
+            yaw_from_quaternion(*yaw_to_quaternion(bad))

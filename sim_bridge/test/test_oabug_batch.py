@@ -9,7 +9,14 @@ from oabug_robot.fsm import Command
 from oabug_robot.sound import PeerBearings
 from sim_bridge.errors import ConfigurationError
 from sim_bridge.mission import RecordingSpec, StopReason, run_mission
-from sim_bridge.oabug_batch import BatchRobot, _near_peers, run_oabug_batch, run_spawn_batch
+from sim_bridge.oabug_batch import (
+    BatchRobot,
+    _deliver_bearings,
+    _near_peers,
+    run_oabug_batch,
+    run_spawn_batch,
+)
+from sim_bridge.sensors.bearings import BearingConfig, BearingModel
 from sim_bridge.sensors.lidar import LidarConfig
 from sim_bridge.spawn import SpawnConfig, build_mission
 
@@ -124,3 +131,33 @@ def test_near_peers_of_many_robots_equal_each_robots_own_selection():
             assert azimuths[lo:hi].tobytes() == want_azimuths.tobytes()
             assert distances[lo:hi].tobytes() == want_distances.tobytes()
         assert bounds[-1] == len(azimuths) == len(distances)
+
+
+@pytest.mark.parametrize('float32_fields', [True, False])
+def test_a_bearing_cycle_is_held_as_each_robots_report_would_be(float32_fields):
+    """_deliver_bearings on one flat BearingCycle gives every robot the bearings its own
+    receive_bearings gives from its report (own tags dropped, fields rounded), bit for bit."""
+    rng = np.random.default_rng(8)
+    lidar = LidarConfig()
+    for _ in range(50):
+        n = int(rng.integers(1, 8))
+        model = BearingModel(n, BearingConfig(range_m=20.0), np.random.default_rng(1))
+        cycle = model.measure_cycle(np.column_stack((rng.uniform(0, 5, (n, 2)), np.zeros(n))))
+        # A robot may carry a tag another robot's id names (it keeps that tag's bearings
+        # out), or a tag nobody has (-1).
+        tag_ids = tuple(f'R{i}' for i in range(n))
+        own = [str(rng.choice([*tag_ids, 'X'])) for _ in range(n)]
+        batch = [
+            BatchRobot({'own_tag_id': tag}, lidar, float32_fields=float32_fields) for tag in own
+        ]
+        single = [
+            BatchRobot({'own_tag_id': tag}, lidar, float32_fields=float32_fields) for tag in own
+        ]
+        own_tags = np.array([robot.own_tag_index(tag_ids) for robot in batch], dtype=np.int64)
+        _deliver_bearings(batch, cycle, own_tags, 1.5)
+        for robot, report in zip(single, cycle.reports(), strict=True):
+            robot.receive_bearings(report, tag_ids, 1.5)
+        for got, want in zip(batch, single, strict=True):
+            a, b = got.peer_bearings(1.5), want.peer_bearings(1.5)
+            assert a[0].tobytes() == b[0].tobytes()
+            assert a[1].tobytes() == b[1].tobytes()

@@ -21,7 +21,7 @@ from sim_bridge.errors import ConfigurationError
 from sim_bridge.geometry import as_segments, count_crossings, padded_walls, wrap_angle
 from sim_bridge.raycast_kernel import sight_lines_kernel
 
-__all__ = ['BearingConfig', 'BearingModel', 'PeerBearings']
+__all__ = ['BearingConfig', 'BearingCycle', 'BearingModel', 'PeerBearings']
 
 
 @dataclass(frozen=True)
@@ -85,6 +85,44 @@ class PeerBearings:
     sequence: np.ndarray
 
 
+@dataclass(frozen=True)
+class BearingCycle:
+    """One locator cycle of every robot in flat arrays: the fields of the
+    :class:`PeerBearings` reports laid end to end in receiver order (T entries).
+
+    Attributes:
+        receivers: (T,) index of the receiving robot, ascending.
+        tags: (T,) indices of the robots whose tags were heard.
+        azimuth_rad: (T,) azimuth in the receiver's base frame, REP 103, in (-pi, pi].
+        elevation_rad: (T,) elevation [rad].
+        distance_m: (T,) coarse distance [m].
+        sequence: (T,) per-tag report counters (wrap at 65536).
+        bounds: N + 1 slice bounds: robot i's report is entries ``bounds[i]:bounds[i + 1]``.
+    """
+
+    receivers: np.ndarray
+    tags: np.ndarray
+    azimuth_rad: np.ndarray
+    elevation_rad: np.ndarray
+    distance_m: np.ndarray
+    sequence: np.ndarray
+    bounds: list[int]
+
+    def reports(self) -> list[PeerBearings]:
+        """One :class:`PeerBearings` per robot, in robot order."""
+        return [
+            PeerBearings(
+                receiver=i,
+                tags=self.tags[lo:hi],
+                azimuth_rad=self.azimuth_rad[lo:hi],
+                elevation_rad=self.elevation_rad[lo:hi],
+                distance_m=self.distance_m[lo:hi],
+                sequence=self.sequence[lo:hi],
+            )
+            for i, (lo, hi) in enumerate(itertools.pairwise(self.bounds))
+        ]
+
+
 class BearingModel:
     """Noisy, range-limited bearings between all robots."""
 
@@ -115,10 +153,14 @@ class BearingModel:
         Returns:
             N reports, one per receiving robot, in robot order.
         """
+        return self.measure_cycle(poses).reports()
+
+    def measure_cycle(self, poses: np.ndarray) -> BearingCycle:
+        """:meth:`measure` with the reports in flat arrays (the same values and draws)."""
         rx, tx, delta, dist, walls = sight_lines_kernel(
             np.ascontiguousarray(poses, dtype=float), self.config.range_m, *self._padded_walls
         )
-        return self._reports(poses, rx, tx, delta, dist, walls)
+        return self._cycle(poses, rx, tx, delta, dist, walls)
 
     def measure_reference(self, poses: np.ndarray) -> list[PeerBearings]:
         """:meth:`measure` with the sight lines in numpy, the reference of the compiled
@@ -133,9 +175,9 @@ class BearingModel:
         if len(self._walls) and in_los_range.any():
             idx = np.flatnonzero(in_los_range)
             walls[idx] = count_crossings(poses[rx[idx], :2], poses[tx[idx], :2], self._walls)
-        return self._reports(poses, rx, tx, delta, dist, walls)
+        return self._cycle(poses, rx, tx, delta, dist, walls).reports()
 
-    def _reports(
+    def _cycle(
         self,
         poses: np.ndarray,
         rx: np.ndarray,
@@ -143,7 +185,7 @@ class BearingModel:
         delta: np.ndarray,
         dist: np.ndarray,
         walls: np.ndarray,
-    ) -> list[PeerBearings]:
+    ) -> BearingCycle:
         """The reports from the sight lines: receivers, transmitters, offsets [m],
         distances [m] and walls crossed of every ordered pair."""
         cfg = self.config
@@ -163,14 +205,12 @@ class BearingModel:
         azimuth = np.atleast_1d(azimuth)
         # rx is sorted (np.nonzero order), so each receiver's reports are one slice.
         bounds = np.searchsorted(rx, np.arange(n + 1)).tolist()
-        return [
-            PeerBearings(
-                receiver=i,
-                tags=tx[lo:hi],
-                azimuth_rad=azimuth[lo:hi],
-                elevation_rad=elevation[lo:hi],
-                distance_m=distance[lo:hi],
-                sequence=sequence[lo:hi],
-            )
-            for i, (lo, hi) in enumerate(itertools.pairwise(bounds))
-        ]
+        return BearingCycle(
+            receivers=rx,
+            tags=tx,
+            azimuth_rad=azimuth,
+            elevation_rad=elevation,
+            distance_m=distance,
+            sequence=sequence,
+            bounds=bounds,
+        )
