@@ -238,6 +238,14 @@ _CENSOR_U_MAX = 6.0  # Phi(6) = 1 - 1e-9: no correction beyond
 _CENSOR_U_MIN = -8.0  # the squared error term dominates beyond
 
 
+def _neg_log_phi(u: float) -> float:
+    """``-log Phi(u)`` of the standard normal distribution, also far in the lower tail."""
+    if u > -30.0:
+        return -math.log(0.5 * math.erfc(-u / math.sqrt(2.0)))
+    # Mills ratio: Phi(u) ~ phi(u) / |u| (relative error below 1e-3 here).
+    return 0.5 * u * u + math.log(-u) + 0.5 * math.log(2.0 * math.pi)
+
+
 @functools.lru_cache(maxsize=8)
 def _censoring_table(noise_std_db: float, margin_db: float) -> np.ndarray:
     """``-log Phi((margin - L) / s)`` over the path loss ``L = P0 - R`` [dB], bin i at i * step.
@@ -251,12 +259,27 @@ def _censoring_table(noise_std_db: float, margin_db: float) -> np.ndarray:
     loss = (np.arange(count) + 0.5) * _CENSOR_STEP_DB
     u = (margin_db - loss) / noise_std_db
     table = np.array(
-        [
-            0.0 if v > _CENSOR_U_MAX else -math.log(0.5 * math.erfc(-v / math.sqrt(2.0)))
-            for v in u.tolist()
-        ],
+        [0.0 if v > _CENSOR_U_MAX else _neg_log_phi(v) for v in u.tolist()],
         np.float32,
     )
+    table.flags.writeable = False
+    return table
+
+
+@functools.lru_cache(maxsize=8)
+def _miss_table(noise_std_db: float, margin_db: float) -> np.ndarray:
+    """``-log Phi((L - margin) / s)``, the chance of not hearing, over the path loss L [dB].
+
+    The complement of :func:`_censoring_table`, on the same bins; the table ends where the
+    chance of not hearing exceeds Phi(U_MAX) (a look-up beyond clips to its last bin, 0).
+    """
+    count = math.ceil((margin_db + _CENSOR_U_MAX * noise_std_db) / _CENSOR_STEP_DB) + 1
+    loss = (np.arange(count) + 0.5) * _CENSOR_STEP_DB
+    u = (loss - margin_db) / max(noise_std_db, 1e-9)
+    table = np.array(
+        [0.0 if v > _CENSOR_U_MAX else _neg_log_phi(v) for v in u.tolist()], np.float64
+    )
+    table[-1] = 0.0
     table.flags.writeable = False
     return table
 
@@ -320,6 +343,10 @@ class ParticleFilterBank:
         )
         # float32 as numpy compares the float32 logs with it
         self._censor_from_log32 = np.float32(self._censor_from_log)
+        # Non-detections (update_unheard): the noise standard deviation the likelihood implies.
+        self._miss_table = _miss_table(
+            math.sqrt(denominator / 2.0), radio.rssi_at_1m_dbm - radio.detection_threshold_dbm
+        )
         self._pool = (
             rng.standard_normal(config.noise_pool_size, dtype=np.float32)
             if config.noise_pool_size
@@ -715,6 +742,66 @@ class ParticleFilterBank:
                 self._reinitialise(slot, first[row, :2])
                 reinitialised.append(self._ids[slot])
         return reinitialised
+
+    def update_unheard(self, target_id: int, observers_xy: np.ndarray) -> float:
+        """Fold in that ``target_id`` was *not* heard at the observers (negative information).
+
+        Each particle is weighted by the chance that a target there would have stayed below
+        gamma_D at every observer, ``prod_o Phi((gamma_D - R_j,o) / s)`` with R_j,o of eq. (4)
+        and s the noise standard deviation the likelihood implies (the complement of the
+        censoring correction); then estimate, spread and largest-weight particle are taken
+        from these weights, and the filter is resampled and roughened as after a sample.
+
+        Args:
+            target_id: a tracked target.
+            observers_xy: (M, 2) positions where it was not heard this step [m].
+
+        Returns:
+            The weighted share of the filter's belief that the non-detections leave (the mean
+            chance of not hearing, 1 when every particle is far out of range, near 0 when the
+            observers covered the whole belief). The filter is left unchanged when it is
+            below 1e-12 (no particle is compatible with the non-detections).
+
+        Raises:
+            KeyError: ``target_id`` is not tracked.
+        """
+        slot = self._slot_of[target_id]
+        observers = np.asarray(observers_xy, dtype=np.float64).reshape(-1, 2)
+        x = self._x[slot].astype(np.float64)
+        y = self._y[slot].astype(np.float64)
+        q = np.zeros(self._n)
+        bins_per_log = 5.0 * self._radio.path_loss_exponent / _CENSOR_STEP_DB
+        last = len(self._miss_table) - 1
+        for ox, oy in observers.tolist():
+            d2 = np.maximum((x - ox) ** 2 + (y - oy) ** 2, 1.0)
+            bins = np.minimum((np.log10(d2) * bins_per_log).astype(np.intp), last)
+            q += self._miss_table[bins]
+        least = float(q.min())
+        w = np.exp(least - q)
+        total = float(w.sum())
+        kept = math.exp(-least) * total / self._n
+        if not kept > 1e-12:
+            return kept
+        mx = float(w @ x) / total
+        my = float(w @ y) / total
+        spread2 = float(w @ ((x - mx) ** 2 + (y - my) ** 2)) / total
+        best = int(np.argmax(w))
+        self._best[slot] = (x[best], y[best])
+        self._estimate[slot] = (mx, my)
+        self._spread[slot] = math.sqrt(max(spread2, 0.0))
+        offsets, counts = self._resampling_draws(w[None, :].astype(np.float32))
+        if offsets is not None:
+            index = systematic_index(w[None, :].astype(np.float32), offsets).reshape(-1)
+        else:
+            index = np.repeat(np.arange(self._n), counts.ravel())
+        new_x = self._x[slot][index][None, :]
+        new_y = self._y[slot][index][None, :]
+        self._roughen(new_x, new_y, *self._jitter_noise(1))
+        self._x[slot] = new_x[0]
+        self._y[slot] = new_y[0]
+        self._updated[slot] = True
+        self._any_updated = True
+        return kept
 
     def _resampling_draws(self, w: np.ndarray) -> tuple[np.ndarray | None, np.ndarray | None]:
         """The random draws of the resampling of the rows of ``w``: (k, 1) float32 offsets

@@ -260,7 +260,7 @@ class RobotController:
                 self._search.record_other_visit(peer.visited_cell)
 
         if self._bank is not None:
-            events += self._update_filters(position, own, fresh)
+            events += self._update_filters(now_s, position, own, fresh)
 
         if not self.membership.formed:
             waited = now_s - self._start_s
@@ -322,7 +322,11 @@ class RobotController:
 
     # ------------------------------------------------------------------ filters
     def _update_filters(
-        self, position: np.ndarray, own: Mapping[int, float], fresh: Sequence[PeerInfo]
+        self,
+        now_s: float,
+        position: np.ndarray,
+        own: Mapping[int, float],
+        fresh: Sequence[PeerInfo],
     ) -> list[str]:
         assert self._bank is not None
         events: list[str] = []
@@ -345,8 +349,47 @@ class RobotController:
                 continue
             for target in self._bank.update_joint(group):
                 events.append(f'filter of target {target} degenerated: re-initialised')
+        self._fold_in_unheard(now_s, position, fresh)
         self._bank.end_step()
         return events
+
+    def _fold_in_unheard(
+        self,
+        now_s: float,
+        position: np.ndarray,
+        fresh: Sequence[PeerInfo],
+    ) -> None:
+        """Proposed scheme: a pursued estimate nobody hears is evidence too.
+
+        With ``phases.unheard_updates``, while the robot pursues a target it has not heard
+        for ``msc.detection_memory_s`` (a recorded or converged estimate after a capture) and
+        no neighbour's sample of it arrived this step, the target's filter weighs its
+        particles by the chance of not hearing it at this robot and at the members of its
+        swarm heard this step (:meth:`ParticleFilterBank.update_unheard`; other neighbours
+        are left out to bound the cost). The goal thus moves off ground where the target
+        would have been heard; when less than ``phases.unheard_exhausted_share`` of the
+        belief survives one step, the filter is dropped (the target is not where it was
+        thought to be).
+        """
+        phases = self.config.phases
+        target = self.target_id
+        bank = self._bank
+        if (
+            not (phases.unheard_updates and self.config.scheme.uses_stored_estimates)
+            or bank is None
+            or target == NO_TARGET
+            or target in self._captured
+            or self.smoothed_rssi(target, now_s) is not None
+            or not bank.is_tracked(target)
+            or any(t == target for peer in fresh for t, _ in peer.readings)
+        ):
+            return
+        observers = [position] + [
+            np.asarray(p.position_m, dtype=np.float64) for p in fresh if self._in_my_swarm(p)
+        ]
+        kept = bank.update_unheard(target, np.array(observers))
+        if kept < phases.unheard_exhausted_share:
+            self._abandon(target, heard=False, why='where its filter put it')
 
     # ------------------------------------------------------------------ targets
     def _own_target(self, now_s: float) -> int:
@@ -431,10 +474,11 @@ class RobotController:
             self._committed = choice
             events.append(f'target {captured} captured: re-targets {choice} from {kind}')
 
-    def _abandon(self, target: int, *, heard: bool) -> None:
+    def _abandon(self, target: int, *, heard: bool, why: str = 'at its estimate') -> None:
         """Forget ``target``'s filter (it restarts from the next sample of the target).
 
-        When the target is not heard at all the robot also stops pursuing it.
+        When the target is not heard at all the robot also stops pursuing it; ``why`` says
+        where it was not heard (for the event note).
         """
         assert self._bank is not None
         self._bank.forget(target)
@@ -443,7 +487,7 @@ class RobotController:
         if heard:
             self._events.append(f'target {target} is weak at its estimate: filter restarted')
             return
-        self._events.append(f'target {target} not heard at its estimate: estimate dropped')
+        self._events.append(f'target {target} not heard {why}: estimate dropped')
         self.target_id = NO_TARGET
 
     def _update_work(self, now_s: float, own_target: int) -> None:

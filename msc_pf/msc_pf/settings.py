@@ -340,6 +340,17 @@ class PhaseConfig:
         unheard_give_up_m: a robot that approaches an unconverged recorded estimate and does
             not hear the target within this distance of it drops that filter [m]; about a third
             of the 292 m detection range, so an estimate 100-200 m off still gets heard.
+        unheard_updates: proposed scheme: while the robot pursues a target it has not heard
+            for msc.detection_memory_s and no neighbour's sample of it arrives, its filter
+            folds in that non-detection at the robot and at its swarm's members (each
+            particle weighted by the chance a target there would have stayed below gamma_D),
+            so an estimate on the wrong side of the ring of distances a far swarm observed
+            moves to the side not yet ruled out. The paper's filter uses only the samples
+            heard; this is the same observation model's other half. Off by default: on 8
+            screened runs it fixed such losses but did not lower the mean CCT.
+        unheard_exhausted_share: with ``unheard_updates``, a filter of which less than this
+            share of the belief survives one step's non-detections is dropped (the robot has
+            covered the ground the filter allowed without hearing the target).
     """
 
     gamma1_dbm: float = -78.0
@@ -357,6 +368,8 @@ class PhaseConfig:
     retarget_unconverged: bool = True
     recorded_max_age_s: float = 600.0
     unheard_give_up_m: float = 100.0
+    unheard_updates: bool = False
+    unheard_exhausted_share: float = 0.01
 
     def __post_init__(self) -> None:
         _require_finite(self)
@@ -370,6 +383,10 @@ class PhaseConfig:
         _require(self.work_timeout_s > 0.0, 'work_timeout_s must be positive')
         _require(self.unheard_give_up_m > 0.0, 'unheard_give_up_m must be positive')
         _require(self.recorded_max_age_s >= 0.0, 'recorded_max_age_s must be non-negative')
+        _require(
+            0.0 <= self.unheard_exhausted_share < 1.0,
+            'unheard_exhausted_share must be in [0, 1)',
+        )
 
 
 @dataclass(frozen=True)

@@ -431,3 +431,49 @@ def test_backend_without_numba(monkeypatch):
     assert make_bank(backend='numpy').backend == 'numpy'
     with pytest.raises(ConfigError, match=r"'numba' needs the numba package.*named 'numba'"):
         make_bank(backend='numba')
+
+
+def test_miss_table_is_the_chance_of_not_hearing():
+    # -log Phi((L - margin) / s): ~0 far beyond the detection range, huge near the sensor.
+    bank = make_bank()
+    table = bank._miss_table
+    margin = RADIO.rssi_at_1m_dbm - RADIO.detection_threshold_dbm
+    for loss_db in (30.0, 60.0, 70.0, margin, 76.0, 79.0):
+        u = (loss_db - margin) / 1.0  # Gaussian likelihood of sigma^2 = 1: s = 1 dB
+        expected = -math.log(0.5 * math.erfc(-u / math.sqrt(2.0))) if u > -30 else None
+        got = float(table[int(loss_db / 0.01)])
+        if expected is None:
+            assert got > 400.0
+        else:
+            assert got == pytest.approx(expected, rel=2e-2, abs=2e-2)
+    assert table[-1] == 0.0
+
+
+def test_non_detection_removes_the_particles_the_observer_would_have_heard():
+    bank = make_bank(seed=1)
+    center = np.array([1000.0, 1000.0])
+    bank.track(3, center)
+    observer = center + np.array([250.0, 0.0])
+    kept = bank.update_unheard(3, observer[None, :])
+    # Some of the detection square lies within the observer's range, most of it not.
+    assert 0.2 < kept < 0.95
+    particles = bank.particles(3)
+    distances = np.hypot(*(particles - observer).T)
+    assert distances.min() > 220.0  # nothing survives where the target would be heard
+    estimate = bank.estimate(3)
+    assert estimate.position_m[0] < center[0] - 30.0  # pushed away from the observer
+    assert np.hypot(*(estimate.best_particle_m - observer)) > 220.0
+
+
+def test_non_detection_far_away_changes_nothing_and_covering_the_belief_is_reported():
+    bank = make_bank(seed=2)
+    bank.track(3, (1000.0, 1000.0))
+    before = bank.estimate(3).position_m
+    assert bank.update_unheard(3, np.array([[1900.0, 1900.0]])) == pytest.approx(1.0, abs=1e-6)
+    assert np.hypot(*(bank.estimate(3).position_m - before)) < 5.0
+    # A filter confined to 100 m around the observer cannot be right if nothing is heard.
+    small = make_bank(seed=2, init_half_width_m=100.0)
+    small.track(3, (1000.0, 1000.0))
+    particles = small.particles(3)
+    assert small.update_unheard(3, np.array([[1000.0, 1000.0]])) < 1e-12
+    np.testing.assert_array_equal(small.particles(3), particles)  # left unchanged

@@ -140,7 +140,10 @@ def test_msc_pf_robot_does_not_use_stored_estimates_after_a_capture():
 
 
 def test_robot_drops_an_estimate_where_nothing_is_heard_and_searches_again():
-    robot, out = run_capture_scenario('proposed')
+    # Without the non-detection updates (unheard_updates, which drop it earlier, see below)
+    # the robot drives all the way to the estimate.
+    phases = PhaseConfig(work_timeout_s=100.0, unheard_updates=False)
+    robot, out = run_capture_scenario('proposed', phases=phases)
     position = HOME.copy()
     t = 40.0
     for _ in range(400):
@@ -193,7 +196,8 @@ def test_unconverged_recorded_estimates_are_not_used_when_old_switched_off_or_by
 
 
 def test_robot_drops_an_unconverged_estimate_it_does_not_hear_near_its_best_particle():
-    robot, out = run_capture_scenario('proposed', sampled_steps=3)
+    phases = PhaseConfig(work_timeout_s=100.0, unheard_updates=False)
+    robot, out = run_capture_scenario('proposed', sampled_steps=3, phases=phases)
     best = robot.filters.estimate(2).best_particle_m
     give_up = PhaseConfig().unheard_give_up_m
     # Far from the best particle the robot keeps going; within the give-up radius it stops.
@@ -231,3 +235,60 @@ def test_a_lost_converged_target_is_approached_only_with_keep_converged_target()
     off = converge_on_target_2_then_lose_it(PhaseConfig())
     assert off.status.target_id == NO_TARGET
     assert off.status.phase is Phase.SEARCH
+
+
+def test_recorded_goal_moves_off_ground_where_the_target_is_not_heard():
+    # Target 2's unconverged filter (never heard by the robot itself) is tight around the
+    # target. Not hearing it 300 m from the largest-weight particle (the detection edge) rules
+    # out the near side: the goal moves away and the robot still pursues it. Not hearing it
+    # 150 m away rules the whole belief out: the filter is dropped. Without unheard_updates
+    # neither step changes the filter.
+    on = PhaseConfig(work_timeout_s=100.0, unheard_updates=True)
+    robot, out = run_capture_scenario('proposed', sampled_steps=3, phases=on)
+    assert out.status.phase is Phase.FAR_LOCALISATION
+    best = robot.filters.estimate(2).best_particle_m
+    edge = best + np.array([0.0, 300.0])
+    out = robot.step(41.0, edge, {})
+    assert out.status.target_id == 2
+    assert np.hypot(*(robot.filters.estimate(2).best_particle_m - edge)) > 310.0
+    out = robot.step(42.0, best + np.array([0.0, 150.0]), {})
+    assert not robot.filters.is_tracked(2)
+    assert out.status.target_id == NO_TARGET
+    assert any('not heard where its filter put it' in e for e in out.events)
+
+    off = PhaseConfig(work_timeout_s=100.0, unheard_updates=False)
+    robot, _ = run_capture_scenario('proposed', sampled_steps=3, phases=off)
+    before = robot.filters.particles(2)
+    robot.step(41.0, edge, {})
+    out = robot.step(42.0, best + np.array([0.0, 150.0]), {})
+    np.testing.assert_array_equal(robot.filters.particles(2), before)
+    assert out.status.phase is Phase.FAR_LOCALISATION
+
+
+def test_msc_pf_robot_does_not_fold_in_non_detections():
+    phases = PhaseConfig(work_timeout_s=100.0, unheard_updates=True)
+    robot, _ = run_capture_scenario('msc_pf', sampled_steps=3, phases=phases)
+    before = robot.filters.particles(2)
+    robot.target_id = 2  # as if it still pursued target 2
+    robot.step(41.0, robot.filters.estimate(2).best_particle_m, {})
+    np.testing.assert_array_equal(robot.filters.particles(2), before)
+
+
+def test_converged_estimate_not_heard_within_range_is_dropped_before_reaching_it():
+    # Heading for the converged estimate of target 2 (which it never heard itself), the robot
+    # comes within detection range of it without hearing it: the filter is dropped there,
+    # not only at the estimate.
+    phases = PhaseConfig(work_timeout_s=100.0, unheard_updates=True)
+    robot, out = run_capture_scenario('proposed', phases=phases)
+    assert out.status.phase is Phase.DIRECT_APPROACH
+    goal = robot.filters.estimate(2).position_m
+    where = goal + np.array([0.0, 200.0])
+    t = 41.0
+    for _ in range(5):
+        out = robot.step(t, where, {})
+        t += 1.0
+        if not robot.filters.is_tracked(2):
+            break
+    assert not robot.filters.is_tracked(2)
+    assert out.status.phase is Phase.SEARCH
+    assert any('not heard where its filter put it' in e for e in out.events)
