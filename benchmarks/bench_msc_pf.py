@@ -32,13 +32,13 @@ import itertools  # noqa: E402
 import math  # noqa: E402
 import time  # noqa: E402
 from concurrent.futures import ProcessPoolExecutor  # noqa: E402
-from dataclasses import dataclass  # noqa: E402
+from dataclasses import dataclass, is_dataclass, replace  # noqa: E402
 from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
 from msc_pf.particle_filter import ParticleFilterBank, resolve_backend  # noqa: E402
 from msc_pf.schemes import Scheme  # noqa: E402
-from msc_pf.settings import ParticleFilterConfig, RadioConfig  # noqa: E402
+from msc_pf.settings import MscPfConfig, ParticleFilterConfig, RadioConfig  # noqa: E402
 from sim_bridge.msc_pf_batch import BatchScenario, run_batch  # noqa: E402
 
 SCHEMES = ('proposed', 'msc_pf', 'msc')
@@ -61,8 +61,44 @@ class RunOutcome:
     cpu_time_s: float = math.nan
 
 
-def _run_one(job: tuple[str, int, int, int, float]) -> RunOutcome:
-    scheme, n_targets, n_robots, seed, max_time_s = job
+Overrides = tuple[tuple[str, str], ...]
+"""Controller settings changed from the defaults: ('section.field', value as text)."""
+
+Job = tuple[str, int, int, int, float, Overrides]
+
+
+def _parse_value(text: str, current: object) -> object:
+    """``text`` read as the type of the field's ``current`` value."""
+    if isinstance(current, bool):
+        if text.lower() not in ('true', 'false'):
+            raise ValueError(f'expected true or false, got {text!r}')
+        return text.lower() == 'true'
+    if isinstance(current, int):
+        return int(text)
+    if isinstance(current, float) or current is None:
+        return float(text)
+    return text
+
+
+def controller_config(overrides: Overrides) -> MscPfConfig:
+    """The default controller configuration with ``overrides`` applied.
+
+    Raises:
+        ValueError: an unknown section or field, or a value of the wrong type.
+    """
+    config = MscPfConfig()
+    for name, text in overrides:
+        section, _, field_name = name.partition('.')
+        part = getattr(config, section, None)
+        if part is None or not is_dataclass(part) or field_name not in part.__dataclass_fields__:
+            raise ValueError(f'unknown controller setting {name!r}')
+        value = _parse_value(text, getattr(part, field_name))
+        config = replace(config, **{section: replace(part, **{field_name: value})})
+    return config
+
+
+def _run_one(job: Job) -> RunOutcome:
+    scheme, n_targets, n_robots, seed, max_time_s, overrides = job
     start_cpu = time.process_time()
     result = run_batch(
         BatchScenario(
@@ -71,6 +107,7 @@ def _run_one(job: tuple[str, int, int, int, float]) -> RunOutcome:
             n_targets=n_targets,
             seed=seed,
             max_time_s=max_time_s,
+            controller=controller_config(overrides),
         )
     )
     cpu = time.process_time() - start_cpu
@@ -107,9 +144,7 @@ def _csv_row(o: RunOutcome) -> str:
     )
 
 
-def _run_all(
-    jobs: list[tuple[str, int, int, int, float]], workers: int, csv_path: Path | None
-) -> list[RunOutcome]:
+def _run_all(jobs: list[Job], workers: int, csv_path: Path | None) -> list[RunOutcome]:
     if workers <= 1:
         return [_log(_run_one(job), csv_path) for job in jobs]
     with ProcessPoolExecutor(max_workers=workers) as pool:
@@ -329,16 +364,19 @@ def run(
     workers: int = 1,
     csv_path: Path | None = None,
     pf_backends: tuple[str, ...] = ('auto',),
+    overrides: Overrides = (),
 ) -> tuple[str, list[RunOutcome]]:
     """Run the experiments; return the report (markdown) and every run's outcome.
 
-    With ``csv_path``, every outcome is appended to that CSV file as soon as it is known.
+    With ``csv_path``, every outcome is appended to that CSV file as soon as it is known;
+    ``overrides`` change controller settings of the main and robots experiments.
     """
+    controller_config(overrides)  # fail before any run on a bad setting
     lines: list[str] = []
     outcomes: list[RunOutcome] = []
     if 'main' in experiments:
         jobs = [
-            (scheme, n, robots, first_seed + s, max_time_s)
+            (scheme, n, robots, first_seed + s, max_time_s, overrides)
             for n in targets
             for s in range(runs)
             for scheme in schemes
@@ -348,7 +386,7 @@ def run(
         lines += main_table(main, robots, schemes)
     if 'robots' in experiments:
         jobs = [
-            (scheme, sweep_targets, count, first_seed + s, max_time_s)
+            (scheme, sweep_targets, count, first_seed + s, max_time_s, overrides)
             for count in robot_counts
             for s in range(sweep_runs)
             for scheme in schemes
@@ -387,9 +425,19 @@ def main() -> None:
         help="particle_filter.backend of the pf experiment ('auto': numba if installed)",
     )
     parser.add_argument(
+        '--set',
+        nargs='+',
+        default=[],
+        metavar='SECTION.FIELD=VALUE',
+        help='controller settings other than the defaults (e.g. phases.unheard_updates=true)',
+    )
+    parser.add_argument(
         '--table-from', type=Path, help='only print the tables of a CSV of finished runs'
     )
     args = parser.parse_args()
+    overrides: Overrides = tuple(
+        (name.strip(), value.strip()) for name, _, value in (s.partition('=') for s in args.set)
+    )
     if args.table_from is not None:
         outcomes = read_outcomes(args.table_from)
         schemes = tuple(args.schemes)
@@ -413,6 +461,7 @@ def main() -> None:
         workers=args.workers,
         csv_path=args.out.with_suffix('.csv') if args.out is not None else None,
         pf_backends=tuple(args.pf_backend),
+        overrides=overrides,
     )
     report += f'\nTotal wall time: {time.perf_counter() - start:.0f} s'
     if outcomes:
