@@ -380,6 +380,9 @@ class RayCaster:
         self._bin_offsets_rad = self.angle_min_rad + self.angle_increment_rad * np.arange(
             self.num_bins
         )
+        # A ray's direction is its bin's fixed direction rotated by the robot's yaw.
+        self._cos_offsets = np.cos(self._bin_offsets_rad)
+        self._sin_offsets = np.sin(self._bin_offsets_rad)
 
     @property
     def bin_angles_rad(self) -> np.ndarray:
@@ -419,7 +422,8 @@ class RayCaster:
         scan_kernel(
             np.ascontiguousarray(poses[:, :2]),
             np.ascontiguousarray(poses[:, 2]),
-            self._bin_offsets_rad,
+            self._cos_offsets,
+            self._sin_offsets,
             self._faces,
             self.angle_min_rad,
             self.angle_increment_rad,
@@ -444,8 +448,12 @@ class RayCaster:
             return best.reshape(0, nb)
         origin = poses[:, :2]
         yaw = poses[:, 2]
-        theta = (yaw[:, None] + self._bin_offsets_rad[None, :]).ravel()
-        ray_dir = (np.cos(theta), np.sin(theta))
+        # Every bin's fixed direction rotated by the robot's yaw, in the kernel's order.
+        cos_yaw = np.cos(yaw)[:, None]
+        sin_yaw = np.sin(yaw)[:, None]
+        co = self._cos_offsets[None, :]
+        so = self._sin_offsets[None, :]
+        ray_dir = ((cos_yaw * co - sin_yaw * so).ravel(), (sin_yaw * co + cos_yaw * so).ravel())
         near, far = self._segment_pairs(origin, yaw, max_range_m)
         self._fill(near, ray_dir, best)
         if n > 1:

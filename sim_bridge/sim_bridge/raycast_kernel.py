@@ -10,7 +10,8 @@ catch if a platform broke them:
 
 * the C library's ``cos``, ``sin``, ``atan2`` and ``asin`` give numpy's values (numpy calls
   the same functions for float64 here; a vectorised numpy build could differ in the last
-  place). ``cos`` and ``sin`` give the ray directions; ``atan2`` and ``asin`` only decide which
+  place). ``cos`` and ``sin`` of the yaws rotate the bins' fixed directions (precomputed by
+  the caster) into the ray directions; ``atan2`` and ``asin`` only decide which
   bins a face's interval covers, so a difference would matter only for a face end within about
   1e-15 rad of a ray;
 * no fused multiply-add (numba does not contract without ``fastmath``).
@@ -109,7 +110,8 @@ def _cast_face(
 def scan_kernel(
     origin: np.ndarray,
     yaw: np.ndarray,
-    bin_offsets: np.ndarray,
+    cos_offsets: np.ndarray,
+    sin_offsets: np.ndarray,
     faces: np.ndarray,
     angle_min: float,
     inc: float,
@@ -130,7 +132,8 @@ def scan_kernel(
     Args:
         origin: (N, 2) robot centres [m].
         yaw: (N,) robot headings [rad].
-        bin_offsets: (B,) robot-frame angle of every bin [rad].
+        cos_offsets: (B,) cosine of the robot-frame angle of every bin.
+        sin_offsets: (B,) sine of the robot-frame angle of every bin.
         faces: (F, 6) per face: start x, y, end x, y [m], half thickness [m] and the outward
             sign of a one-sided end face (0 for a two-sided wall).
         angle_min: robot-frame angle of bin 0 [rad].
@@ -143,15 +146,17 @@ def scan_kernel(
         best: ranges to lower in place.
     """
     n = origin.shape[0]
-    nb = bin_offsets.shape[0]
-    # The ray directions, as the reference computes them: cos and sin of yaw + offset.
+    nb = cos_offsets.shape[0]
+    # The ray directions, as the reference computes them: every bin's fixed direction
+    # rotated by the robot's yaw.
     cos_t = np.empty(n * nb)
     sin_t = np.empty(n * nb)
     for i in range(n):
+        cy = math.cos(yaw[i])
+        sy = math.sin(yaw[i])
         for k in range(nb):
-            theta = yaw[i] + bin_offsets[k]
-            cos_t[i * nb + k] = math.cos(theta)
-            sin_t[i * nb + k] = math.sin(theta)
+            cos_t[i * nb + k] = cy * cos_offsets[k] - sy * sin_offsets[k]
+            sin_t[i * nb + k] = sy * cos_offsets[k] + cy * sin_offsets[k]
     num_faces = faces.shape[0]
     far_first = np.empty(num_faces, dtype=np.int64)
     far_count = np.empty(num_faces, dtype=np.int64)

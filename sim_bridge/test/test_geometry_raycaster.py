@@ -249,3 +249,15 @@ def test_compiled_lidar_noise_equals_the_numpy_reference(dropout):
         expected = reference.measure_reference(poses)
         assert np.isneginf(expected).any() or np.isposinf(expected).any()
         np.testing.assert_array_equal(got, expected)
+
+
+def test_compiled_scan_is_bit_identical_for_special_headings():
+    # The rays are the bins' fixed directions rotated by the yaw: headings on and next to the
+    # bins, signed zeros, +-pi and large multiples of a turn give the reference's ranges.
+    walls = _random_walls(np.random.default_rng(3), 20)
+    caster = RayCaster(walls, wall_thickness_m=0.025, robot_radius_m=0.1, num_bins=360)
+    yaws = [0.0, -0.0, math.pi, -math.pi, 1e-300, -1e-17, math.pi / 2, 100.0 * math.pi, -57.3]
+    yaws += list(np.nextafter(np.float64(math.pi / 180.0), 1.0) * np.arange(-3, 4))
+    for k, yaw in enumerate(yaws):
+        poses = np.array([[2.0 + 0.3 * k, 3.0, yaw], [2.5, 3.4, -yaw], [6.0, 1.0, yaw + 1.0]])
+        np.testing.assert_array_equal(caster.scan(poses, 12.0), caster.scan_reference(poses, 12.0))
