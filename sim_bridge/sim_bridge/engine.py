@@ -278,8 +278,9 @@ class SimEngine:
         if not len(robots) == len(commands) == len(pumps):
             msg = f'{len(robots)} robots, {len(commands)} commands and {len(pumps)} pump states'
             raise ValueError(msg)
-        for robot in robots:
-            self._check_robot(robot)
+        if robots and not 0 <= min(robots) <= max(robots) < self.num_robots:
+            for robot in robots:
+                self._check_robot(robot)  # raises for the first index out of range
         # Element by element: cheaper than array operations for a few robots.
         command, pump_on = self._command, self._pump_on
         command_time, pump_time = self._command_time_s, self._pump_time_s

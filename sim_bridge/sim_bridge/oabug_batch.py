@@ -247,21 +247,27 @@ class BatchRobot:
             return
         self._features_time_s = scan_time
 
-    def _fresh(self, stamp_s: float | None, now_s: float) -> bool:
-        return stamp_s is not None and 0.0 <= now_s - stamp_s <= self.stale_timeout_s
-
     def control(self, now_s: float) -> Command:
         """One control step at node time ``now_s``: the command the node would publish."""
-        if math.isfinite(self._yaw.value):
+        held_yaw = self._yaw
+        if math.isfinite(held_yaw.value) and self._scan.value is not None:
             self._update_features(now_s)
-        fresh = self._fresh(self._features_time_s, now_s) and self._fresh(self._yaw.time_s, now_s)
+        # Every reading the step reads must be fresh: stamped at most the stale timeout ago.
+        timeout = self.stale_timeout_s
+        features_s, yaw_s = self._features_time_s, held_yaw.time_s
+        if features_s is None or not 0.0 <= now_s - features_s <= timeout:
+            return _STOP
+        if yaw_s is None or not 0.0 <= now_s - yaw_s <= timeout:
+            return _STOP
         if self._needs_gas:
-            fresh = fresh and self._fresh(self._gas.time_s, now_s)
-        if not fresh or self._features is None:
+            gas_s = self._gas.time_s
+            if gas_s is None or not 0.0 <= now_s - gas_s <= timeout:
+                return _STOP
+        if self._features is None:
             return _STOP
         snapshot = SensorSnapshot(
             time_s=now_s,
-            yaw_rad=self._yaw.value,
+            yaw_rad=held_yaw.value,
             scan=self._features,
             gas_raw=self._gas.value,
             bearings=self._bearings,

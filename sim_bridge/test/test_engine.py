@@ -179,6 +179,8 @@ def test_commands_set_together_equal_commands_set_one_by_one():
     before = together.active_commands()
     with pytest.raises(WorldGeometryError, match='out of range'):
         together.set_commands([0, 7], [(0.3, 0.0), (0.3, 0.0)], [True, True])
+    with pytest.raises(WorldGeometryError, match='robot index -1 out of range'):
+        together.set_commands([1, -1], [(0.3, 0.0), (0.3, 0.0)], [True, True])
     assert together.active_commands().tobytes() == before.tobytes()
     with pytest.raises(ValueError, match='pump states'):
         together.set_commands([0], [(0.3, 0.0)], [])
