@@ -789,9 +789,10 @@ class ParticleFilterBank:
         self._best[slot] = (x[best], y[best])
         self._estimate[slot] = (mx, my)
         self._spread[slot] = math.sqrt(max(spread2, 0.0))
-        offsets, counts = self._resampling_draws(w[None, :].astype(np.float32))
+        w32 = w[None, :].astype(np.float32)
+        offsets, counts = self._resampling_draws(w32)
         if offsets is not None:
-            index = systematic_index(w[None, :].astype(np.float32), offsets).reshape(-1)
+            index = systematic_index(w32, offsets).reshape(-1)
         else:
             index = np.repeat(np.arange(self._n), counts.ravel())
         new_x = self._x[slot][index][None, :]
