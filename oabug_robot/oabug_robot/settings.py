@@ -124,6 +124,9 @@ class PerceptionConfig:
             close ahead stops the arc (the far jamb of a 0.5 m door is nearer than
             wall_hit_distance_m) [m].
         robot_hit_distance_m: a peer return this close inside the front cone is a hit [m].
+            The authors' simulator cancels a 0.1 m step that would bring two 0.2 m robots
+            into contact, i.e. it hits a peer 0.3 m centre to centre ahead: 0.2 m from the
+            lidar to the peer's surface.
         robot_cone_half_angle_rad: half angle of the cone in which peers count as hit [rad]
             (the authors' robot: 30 deg).
         peer_bearing_tolerance_rad: angular error allowed between a bearing and the peer's
@@ -158,7 +161,7 @@ class PerceptionConfig:
     front_half_width_m: float = 0.12
     wall_hit_distance_m: float = 0.22
     wrap_stop_distance_m: float = 0.18
-    robot_hit_distance_m: float = 0.25
+    robot_hit_distance_m: float = 0.2
     robot_cone_half_angle_rad: float = math.radians(30.0)
     peer_bearing_tolerance_rad: float = math.radians(10.0)
     peer_mask_range_m: float = 1.0
