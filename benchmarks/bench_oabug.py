@@ -10,6 +10,10 @@ ros`` runs the full simulation (sim bridge + OA-Bug nodes on the built-in runtim
 (the Small sweep of the closing note, 20 sites, both cores)::
 
     python benchmarks/bench_oabug.py --config small --sites 20 --workers 2 --out small.md
+
+``--set NAME=VALUE ...`` runs every mission with OA-Bug node parameters other than the
+defaults (e.g. ``--set gas_threshold=300 sound_turn_rule=away``); they are typed and checked
+before the first run and printed under the table.
 """
 
 from __future__ import annotations
@@ -71,6 +75,7 @@ class Job:
     actions: int | None
     speed_mps: float
     path: str = 'batch'
+    parameters: tuple[tuple[str, object], ...] = ()
 
 
 @dataclass(frozen=True)
@@ -112,6 +117,7 @@ def run_job(job: Job) -> Outcome:
         seed=job.site_seed,
         actions=job.actions,
         speed_mps=job.speed_mps,
+        robot_parameters=dict(job.parameters),
     )
     start = time.perf_counter()
     start_cpu = time.process_time()
@@ -171,6 +177,9 @@ def format_footer(outcomes: Sequence[Outcome], total_s: float, args: argparse.Na
     metres = sum(o.robot_metres for o in outcomes)
     sim_s = sum(o.sim_time_s for o in outcomes)
     workers = max(args.workers, 1)
+    settings = ''
+    if args.set:
+        settings = f' OA-Bug parameters other than the defaults: {" ".join(args.set)}.'
     return (
         f'{n} runs ({args.config}, {args.robots} robots, {args.sites} sites, {args.path} path) '
         f'in {total_s:.0f} s wall with {workers} workers: {cpu:.2f} CPU s per run, '
@@ -178,6 +187,7 @@ def format_footer(outcomes: Sequence[Outcome], total_s: float, args: argparse.Na
         f'{sim_s / total_s:.1f} sim s per wall s. A {SWEEP_RUNS}-run sweep: '
         f'{SWEEP_RUNS * total_s / n / 60:.0f} min at this wall rate, '
         f'{SWEEP_RUNS * cpu / workers / 60:.0f} min from the CPU time on {workers} idle cores.'
+        f'{settings}'
     )
 
 
@@ -193,10 +203,15 @@ def run(
     speed_mps: float = 0.3,
     workers: int = 2,
     path: str = 'batch',
+    parameters: dict[str, object] | None = None,
 ) -> tuple[list[Outcome], float]:
-    """Run the sweep; return the outcomes and the total wall time [s]."""
+    """Run the sweep; return the outcomes and the total wall time [s].
+
+    ``parameters`` are OA-Bug node parameters for every robot of every mission.
+    """
+    settings = tuple(sorted((parameters or {}).items()))
     jobs = [
-        Job(config, seed, variant, departure, robots, actions, speed_mps, path)
+        Job(config, seed, variant, departure, robots, actions, speed_mps, path, settings)
         for seed in range(first_site_seed, first_site_seed + sites)
         for departure in departures
         for variant in variants
@@ -248,7 +263,21 @@ def main(argv: Sequence[str] | None = None) -> int:
         help='batch: engine + controllers without the runtime (sweeps); ros: the node path',
     )
     parser.add_argument('--out', type=Path, default=None, help='also write the table here')
+    parser.add_argument(
+        '--set',
+        nargs='+',
+        default=[],
+        metavar='NAME=VALUE',
+        help='OA-Bug node parameters other than the defaults (e.g. gas_threshold=300)',
+    )
     args = parser.parse_args(argv)
+    from sim_bridge.errors import ConfigurationError
+    from sim_bridge.spawn import oabug_parameter_overrides
+
+    try:
+        parameters = oabug_parameter_overrides(args.set)
+    except ConfigurationError as err:
+        parser.error(str(err))
     outcomes, total_s = run(
         config=args.config,
         sites=args.sites,
@@ -260,6 +289,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         speed_mps=args.speed,
         workers=args.workers,
         path=args.path,
+        parameters=parameters,
     )
     table = format_table(outcomes, args.config)
     footer = '\n' + format_footer(outcomes, total_s, args)

@@ -35,6 +35,7 @@ from sim_bridge.mission import (
     RobotNodeSpec,
     run_mission,
 )
+from sim_bridge.node_overrides import parse_overrides
 from sim_bridge.site_loading import load_site, site_budget_actions
 
 __all__ = [
@@ -44,6 +45,7 @@ __all__ = [
     'SpawnConfig',
     'SpawnResult',
     'main',
+    'oabug_parameter_overrides',
     'run',
 ]
 
@@ -51,6 +53,17 @@ VARIANTS = ('random', 'minimum', 'sound', 'gas', 'gas_sound')
 ACTION_LENGTH_M = 0.1
 DEFAULT_ACTIONS = 1000
 DEFAULT_RECORD_TOPICS = ('/clock', '/sim/poses', '/sim/coverage', '/sim/site')
+# OA-Bug node parameters the spawner sets from its own options (see build_mission).
+SPAWNER_PARAMETERS = (
+    'variant',
+    'robot_index',
+    'robot_count',
+    'departure',
+    'heading_bias_deg',
+    'forward_speed_mps',
+    'own_tag_id',
+    'seed',
+)
 
 
 @dataclass(frozen=True)
@@ -147,6 +160,32 @@ def heading_bias_rad(departure: str, into_site_rad: float | None, seed: int) -> 
         return float(into_site_rad) - 0.5 * math.pi
     rng = np.random.default_rng(np.random.SeedSequence([seed, 0xB1A5]))
     return float(rng.uniform(-math.pi, math.pi))
+
+
+def oabug_parameter_overrides(items: Sequence[str]) -> dict[str, object]:
+    """OA-Bug node parameters from ``NAME=VALUE`` items, typed and checked before a run.
+
+    Every parameter the node declares may be set except those the spawner derives from its
+    own options (:data:`SPAWNER_PARAMETERS`: use ``--variant``, ``--speed``, ...).
+
+    Raises:
+        ConfigurationError: a malformed item, an unknown or spawner-set name, a value of the
+            wrong type, or one the controller rejects (e.g. a negative distance).
+        SimBridgeError: the OA-Bug package cannot be imported.
+    """
+    try:
+        from oabug_robot.errors import ConfigError
+        from oabug_robot.node import PARAMETERS, config_from_parameters
+    except ImportError as err:
+        msg = f'the OA-Bug node (package oabug_robot) cannot be imported: {err}'
+        raise SimBridgeError(msg) from err
+    declared = {name: default for name, default, _ in PARAMETERS}
+    overrides = parse_overrides(items, declared, reserved=SPAWNER_PARAMETERS)
+    try:
+        config_from_parameters({**declared, **overrides})
+    except ConfigError as err:
+        raise ConfigurationError(str(err)) from err
+    return overrides
 
 
 def _oabug_factory() -> Callable[..., object]:
@@ -303,6 +342,14 @@ def _parser() -> argparse.ArgumentParser:
     )
     parser.add_argument('--no-figures', action='store_true', help='do not write PNGs')
     parser.add_argument('--quiet', action='store_true', help='no progress lines')
+    parser.add_argument(
+        '--param',
+        action='append',
+        default=[],
+        metavar='NAME=VALUE',
+        help='set an OA-Bug node parameter for every robot (repeatable), e.g. '
+        'gas_threshold=300 or sound_turn_rule=away; names and defaults: docs/oabug.md',
+    )
     return parser
 
 
@@ -311,6 +358,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = _parser().parse_args(argv)
     try:
         config = SpawnConfig(
+            robot_parameters=oabug_parameter_overrides(args.param),
             site=args.site,
             site_seed=args.site_seed,
             variant=args.variant,
@@ -325,6 +373,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     except ConfigurationError as err:
         print(f'spawn: {err}', file=sys.stderr)
         return 2
+    except SimBridgeError as err:
+        print(f'spawn: {err}', file=sys.stderr)
+        return 1
 
     def show(p: MissionProgress) -> None:
         print(
@@ -339,6 +390,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         f'= {config.budget_s:.0f} s at {config.speed_mps} m/s',
         flush=True,
     )
+    if config.robot_parameters:
+        settings = ', '.join(f'{k}={v}' for k, v in sorted(config.robot_parameters.items()))
+        print(f'OA-Bug parameters other than the defaults: {settings}', flush=True)
     try:
         result = run(config, progress=None if args.quiet else show)
     except SimBridgeError as err:

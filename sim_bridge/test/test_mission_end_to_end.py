@@ -123,3 +123,55 @@ def test_spawner_reports_bad_input_without_a_traceback(capsys):
 
     assert main(['--robots', '0']) == 2
     assert 'robots must be >= 1' in capsys.readouterr().err
+
+
+def test_spawner_parameters_reach_every_robot_node_typed():
+    pytest.importorskip('oabug_robot.node')
+    from sim_bridge.spawn import SpawnConfig, build_mission, oabug_parameter_overrides
+
+    overrides = oabug_parameter_overrides(['gas_threshold=300', 'sound_turn_rule=away'])
+    spec, _ = build_mission(
+        SpawnConfig(site=str(FIVE_ROOMS), departure='edge', robots=3, robot_parameters=overrides)
+    )
+    for index, robot in enumerate(spec.robots):
+        assert robot.parameters['gas_threshold'] == 300
+        assert robot.parameters['sound_turn_rule'] == 'away'
+        assert robot.parameters['robot_index'] == index
+
+
+def test_spawner_parameters_change_the_run():
+    pytest.importorskip('oabug_robot.node')
+    from sim_bridge.oabug_batch import run_spawn_batch
+    from sim_bridge.spawn import SpawnConfig
+
+    def trajectories(**parameters):
+        config = SpawnConfig(
+            site=str(FIVE_ROOMS),
+            departure='edge',
+            robots=2,
+            actions=120,
+            variant='minimum',
+            seed=1,
+            robot_parameters=parameters,
+        )
+        return run_spawn_batch(config).mission.trajectories
+
+    default = trajectories()
+    assert np.array_equal(default, trajectories(fixed_turn='right'))
+    assert not np.array_equal(default, trajectories(fixed_turn='left'))
+
+
+@pytest.mark.parametrize(
+    ('option', 'message'),
+    [
+        ('gas_treshold=300', "unknown parameter 'gas_treshold' (did you mean gas_threshold?)"),
+        ('robot_count=4', "'robot_count' is set by the spawner"),
+        ('wall_hit_distance_m=0.05', 'wall_hit_distance_m must exceed robot_radius_m'),
+    ],
+)
+def test_spawner_rejects_bad_parameters_before_running(capsys, option, message):
+    pytest.importorskip('oabug_robot.node')
+    from sim_bridge.spawn import main
+
+    assert main(['--param', option, '--no-figures']) == 2
+    assert message in capsys.readouterr().err

@@ -1,0 +1,67 @@
+"""NAME=VALUE overrides of node parameters: typed like the defaults, bad ones named."""
+
+import pytest
+from sim_bridge.errors import ConfigurationError
+from sim_bridge.node_overrides import parse_overrides
+
+DECLARED = {
+    'gas_threshold': 200,
+    'scent_window_s': 2.0,
+    'sound_picks_wall_side': True,
+    'sound_turn_rule': 'toward',
+    'robot_index': 0,
+}
+
+
+def test_values_take_the_type_of_the_declared_default() -> None:
+    values = parse_overrides(
+        [
+            'gas_threshold=300',
+            'scent_window_s:=1',
+            'sound_picks_wall_side=false',
+            'sound_turn_rule = away',
+        ],
+        DECLARED,
+    )
+    assert values == {
+        'gas_threshold': 300,
+        'scent_window_s': 1.0,
+        'sound_picks_wall_side': False,
+        'sound_turn_rule': 'away',
+    }
+    assert isinstance(values['scent_window_s'], float)
+
+
+def test_a_later_override_of_the_same_name_wins() -> None:
+    assert parse_overrides(['gas_threshold=250', 'gas_threshold=300'], DECLARED) == {
+        'gas_threshold': 300
+    }
+
+
+@pytest.mark.parametrize(
+    ('item', 'message'),
+    [
+        ('gas_threshold=2.5', 'expected an integer'),
+        ('gas_threshold=true', 'expected an integer'),
+        ('gas_threshold=abc', 'expected an integer'),
+        ('scent_window_s=.inf', 'expected a finite number'),
+        ('scent_window_s=fast', 'expected a finite number'),
+        ('sound_picks_wall_side=1', 'expected true or false'),
+        ('gas_threshold', 'must look like NAME=VALUE'),
+        ('=3', 'must look like NAME=VALUE'),
+    ],
+)
+def test_malformed_or_mistyped_overrides_are_rejected(item: str, message: str) -> None:
+    with pytest.raises(ConfigurationError, match=message):
+        parse_overrides([item], DECLARED)
+
+
+def test_an_unknown_name_is_rejected_with_the_close_matches() -> None:
+    message = r"unknown parameter 'gas_treshold' \(did you mean gas_threshold\?\)"
+    with pytest.raises(ConfigurationError, match=message):
+        parse_overrides(['gas_treshold=300'], DECLARED)
+
+
+def test_a_parameter_the_caller_sets_itself_cannot_be_overridden() -> None:
+    with pytest.raises(ConfigurationError, match="'robot_index' is set by the spawner"):
+        parse_overrides(['robot_index=3'], DECLARED, reserved=('robot_index',))
