@@ -11,6 +11,9 @@ ros`` runs the full simulation (sim bridge + OA-Bug nodes on the built-in runtim
 
     python benchmarks/bench_oabug.py --config small --sites 20 --workers 2 --out small.md
 
+With ``--out small.md`` every run is also written to ``small.csv`` (one row per site,
+departure and variant), so two sweeps on the same sites can be compared run by run.
+
 ``--set NAME=VALUE ...`` runs every mission with OA-Bug node parameters other than the
 defaults (e.g. ``--set gas_threshold=300 sound_turn_rule=away``); they are typed and checked
 before the first run and printed under the table.
@@ -19,6 +22,7 @@ before the first run and printed under the table.
 from __future__ import annotations
 
 import argparse
+import csv
 import gc
 import math
 import multiprocessing
@@ -170,6 +174,49 @@ def format_table(outcomes: Sequence[Outcome], config: str) -> str:
     return '\n'.join(lines)
 
 
+CSV_FIELDS = (
+    'config',
+    'site_seed',
+    'variant',
+    'departure',
+    'robots',
+    'coverage',
+    'sim_time_s',
+    'wall_time_s',
+    'cpu_time_s',
+    'robot_metres',
+    'parameters',
+)
+
+
+def write_csv(outcomes: Sequence[Outcome], path: Path) -> None:
+    """One row per run, sorted by site, departure and variant, for paired comparisons."""
+    rows = sorted(
+        outcomes, key=lambda o: (o.job.site_seed, o.job.departure, VARIANTS.index(o.job.variant))
+    )
+    with path.open('w', newline='', encoding='utf-8') as stream:
+        writer = csv.writer(stream)
+        writer.writerow(CSV_FIELDS)
+        for o in rows:
+            job = o.job
+            settings = ' '.join(f'{k}={v}' for k, v in job.parameters)
+            writer.writerow(
+                (
+                    job.config,
+                    job.site_seed,
+                    job.variant,
+                    job.departure,
+                    job.robots,
+                    f'{o.coverage:.6f}',
+                    f'{o.sim_time_s:.3f}',
+                    f'{o.wall_time_s:.3f}',
+                    f'{o.cpu_time_s:.3f}',
+                    f'{o.robot_metres:.2f}',
+                    settings,
+                )
+            )
+
+
 def format_footer(outcomes: Sequence[Outcome], total_s: float, args: argparse.Namespace) -> str:
     """Throughput: CPU and wall time per run, robot-metres per wall second, sweep projection."""
     n = len(outcomes)
@@ -262,7 +309,12 @@ def main(argv: Sequence[str] | None = None) -> int:
         default='batch',
         help='batch: engine + controllers without the runtime (sweeps); ros: the node path',
     )
-    parser.add_argument('--out', type=Path, default=None, help='also write the table here')
+    parser.add_argument(
+        '--out',
+        type=Path,
+        default=None,
+        help='also write the table here, and every run to the same name with .csv',
+    )
     parser.add_argument(
         '--set',
         nargs='+',
@@ -296,6 +348,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     print(table + footer)
     if args.out is not None:
         args.out.write_text(table + '\n' + footer + '\n', encoding='utf-8')
+        write_csv(outcomes, args.out.with_suffix('.csv'))
     return 0
 
 
