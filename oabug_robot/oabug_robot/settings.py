@@ -210,9 +210,11 @@ class MotionConfig:
         min_turn_rate_radps: smallest yaw rate of a turn in place, so turns finish [rad/s].
         heading_gain_per_s: P gain of the heading controller [1/s].
         heading_tolerance_rad: a turn in place ends when the heading error is below this [rad].
-        wall_distance_m: distance kept from the followed wall, lidar origin to wall [m]; the
-            authors' robots hug their wall (0.1-0.2 m centre to wall), and 0.2 m leaves room
-            in 2-cell corridors, rooms and doors.
+        wall_distance_m: distance kept from the followed wall, lidar origin to wall [m]. The
+            authors' grid robots hug their wall at 0.1-0.2 m centre to wall; 0.15 m is the
+            middle of that range and the closest a lidar with the RPLidar A1's 0.15 m minimum
+            range still measures (nearer returns read -inf, i.e. at the minimum range).
+            Measured against 0.16, 0.18 and 0.2 m in docs/oabug.md (Results).
         wall_distance_gain_radps_per_m: yaw rate per metre of wall-distance error [rad/(s m)].
         wall_angle_gain_per_s: yaw rate per radian of wall-direction error [1/s].
         random_step_m: the Random variant redraws its heading with probability
@@ -229,7 +231,7 @@ class MotionConfig:
     min_turn_rate_radps: float = 0.3
     heading_gain_per_s: float = 3.0
     heading_tolerance_rad: float = math.radians(3.0)
-    wall_distance_m: float = 0.2
+    wall_distance_m: float = 0.15
     wall_distance_gain_radps_per_m: float = 6.0
     wall_angle_gain_per_s: float = 2.5
     random_step_m: float = 0.1
