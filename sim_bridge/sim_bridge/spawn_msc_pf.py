@@ -11,7 +11,9 @@ the field with every robot's path and the targets coloured by capture time, and 
 the robots' PF estimates over time. With ``--record`` it writes a rosbag2 (MCAP) bag from
 which ``swarm_analysis.cct.cct_from_bag`` recomputes the CCT.
 
-Example: ``spawn_msc_pf --scheme proposed --robots 15 --targets 10 --seed 1 --out runs/p1``.
+Example: ``spawn_msc_pf --scheme proposed --robots 15 --targets 10 --seed 1 --out runs/p1``;
+``--param msc.leader_rule=pbest --param phases.unheard_updates=true`` changes any other msc_pf
+node parameter for every robot (names: ``msc_pf/config/msc_pf.yaml``).
 """
 
 # ruff: noqa: T201  (main() is a command-line entry point that prints its report)
@@ -29,7 +31,7 @@ import numpy as np
 
 from sim_bridge.cli_args import points_argument
 from sim_bridge.engine import EngineConfig, SiteGeometry
-from sim_bridge.errors import SimBridgeError
+from sim_bridge.errors import ConfigurationError, SimBridgeError
 from sim_bridge.mission import (
     MissionProgress,
     MissionSpec,
@@ -37,6 +39,7 @@ from sim_bridge.mission import (
     RobotNodeSpec,
     run_mission,
 )
+from sim_bridge.node_overrides import parse_overrides
 from sim_bridge.rssi_extension import RssiExtension
 from sim_bridge.rssi_targets import RssiTargetConfig, RssiTargetField, place_robots
 from sim_bridge.sensors.bearings import BearingConfig
@@ -46,7 +49,10 @@ from sim_bridge.sensors.lidar import LidarConfig
 from sim_bridge.sensors.odometry import OdometryConfig
 from sim_bridge.world import BodyConfig
 
-__all__ = ['SCHEMES', 'MscPfRun', 'SpawnSettings', 'main', 'run']
+__all__ = ['SCHEMES', 'MscPfRun', 'SpawnSettings', 'controller_parameter_overrides', 'main', 'run']
+
+# msc_pf node parameters the spawner sets from its own options (see node_parameters).
+SPAWNER_PARAMETERS = ('scheme', 'seed', 'robot_id', 'field_size_m', 'swarm.comm_range_m')
 
 SCHEMES = ('proposed', 'msc_pf', 'msc')
 PEER_TYPE = 'swarm_interfaces/msg/MscPeer'
@@ -150,6 +156,29 @@ def _engine_config(settings: SpawnSettings) -> EngineConfig:
         imu=ImuConfig(rate_hz=slow),
         odometry=OdometryConfig(rate_hz=settings.physics_rate_hz),
     )
+
+
+def controller_parameter_overrides(items: Sequence[str]) -> dict[str, Any]:
+    """msc_pf controller parameters from ``NAME=VALUE`` items, typed and checked before a run.
+
+    Names are the node's flat ``<section>.<field>`` parameters (``msc.leader_rule``,
+    ``phases.unheard_updates``, ...) except those the spawner derives from its own options
+    (:data:`SPAWNER_PARAMETERS`: use ``--scheme``, ``--seed``, ``--comm-range``).
+
+    Raises:
+        ConfigurationError: a malformed item, an unknown or spawner-set name, a value of the
+            wrong type, or one the controller rejects.
+    """
+    from msc_pf.errors import ConfigError
+    from msc_pf.parameters import config_from_parameters, parameter_defaults
+
+    declared = parameter_defaults()
+    overrides = parse_overrides(items, declared, reserved=SPAWNER_PARAMETERS)
+    try:
+        config_from_parameters({**declared, **overrides})
+    except ConfigError as err:
+        raise ConfigurationError(str(err)) from err
+    return overrides
 
 
 def node_parameters(settings: SpawnSettings, index: int) -> dict[str, Any]:
@@ -332,6 +361,14 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument('--record', type=Path, default=None, help='bag directory to write')
     parser.add_argument('--out', type=Path, default=Path('msc_pf_run'), help='plot directory')
     parser.add_argument('--no-plots', action='store_true')
+    parser.add_argument(
+        '--param',
+        action='append',
+        default=[],
+        metavar='NAME=VALUE',
+        help='set an msc_pf controller parameter for every robot (repeatable), e.g. '
+        'msc.leader_rule=pbest; names and defaults: msc_pf/config/msc_pf.yaml',
+    )
     return parser
 
 
@@ -339,7 +376,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``spawn_msc_pf``; returns the exit status."""
     args = build_parser().parse_args(argv)
     targets = args.targets if args.target_positions is None else len(args.target_positions)
+    try:
+        extra = controller_parameter_overrides(args.param)
+    except ConfigurationError as err:
+        print(f'spawn_msc_pf: {err}', file=sys.stderr)
+        return 2
     settings = SpawnSettings(
+        extra_parameters=extra,
         scheme=args.scheme,
         robots=args.robots,
         targets=targets,

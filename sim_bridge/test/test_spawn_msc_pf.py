@@ -86,3 +86,34 @@ def test_invalid_settings_are_rejected_before_anything_runs(overrides, message):
 def test_command_line_reports_bad_settings_with_exit_status_2(capsys):
     assert main(['--robots', '0', '--no-plots']) == 2
     assert '--robots' in capsys.readouterr().err
+
+
+def test_command_line_parameters_reach_every_robot_node_typed():
+    from sim_bridge.spawn_msc_pf import controller_parameter_overrides, node_parameters
+
+    extra = controller_parameter_overrides(
+        ['msc.leader_rule=pbest', 'phases.unheard_updates=true', 'msc.inertia=1']
+    )
+    assert extra == {'msc.leader_rule': 'pbest', 'phases.unheard_updates': True, 'msc.inertia': 1.0}
+    run_settings = settings(extra_parameters=extra)
+    for index in range(run_settings.robots):
+        params = node_parameters(run_settings, index)
+        assert params['msc.leader_rule'] == 'pbest'
+        assert params['robot_id'] == index
+
+
+@pytest.mark.parametrize(
+    ('option', 'message'),
+    [
+        (
+            'msc.leader_rul=pbest',
+            "unknown parameter 'msc.leader_rul' (did you mean msc.leader_rule?)",
+        ),
+        ('swarm.comm_range_m=50', "'swarm.comm_range_m' is set by the spawner"),
+        ('msc.leader_rule=uphill', 'leader_rule not in'),
+        ('phases.unheard_updates=maybe', 'expected true or false'),
+    ],
+)
+def test_command_line_rejects_bad_parameters_with_exit_status_2(capsys, option, message):
+    assert main(['--param', option, '--no-plots']) == 2
+    assert message in capsys.readouterr().err
