@@ -10,7 +10,9 @@ signal field with every robot's path, and one robot's GP mean with its waypoints
 ``--record`` it writes a rosbag2 (MCAP) bag from which ``swarm_analysis.tau.tau_from_bag``
 recomputes tau.
 
-Example: ``spawn_bayes_swarm --case case1 --robots 5 --seed 1 --out runs/case1``.
+Example: ``spawn_bayes_swarm --case case1 --robots 5 --seed 1 --out runs/case1``;
+``--param horizon_s=20`` changes any other bayes_swarm node parameter for every robot,
+including those the case sets.
 """
 
 # ruff: noqa: T201  (main() is a command-line entry point that prints its report)
@@ -28,8 +30,9 @@ import numpy as np
 
 from sim_bridge.cli_args import points_argument
 from sim_bridge.engine import EngineConfig, SiteGeometry
-from sim_bridge.errors import SimBridgeError
+from sim_bridge.errors import ConfigurationError, SimBridgeError
 from sim_bridge.mission import MissionSpec, RecordingSpec, RobotNodeSpec, run_mission
+from sim_bridge.node_overrides import parse_overrides
 from sim_bridge.sensors.bearings import BearingConfig
 from sim_bridge.sensors.gas_sensor import GasSensorConfig
 from sim_bridge.sensors.imu import ImuConfig
@@ -39,7 +42,26 @@ from sim_bridge.signal_extension import SignalExtension, SignalMissionModel
 from sim_bridge.signal_fields import CASE_NAMES, SignalCase, UnknownCaseError, get_case
 from sim_bridge.world import BodyConfig
 
-__all__ = ['ALGORITHMS', 'BayesSwarmRun', 'SpawnSettings', 'batch_mission_spec', 'main', 'run']
+__all__ = [
+    'ALGORITHMS',
+    'BayesSwarmRun',
+    'SpawnSettings',
+    'batch_mission_spec',
+    'main',
+    'node_parameter_overrides',
+    'run',
+]
+
+# bayes_swarm node parameters the spawner sets from its own options (see node_parameters);
+# the ones it takes from the case (arena, speed, horizon, ...) may be overridden.
+SPAWNER_PARAMETERS = (
+    'algorithm',
+    'robot_index',
+    'n_robots',
+    'seed',
+    'noise_std',
+    'outer_optimizer',
+)
 
 ALGORITHMS = ('bayes_swarm_p', 'bayes_swarm_o', 'glowworm', 'levy', 'exhaustive')
 DEFAULT_RECORD_TOPICS = (
@@ -187,6 +209,27 @@ def _robot_layout(case: SignalCase, n: int) -> list[tuple[np.ndarray, int, int, 
             (depots[depot], i // depots.shape[0] + 1, fan_size, offsets[depot % len(offsets)])
         )
     return layout
+
+
+def node_parameter_overrides(items: Sequence[str]) -> dict[str, Any]:
+    """bayes_swarm node parameters from ``NAME=VALUE`` items, typed and checked before a run.
+
+    Raises:
+        ConfigurationError: a malformed item, an unknown or spawner-set name
+            (:data:`SPAWNER_PARAMETERS`: use ``--algorithm``, ``--robots``, ``--seed``,
+            ``--noise``, ``--outer-optimizer``), a value of the wrong type, or one the node
+            rejects.
+    """
+    from bayes_swarm.errors import ConfigError
+    from bayes_swarm.node_settings import PARAMETERS, settings_from_values
+
+    declared = {spec.name: spec.default for spec in PARAMETERS}
+    overrides = parse_overrides(items, declared, reserved=SPAWNER_PARAMETERS)
+    try:
+        settings_from_values(overrides)
+    except ConfigError as err:
+        raise ConfigurationError(str(err)) from err
+    return overrides
 
 
 def node_parameters(case: SignalCase, settings: SpawnSettings, n: int, i: int) -> dict[str, Any]:
@@ -423,13 +466,27 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument('--record', type=Path, default=None, help='bag directory to write')
     parser.add_argument('--out', type=Path, default=Path('bayes_swarm_run'), help='plot dir')
     parser.add_argument('--no-plots', action='store_true')
+    parser.add_argument(
+        '--param',
+        action='append',
+        default=[],
+        metavar='NAME=VALUE',
+        help='set a bayes_swarm node parameter for every robot (repeatable), e.g. '
+        'horizon_s=20; names and defaults: ros2 param describe, or bayes_swarm.node_settings',
+    )
     return parser
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``spawn_bayes_swarm``; returns the exit status."""
     args = build_parser().parse_args(argv)
+    try:
+        extra = node_parameter_overrides(args.param)
+    except ConfigurationError as err:
+        print(f'error: {err}', file=sys.stderr)
+        return 2
     settings = SpawnSettings(
+        extra_parameters=extra,
         algorithm=args.algorithm,
         case=args.case,
         robots=args.robots,

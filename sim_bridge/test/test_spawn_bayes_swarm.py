@@ -121,3 +121,30 @@ def test_bad_settings_are_rejected_before_the_run(capsys):
         run(SpawnSettings(depots=np.array([[50.0, 50.0]])))
     assert main(['--case', 'case1', '--robots', '0', '--no-plots']) == 2
     assert 'robots' in capsys.readouterr().err
+
+
+def test_command_line_parameters_override_the_case_for_every_robot():
+    from sim_bridge.spawn_bayes_swarm import node_parameter_overrides, node_parameters
+
+    extra = node_parameter_overrides(['horizon_s=20', 'lipschitz=3'])
+    assert extra == {'horizon_s': 20.0, 'lipschitz': 3.0}
+    case = get_case('case1')
+    settings = SpawnSettings(case='case1', extra_parameters=extra)
+    for i in range(3):
+        params = node_parameters(case, settings, 3, i)
+        assert (params['horizon_s'], params['lipschitz']) == (20.0, 3.0)
+        assert params['robot_index'] == i
+    assert node_parameters(case, SpawnSettings(case='case1'), 3, 0)['horizon_s'] != 20.0
+
+
+@pytest.mark.parametrize(
+    ('option', 'message'),
+    [
+        ('horizn_s=3', "unknown parameter 'horizn_s' (did you mean horizon_s?)"),
+        ('n_robots=4', "'n_robots' is set by the spawner"),
+        ('horizon_s=-3', 'horizon_s must be > 0'),
+    ],
+)
+def test_command_line_rejects_bad_parameters_with_exit_status_2(capsys, option, message):
+    assert main(['--param', option, '--no-plots']) == 2
+    assert message in capsys.readouterr().err
