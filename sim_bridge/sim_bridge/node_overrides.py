@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import difflib
 import math
-from collections.abc import Collection, Iterable, Mapping
+from collections.abc import Callable, Collection, Iterable, Mapping
 
 import yaml
 
@@ -59,6 +59,7 @@ def parse_overrides(
     declared: Mapping[str, object],
     *,
     reserved: Collection[str] = (),
+    check: Callable[[dict[str, object]], object] | None = None,
 ) -> dict[str, object]:
     """Read ``NAME=VALUE`` (or ROS-style ``NAME:=VALUE``) items into typed parameter values.
 
@@ -66,13 +67,16 @@ def parse_overrides(
         items: the overrides, in command-line order (a later one wins).
         declared: every parameter the node declares, name to default value.
         reserved: parameters the caller sets itself; overriding one is an error.
+        check: the node's own validation, called with the declared defaults updated by the
+            overrides; a ``ValueError`` it raises (the packages' ``ConfigError``) becomes a
+            ConfigurationError with the same message.
 
     Returns:
         Parameter name to value, of the declared default's type.
 
     Raises:
-        ConfigurationError: a malformed item, an unknown or reserved name, or a value of the
-            wrong type.
+        ConfigurationError: a malformed item, an unknown or reserved name, a value of the
+            wrong type, or values ``check`` rejects.
     """
     values: dict[str, object] = {}
     for item in items:
@@ -85,4 +89,9 @@ def parse_overrides(
             hint = f' (did you mean {", ".join(close)}?)' if close else ''
             raise ConfigurationError(f'unknown parameter {name!r}{hint}')
         values[name] = _typed(name, text, declared[name])
+    if check is not None:
+        try:
+            check({**declared, **values})
+        except ValueError as err:
+            raise ConfigurationError(str(err)) from err
     return values

@@ -174,18 +174,14 @@ def oabug_parameter_overrides(items: Sequence[str]) -> dict[str, object]:
         SimBridgeError: the OA-Bug package cannot be imported.
     """
     try:
-        from oabug_robot.errors import ConfigError
         from oabug_robot.node import PARAMETERS, config_from_parameters
     except ImportError as err:
         msg = f'the OA-Bug node (package oabug_robot) cannot be imported: {err}'
         raise SimBridgeError(msg) from err
     declared = {name: default for name, default, _ in PARAMETERS}
-    overrides = parse_overrides(items, declared, reserved=SPAWNER_PARAMETERS)
-    try:
-        config_from_parameters({**declared, **overrides})
-    except ConfigError as err:
-        raise ConfigurationError(str(err)) from err
-    return overrides
+    return parse_overrides(
+        items, declared, reserved=SPAWNER_PARAMETERS, check=config_from_parameters
+    )
 
 
 def _oabug_factory() -> Callable[..., object]:

@@ -220,16 +220,10 @@ def node_parameter_overrides(items: Sequence[str]) -> dict[str, Any]:
             ``--noise``, ``--outer-optimizer``), a value of the wrong type, or one the node
             rejects.
     """
-    from bayes_swarm.errors import ConfigError
     from bayes_swarm.node_settings import PARAMETERS, settings_from_values
 
     declared = {spec.name: spec.default for spec in PARAMETERS}
-    overrides = parse_overrides(items, declared, reserved=SPAWNER_PARAMETERS)
-    try:
-        settings_from_values(overrides)
-    except ConfigError as err:
-        raise ConfigurationError(str(err)) from err
-    return overrides
+    return parse_overrides(items, declared, reserved=SPAWNER_PARAMETERS, check=settings_from_values)
 
 
 def node_parameters(case: SignalCase, settings: SpawnSettings, n: int, i: int) -> dict[str, Any]:

@@ -169,16 +169,11 @@ def controller_parameter_overrides(items: Sequence[str]) -> dict[str, Any]:
         ConfigurationError: a malformed item, an unknown or spawner-set name, a value of the
             wrong type, or one the controller rejects.
     """
-    from msc_pf.errors import ConfigError
     from msc_pf.parameters import config_from_parameters, parameter_defaults
 
-    declared = parameter_defaults()
-    overrides = parse_overrides(items, declared, reserved=SPAWNER_PARAMETERS)
-    try:
-        config_from_parameters({**declared, **overrides})
-    except ConfigError as err:
-        raise ConfigurationError(str(err)) from err
-    return overrides
+    return parse_overrides(
+        items, parameter_defaults(), reserved=SPAWNER_PARAMETERS, check=config_from_parameters
+    )
 
 
 def node_parameters(settings: SpawnSettings, index: int) -> dict[str, Any]:

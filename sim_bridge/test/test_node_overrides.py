@@ -65,3 +65,17 @@ def test_an_unknown_name_is_rejected_with_the_close_matches() -> None:
 def test_a_parameter_the_caller_sets_itself_cannot_be_overridden() -> None:
     with pytest.raises(ConfigurationError, match="'robot_index' is set by the spawner"):
         parse_overrides(['robot_index=3'], DECLARED, reserved=('robot_index',))
+
+
+def test_the_nodes_own_check_sees_defaults_and_overrides_and_its_error_is_reported() -> None:
+    seen = []
+
+    def check(values):
+        seen.append(values)
+        if values['scent_window_s'] > 10.0:
+            raise ValueError('scent_window_s must be at most 10 s')
+
+    assert parse_overrides(['scent_window_s=4'], DECLARED, check=check) == {'scent_window_s': 4.0}
+    assert seen == [{**DECLARED, 'scent_window_s': 4.0}]
+    with pytest.raises(ConfigurationError, match='scent_window_s must be at most 10 s'):
+        parse_overrides(['scent_window_s=12'], DECLARED, check=check)
