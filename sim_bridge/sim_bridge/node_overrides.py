@@ -33,23 +33,26 @@ def _split(item: str) -> tuple[str, str]:
 
 
 def _typed(name: str, text: str, default: object) -> object:
+    if isinstance(default, str):
+        return text
+    kinds = {bool: 'true or false', int: 'an integer', float: 'a finite number'}
+    if type(default) not in kinds:
+        msg = f'parameter {name} ({type(default).__name__}) cannot be set from the command line'
+        raise ConfigurationError(msg)
     try:
-        value = yaml.safe_load(text) if text else ''
+        value = yaml.safe_load(text) if text else None
     except yaml.YAMLError:
-        value = text
+        value = None
+    is_number = isinstance(value, (int, float)) and not isinstance(value, bool)
     if isinstance(default, bool):
         if isinstance(value, bool):
             return value
     elif isinstance(default, int):
-        if isinstance(value, int) and not isinstance(value, bool):
+        if is_number and isinstance(value, int):
             return value
-    elif isinstance(default, float):
-        number = isinstance(value, (int, float)) and not isinstance(value, bool)
-        if number and math.isfinite(float(value)):
-            return float(value)
-    elif isinstance(default, str):
-        return text
-    kind = {bool: 'true or false', int: 'an integer', float: 'a finite number'}[type(default)]
+    elif is_number and math.isfinite(float(value)):
+        return float(value)
+    kind = kinds[type(default)]
     msg = f'parameter {name}={text!r}: expected {kind}, like its default {default!r}'
     raise ConfigurationError(msg)
 

@@ -79,3 +79,8 @@ def test_the_nodes_own_check_sees_defaults_and_overrides_and_its_error_is_report
     assert seen == [{**DECLARED, 'scent_window_s': 4.0}]
     with pytest.raises(ConfigurationError, match='scent_window_s must be at most 10 s'):
         parse_overrides(['scent_window_s=12'], DECLARED, check=check)
+
+
+def test_a_parameter_of_a_type_the_command_line_cannot_express_is_refused() -> None:
+    with pytest.raises(ConfigurationError, match=r'target_ids \(list\) cannot be set'):
+        parse_overrides(['target_ids=[1, 2]'], {'target_ids': [-1]})
