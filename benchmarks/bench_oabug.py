@@ -15,7 +15,7 @@ With ``--out small.md`` every run is also written to ``small.csv`` (one row per 
 departure and variant), so two sweeps on the same sites can be compared run by run.
 
 ``--set NAME=VALUE ...`` runs every mission with OA-Bug node parameters other than the
-defaults (e.g. ``--set gas_threshold=300 sound_turn_rule=away``); they are typed and checked
+defaults (e.g. ``--set gas_threshold=300 sound_turn_rule=toward``); they are typed and checked
 before the first run and printed under the table.
 """
 

@@ -38,7 +38,14 @@ from oabug_robot.heading import angle_difference, preferred_direction, wrap_angl
 from oabug_robot.motion import Twist2D, follow_wall, go_straight, turn_in_place, wrap_corner
 from oabug_robot.pump import PumpScheduler
 from oabug_robot.scan_features import ScanFeatures
-from oabug_robot.settings import OABugConfig, SoundMemory, SoundTurnRule, TurnDirection, Variant
+from oabug_robot.settings import (
+    OABugConfig,
+    SoundMemory,
+    SoundTurnRule,
+    SoundWallSide,
+    TurnDirection,
+    Variant,
+)
 from oabug_robot.sound import PeerBearings, opposite_direction
 
 __all__ = ['Command', 'Event', 'FsmMemory', 'FsmState', 'Mode', 'OABugFsm', 'SensorSnapshot']
@@ -129,6 +136,7 @@ class FsmMemory:
     started_s: float | None = None
     last_step_s: float | None = None
     last_robot_hit_s: float = -math.inf
+    wall_contacts: int = 0  # Just Started -> Following Wall by hitting a wall
     random_distance_m: float = 0.0
     event: Event = Event.NONE
     counts: dict[Event, int] = field(default_factory=dict)
@@ -295,8 +303,9 @@ class OABugFsm:
             if theta is not None:
                 if self._config.sound_memory is SoundMemory.STORED:
                     mem.preferred_direction_rad = theta
-                if self._config.sound_picks_wall_side:
+                if self._sound_picks_wall_side():
                     side = self._side_from_sound(theta, snap.yaw_rad, side)
+        mem.wall_contacts += 1
         mem.state = FsmState.FOLLOWING_WALL
         mem.mode = Mode.FOLLOW
         mem.wall_side = side
@@ -305,6 +314,14 @@ class OABugFsm:
         mem.driven_since_wrap_m = math.inf
         self._corners.reset()
         self._record(Event.HIT_WALL)
+
+    def _sound_picks_wall_side(self) -> bool:
+        """Whether this wall contact takes its side from theta_opp (sound variants only)."""
+        cfg = self._config
+        rule = cfg.gas_sound_wall_side if cfg.variant is Variant.GAS_SOUND else cfg.sound_wall_side
+        if rule is SoundWallSide.EVERY_CONTACT:
+            return True
+        return rule is SoundWallSide.FIRST_CONTACT and self._memory.wall_contacts == 0
 
     def _on_inner_corner_after_revisit(self) -> None:
         """Hitting a wall in Just Started (still on the wall after a revisit): Following Wall.

@@ -49,6 +49,7 @@ from oabug_robot.settings import (
     PerceptionConfig,
     SoundMemory,
     SoundTurnRule,
+    SoundWallSide,
     SoundWeighting,
     TurnDirection,
     Variant,
@@ -115,12 +116,19 @@ PARAMETERS: tuple[tuple[str, Any, str], ...] = (
     (
         'sound_turn_rule',
         _DEFAULTS.sound_turn_rule.value,
-        "toward (authors' simulator) or away (authors' robot)",
+        'wall side from the sound: away (towards theta_opp, paper) or toward the peers',
     ),
     (
-        'sound_picks_wall_side',
-        _DEFAULTS.sound_picks_wall_side,
-        'sound variants pick the wall side from theta_opp (paper); false: fixed_turn',
+        'sound_wall_side',
+        _DEFAULTS.sound_wall_side.value,
+        'Sound variant: wall contacts whose side the sound picks: every_contact (paper), '
+        'first_contact or never (fixed_turn)',
+    ),
+    (
+        'gas_sound_wall_side',
+        _DEFAULTS.gas_sound_wall_side.value,
+        'Gas+Sound: the same; first_contact (the paper discussion), every_contact '
+        '(Table I) or never',
     ),
     ('sound_weighting', _DEFAULTS.sound_weighting.value, 'distance (paper) or unit'),
     (
@@ -202,7 +210,10 @@ def config_from_parameters(values: dict[str, Any]) -> OABugConfig:
         fixed_turn=_parse(TurnDirection, 'fixed_turn', str(values['fixed_turn'])),
         robot_hit_repeat_s=float(values['robot_hit_repeat_s']),
         sound_turn_rule=_parse(SoundTurnRule, 'sound_turn_rule', str(values['sound_turn_rule'])),
-        sound_picks_wall_side=bool(values['sound_picks_wall_side']),
+        sound_wall_side=_parse(SoundWallSide, 'sound_wall_side', str(values['sound_wall_side'])),
+        gas_sound_wall_side=_parse(
+            SoundWallSide, 'gas_sound_wall_side', str(values['gas_sound_wall_side'])
+        ),
         sound_weighting=_parse(SoundWeighting, 'sound_weighting', str(values['sound_weighting'])),
         sound_memory=_parse(SoundMemory, 'sound_memory', str(values['sound_memory'])),
         sound_updates_at_corner=bool(values['sound_updates_at_corner']),

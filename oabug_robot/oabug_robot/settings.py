@@ -24,6 +24,7 @@ __all__ = [
     'PerceptionConfig',
     'SoundMemory',
     'SoundTurnRule',
+    'SoundWallSide',
     'SoundWeighting',
     'TurnDirection',
     'Variant',
@@ -84,10 +85,18 @@ class TurnDirection(Enum):
 
 
 class SoundTurnRule(Enum):
-    """How the sound variants pick the wall-following side at a first wall contact."""
+    """How a sound variant picks the wall-following side when the sound picks it."""
 
-    AWAY = 'away'  # the authors' robot: turn away from the peers
+    AWAY = 'away'  # paper ("turns ... according to" theta_opp) and the authors' robot
     TOWARD = 'toward'  # the authors' simulator: turn toward the peers' resultant
+
+
+class SoundWallSide(Enum):
+    """At which wall contacts (Just Started -> Following Wall) the sound picks the side."""
+
+    EVERY_CONTACT = 'every_contact'  # Table I
+    FIRST_CONTACT = 'first_contact'  # the paper's discussion: the first wall hit only
+    NEVER = 'never'  # always fixed_turn; theta_opp only says where to leave a wall
 
 
 class SoundWeighting(Enum):
@@ -287,13 +296,18 @@ class OABugConfig:
             another robot (paper: "all turn right").
         robot_hit_repeat_s: a robot hit this soon after the previous one turns to a random
             heading instead of right, to break jams of two robots (0 disables) [s].
-        sound_turn_rule: see SoundTurnRule; the paper does not say which (default: toward,
-            as in the authors' simulator that produced the paper's figures).
-        sound_picks_wall_side: the sound variants pick the wall-following side at a wall
-            contact from theta_opp (sound_turn_rule), as Table I says ("turns left or right
-            according to its direction"); False turns the fixed way (fixed_turn) as Minimum
-            and Gas do, and theta_opp is used only for leaving walls. Not the paper; kept as
-            an option because it measured better here (docs/oabug.md, Results).
+        sound_turn_rule: see SoundTurnRule. Table I has the robot update phi'_i = theta_opp
+            and turn "according to its direction", i.e. towards theta_opp, away from the
+            peers, as the authors' robot does (default); their simulator turns toward the
+            peers' resultant.
+        sound_wall_side: at which wall contacts the Sound variant takes its side from
+            theta_opp (see SoundWallSide; Table I: every contact).
+        gas_sound_wall_side: the same for Gas+Sound. Table I says every contact; the
+            paper's discussion explains Gas+Sound's lead from the edge by robots that "turn
+            in different directions" when first hitting the wall. Default (not Table I):
+            the first contact only, the fixed side after it, so followers keep one hand and
+            do not meet head on along a wall; measured against every contact and never in
+            docs/oabug.md ("The wall side of Gas+Sound").
         sound_weighting: see SoundWeighting (paper: distance).
         sound_memory: see SoundMemory; the paper's text says stored, its 180 deg flip
             ("an area symmetrical ... with respect to the departure point") only makes sense
@@ -323,8 +337,9 @@ class OABugConfig:
     wall_end_face_m: float = 0.15
     fixed_turn: TurnDirection = TurnDirection.RIGHT
     robot_hit_repeat_s: float = 4.0
-    sound_turn_rule: SoundTurnRule = SoundTurnRule.TOWARD
-    sound_picks_wall_side: bool = True
+    sound_turn_rule: SoundTurnRule = SoundTurnRule.AWAY
+    sound_wall_side: SoundWallSide = SoundWallSide.EVERY_CONTACT
+    gas_sound_wall_side: SoundWallSide = SoundWallSide.FIRST_CONTACT
     sound_weighting: SoundWeighting = SoundWeighting.DISTANCE
     sound_memory: SoundMemory = SoundMemory.ONCE
     sound_updates_at_corner: bool = True

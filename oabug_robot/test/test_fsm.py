@@ -14,6 +14,7 @@ from oabug_robot.settings import (
     PerceptionConfig,
     SoundMemory,
     SoundTurnRule,
+    SoundWallSide,
     TurnDirection,
     Variant,
 )
@@ -555,7 +556,13 @@ def test_sound_direction_is_opposite_to_the_resultant_of_the_bearings() -> None:
 def test_sound_variants_choose_the_wall_side_from_the_peers(
     variant: Variant, rule: SoundTurnRule, expected_side: int
 ) -> None:
-    fsm = make(variant, robot_count=2, sound_turn_rule=rule)
+    fsm = make(
+        variant,
+        robot_count=2,
+        sound_turn_rule=rule,
+        sound_wall_side=SoundWallSide.EVERY_CONTACT,
+        gas_sound_wall_side=SoundWallSide.EVERY_CONTACT,
+    )
     script = Script(fsm, yaw_rad=0.0)
     script.step(free(), yaw_rad=fsm.memory.preferred_direction_rad)
     script.step(free(), yaw_rad=0.0)
@@ -722,24 +729,63 @@ def test_commands_are_python_floats_and_bools() -> None:
     assert type(command.pump_on) is bool
 
 
-@pytest.mark.parametrize(('picks', 'expected_side'), [(True, -1), (False, 1)])
+def wall_sides_of_two_contacts(fsm: OABugFsm) -> tuple[int, int]:
+    """Wall side taken at a first wall contact, and at a second one after a robot hit.
+
+    The peer is on the right both times, so theta_opp lies to the left: the sound side
+    (away: towards theta_opp) keeps the wall on the right (-1), the fixed right turn on
+    the left (+1).
+    """
+    script = Script(fsm, yaw_rad=0.0)
+    script.step(free(), yaw_rad=fsm.memory.preferred_direction_rad)
+    script.step(free(), yaw_rad=0.0)
+    script.hear([-90.0])
+    script.step(wall_ahead())
+    first = fsm.memory.wall_side
+    script.follow_straight(first)
+    script.step(robot_ahead())
+    assert fsm.memory.state is FsmState.JUST_STARTED
+    script.step(free(), yaw_rad=fsm.memory.target_yaw_rad)
+    script.hear([-90.0])
+    script.step(wall_ahead())
+    assert fsm.memory.state is FsmState.FOLLOWING_WALL
+    assert fsm.memory.wall_contacts == 2
+    return first, fsm.memory.wall_side
+
+
+@pytest.mark.parametrize(
+    ('rule', 'expected_sides'),
+    [
+        (SoundWallSide.EVERY_CONTACT, (-1, -1)),
+        (SoundWallSide.FIRST_CONTACT, (-1, 1)),
+        (SoundWallSide.NEVER, (1, 1)),
+    ],
+)
 @pytest.mark.parametrize('variant', [Variant.SOUND, Variant.GAS_SOUND])
-def test_sound_picks_wall_side_off_turns_the_fixed_way(
-    variant: Variant, picks: bool, expected_side: int
+def test_wall_side_rule_decides_which_contacts_take_the_side_from_the_sound(
+    variant: Variant, rule: SoundWallSide, expected_sides: tuple[int, int]
 ) -> None:
-    """sound_picks_wall_side false: the fixed turn (right) whatever the peers' side."""
+    """Each sound variant reads its own rule; the other variant's rule does not matter."""
+    other = (
+        SoundWallSide.NEVER if rule is SoundWallSide.EVERY_CONTACT else SoundWallSide.EVERY_CONTACT
+    )
+    own, others = (
+        ('gas_sound_wall_side', 'sound_wall_side')
+        if variant is Variant.GAS_SOUND
+        else ('sound_wall_side', 'gas_sound_wall_side')
+    )
     fsm = make(
         variant,
         robot_count=2,
         fixed_turn=TurnDirection.RIGHT,
-        sound_turn_rule=SoundTurnRule.TOWARD,
-        sound_picks_wall_side=picks,
+        sound_turn_rule=SoundTurnRule.AWAY,
+        **{own: rule, others: other},
     )
-    script = Script(fsm, yaw_rad=0.0)
-    script.step(free(), yaw_rad=fsm.memory.preferred_direction_rad)
-    script.step(free(), yaw_rad=0.0)
-    script.hear([90.0])  # the peer on the left: toward it keeps the wall on the right
-    command = script.step(wall_ahead())
-    assert fsm.memory.state is FsmState.FOLLOWING_WALL
-    assert fsm.memory.wall_side == expected_side
-    assert math.copysign(1.0, command.angular_radps) == -expected_side
+    assert wall_sides_of_two_contacts(fsm) == expected_sides
+
+
+def test_defaults_take_the_sound_side_at_every_contact_for_sound_and_the_first_for_gas_sound():
+    sound = make(Variant.SOUND, robot_count=2)
+    gas_sound = make(Variant.GAS_SOUND, robot_count=2)
+    assert wall_sides_of_two_contacts(sound) == (-1, -1)
+    assert wall_sides_of_two_contacts(gas_sound) == (-1, 1)

@@ -215,6 +215,7 @@ def test_scent_above_the_threshold_shows_in_the_state(make_harness) -> None:
         ('departure', 'roof', 'center or edge'),
         ('robot_index', 5, 'robot_index'),
         ('sound_turn_rule', 'sideways', 'sound_turn_rule'),
+        ('gas_sound_wall_side', 'second_contact', 'gas_sound_wall_side'),
         ('control_rate_hz', 0.0, 'control_rate_hz'),
     ],
 )

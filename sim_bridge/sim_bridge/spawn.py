@@ -344,7 +344,7 @@ def _parser() -> argparse.ArgumentParser:
         default=[],
         metavar='NAME=VALUE',
         help='set an OA-Bug node parameter for every robot (repeatable), e.g. '
-        'gas_threshold=300 or sound_turn_rule=away; names and defaults: docs/oabug.md',
+        'gas_threshold=300 or sound_turn_rule=toward; names and defaults: docs/oabug.md',
     )
     return parser
 

@@ -129,13 +129,13 @@ def test_spawner_parameters_reach_every_robot_node_typed():
     pytest.importorskip('oabug_robot.node')
     from sim_bridge.spawn import SpawnConfig, build_mission, oabug_parameter_overrides
 
-    overrides = oabug_parameter_overrides(['gas_threshold=300', 'sound_turn_rule=away'])
+    overrides = oabug_parameter_overrides(['gas_threshold=300', 'sound_turn_rule=toward'])
     spec, _ = build_mission(
         SpawnConfig(site=str(FIVE_ROOMS), departure='edge', robots=3, robot_parameters=overrides)
     )
     for index, robot in enumerate(spec.robots):
         assert robot.parameters['gas_threshold'] == 300
-        assert robot.parameters['sound_turn_rule'] == 'away'
+        assert robot.parameters['sound_turn_rule'] == 'toward'
         assert robot.parameters['robot_index'] == index
 
 

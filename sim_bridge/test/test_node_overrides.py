@@ -7,7 +7,7 @@ from sim_bridge.node_overrides import parse_overrides
 DECLARED = {
     'gas_threshold': 200,
     'scent_window_s': 2.0,
-    'sound_picks_wall_side': True,
+    'sound_updates_at_corner': True,
     'sound_turn_rule': 'toward',
     'robot_index': 0,
 }
@@ -18,7 +18,7 @@ def test_values_take_the_type_of_the_declared_default() -> None:
         [
             'gas_threshold=300',
             'scent_window_s:=1',
-            'sound_picks_wall_side=false',
+            'sound_updates_at_corner=false',
             'sound_turn_rule = away',
         ],
         DECLARED,
@@ -26,7 +26,7 @@ def test_values_take_the_type_of_the_declared_default() -> None:
     assert values == {
         'gas_threshold': 300,
         'scent_window_s': 1.0,
-        'sound_picks_wall_side': False,
+        'sound_updates_at_corner': False,
         'sound_turn_rule': 'away',
     }
     assert isinstance(values['scent_window_s'], float)
@@ -46,7 +46,7 @@ def test_a_later_override_of_the_same_name_wins() -> None:
         ('gas_threshold=abc', 'expected an integer'),
         ('scent_window_s=.inf', 'expected a finite number'),
         ('scent_window_s=fast', 'expected a finite number'),
-        ('sound_picks_wall_side=1', 'expected true or false'),
+        ('sound_updates_at_corner=1', 'expected true or false'),
         ('gas_threshold', 'must look like NAME=VALUE'),
         ('=3', 'must look like NAME=VALUE'),
     ],
