@@ -31,15 +31,19 @@ import argparse  # noqa: E402
 import itertools  # noqa: E402
 import math  # noqa: E402
 import time  # noqa: E402
+from collections.abc import Sequence  # noqa: E402
 from concurrent.futures import ProcessPoolExecutor  # noqa: E402
-from dataclasses import dataclass, is_dataclass, replace  # noqa: E402
+from dataclasses import dataclass  # noqa: E402
 from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
+from msc_pf.parameters import config_from_parameters, parameter_defaults  # noqa: E402
 from msc_pf.particle_filter import ParticleFilterBank, resolve_backend  # noqa: E402
 from msc_pf.schemes import Scheme  # noqa: E402
 from msc_pf.settings import MscPfConfig, ParticleFilterConfig, RadioConfig  # noqa: E402
+from sim_bridge.errors import ConfigurationError  # noqa: E402
 from sim_bridge.msc_pf_batch import BatchScenario, run_batch  # noqa: E402
+from sim_bridge.node_overrides import parse_overrides  # noqa: E402
 
 SCHEMES = ('proposed', 'msc_pf', 'msc')
 CSV_HEADER = 'scheme,targets,robots,seed,cct_s,finished,wall_s,mean_capture_s,cpu_s\n'
@@ -61,40 +65,31 @@ class RunOutcome:
     cpu_time_s: float = math.nan
 
 
-Overrides = tuple[tuple[str, str], ...]
+Overrides = tuple[tuple[str, object], ...]
 """Controller settings changed from the defaults: ('section.field', value as text)."""
 
 Job = tuple[str, int, int, int, float, Overrides]
 
 
-def _parse_value(text: str, current: object) -> object:
-    """``text`` read as the type of the field's ``current`` value."""
-    if isinstance(current, bool):
-        if text.lower() not in ('true', 'false'):
-            raise ValueError(f'expected true or false, got {text!r}')
-        return text.lower() == 'true'
-    if isinstance(current, int):
-        return int(text)
-    if isinstance(current, float) or current is None:
-        return float(text)
-    return text
+def controller_overrides(items: Sequence[str]) -> Overrides:
+    """Controller settings from ``SECTION.FIELD=VALUE`` items, typed and checked.
+
+    The names and the checks are those of the msc_pf node's parameters
+    (``sim_bridge.node_overrides``); ``scheme`` comes from ``--schemes``.
+
+    Raises:
+        ConfigurationError: a malformed item, an unknown name, ``scheme``, a value of the
+            wrong type, or one the controller rejects.
+    """
+    values = parse_overrides(
+        items, parameter_defaults(), reserved=('scheme',), check=config_from_parameters
+    )
+    return tuple(sorted(values.items()))
 
 
 def controller_config(overrides: Overrides) -> MscPfConfig:
-    """The default controller configuration with ``overrides`` applied.
-
-    Raises:
-        ValueError: an unknown section or field, or a value of the wrong type.
-    """
-    config = MscPfConfig()
-    for name, text in overrides:
-        section, _, field_name = name.partition('.')
-        part = getattr(config, section, None)
-        if part is None or not is_dataclass(part) or field_name not in part.__dataclass_fields__:
-            raise ValueError(f'unknown controller setting {name!r}')
-        value = _parse_value(text, getattr(part, field_name))
-        config = replace(config, **{section: replace(part, **{field_name: value})})
-    return config
+    """The default controller configuration with typed ``overrides`` applied."""
+    return config_from_parameters(dict(overrides))
 
 
 def _run_one(job: Job) -> RunOutcome:
@@ -435,9 +430,10 @@ def main() -> None:
         '--table-from', type=Path, help='only print the tables of a CSV of finished runs'
     )
     args = parser.parse_args()
-    overrides: Overrides = tuple(
-        (name.strip(), value.strip()) for name, _, value in (s.partition('=') for s in args.set)
-    )
+    try:
+        overrides = controller_overrides(args.set)
+    except ConfigurationError as err:
+        parser.error(str(err))
     if args.table_from is not None:
         outcomes = read_outcomes(args.table_from)
         schemes = tuple(args.schemes)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import pytest
+from sim_bridge.errors import ConfigurationError
 
 
 @pytest.fixture
@@ -11,30 +12,41 @@ def bench(benchmark_script):
 
 
 def test_settings_are_read_as_their_fields_types(bench):
-    config = bench.controller_config(
-        (
-            ('phases.unheard_updates', 'true'),
-            ('phases.recorded_max_age_s', '900'),
-            ('swarm.max_size', '4'),
-            ('msc.leader_rule', 'pbest'),
-        )
+    overrides = bench.controller_overrides(
+        [
+            'phases.unheard_updates=true',
+            'phases.recorded_max_age_s=900',
+            'swarm.max_size=4',
+            'msc.leader_rule=pbest',
+        ]
     )
+    config = bench.controller_config(overrides)
     assert config.phases.unheard_updates is True
     assert config.phases.recorded_max_age_s == 900.0
     assert config.swarm.max_size == 4
     assert config.msc.leader_rule == 'pbest'
-    assert bench.controller_config(()) == bench.MscPfConfig()
+    assert bench.controller_config(bench.controller_overrides([])) == bench.MscPfConfig()
 
 
 @pytest.mark.parametrize(
     ('setting', 'message'),
     [
-        (('phases.no_such_field', '1'), 'unknown controller setting'),
-        (('nowhere.x', '1'), 'unknown controller setting'),
-        (('phases.unheard_updates', 'yes'), 'expected true or false'),
-        (('swarm.max_size', 'three'), 'invalid literal'),
+        ('phases.no_such_field=1', 'unknown parameter'),
+        ('nowhere.x=1', 'unknown parameter'),
+        ('phases.unheard_updates=maybe', 'expected true or false'),
+        ('swarm.max_size=three', 'expected an integer'),
+        ('scheme=msc', "'scheme' is set by"),
+        ('swarm.max_size=0', 'max_size'),
     ],
 )
 def test_unknown_settings_and_bad_values_are_rejected(bench, setting, message):
-    with pytest.raises(ValueError, match=message):
-        bench.controller_config((setting,))
+    with pytest.raises(ConfigurationError, match=message):
+        bench.controller_overrides([setting])
+
+
+def test_a_bad_setting_stops_the_benchmark_before_any_run(bench, monkeypatch, capsys):
+    monkeypatch.setattr('sys.argv', ['bench_msc_pf.py', '--set', 'phases.unheard_updates=maybe'])
+    with pytest.raises(SystemExit) as exit_info:
+        bench.main()
+    assert exit_info.value.code == 2
+    assert 'expected true or false' in capsys.readouterr().err
