@@ -38,33 +38,89 @@ DEPARTURES = ('center', 'edge')
 PATHS = ('batch', 'ros')
 SWEEP_RUNS = 1000
 
-# Authors' simulator, 100 Small / 20 Medium sites, 10 robots: mean +- std coverage [%].
-REFERENCE = {
-    'small': {
-        ('center', 'random'): (15.53, 6.17),
-        ('center', 'minimum'): (28.17, 7.53),
-        ('center', 'sound'): (33.20, 7.70),
-        ('center', 'gas'): (96.07, 7.14),
-        ('center', 'gas_sound'): (96.27, 5.40),
-        ('edge', 'random'): (8.10, 4.99),
-        ('edge', 'minimum'): (20.33, 7.36),
-        ('edge', 'sound'): (25.57, 9.76),
-        ('edge', 'gas'): (84.17, 21.07),
-        ('edge', 'gas_sound'): (95.43, 6.64),
-    },
-    'medium': {
-        ('center', 'random'): (14.00, 4.52),
-        ('center', 'minimum'): (17.25, 4.63),
-        ('center', 'sound'): (19.25, 4.55),
-        ('center', 'gas'): (93.75, 5.62),
-        ('center', 'gas_sound'): (92.25, 4.51),
-        ('edge', 'random'): (10.75, 3.63),
-        ('edge', 'minimum'): (13.50, 5.05),
-        ('edge', 'sound'): (13.83, 6.28),
-        ('edge', 'gas'): (74.75, 27.09),
-        ('edge', 'gas_sound'): (88.25, 6.66),
-    },
+
+@dataclass(frozen=True)
+class ReferenceSweep:
+    """The authors' simulator on one configuration and robot count (Table II budget).
+
+    Attributes:
+        sites: how many generated sites the figures average over.
+        section: where REFERENCE_OABUG_SIM.md gives them.
+        coverage: (departure, variant) -> mean and population std of coverage [%].
+    """
+
+    sites: int
+    section: str
+    coverage: dict[tuple[str, str], tuple[float, float]]
+
+
+def _reference(
+    sites: int, section: str, center: Sequence[float], edge: Sequence[float]
+) -> ReferenceSweep:
+    """A sweep from (mean, std) pairs listed in VARIANTS order per departure."""
+    coverage = {}
+    for departure, values in (('center', center), ('edge', edge)):
+        for i, variant in enumerate(VARIANTS):
+            coverage[(departure, variant)] = (values[2 * i], values[2 * i + 1])
+    return ReferenceSweep(sites, section, coverage)
+
+
+# The authors' simulator as measured for this project (REFERENCE_OABUG_SIM.md §5), keyed by
+# (configuration, robots). Mean and std of coverage [%] in the order random, minimum, sound,
+# gas, gas_sound. Only figures measured at the Table II budget are listed.
+REFERENCE: dict[tuple[str, int], ReferenceSweep] = {
+    ('small', 10): _reference(
+        100,
+        '§5.1',
+        (15.53, 6.17, 28.17, 7.53, 33.20, 7.70, 96.07, 7.14, 96.27, 5.40),
+        (8.10, 4.99, 20.33, 7.36, 25.57, 9.76, 84.17, 21.07, 95.43, 6.64),
+    ),
+    ('small', 8): _reference(
+        30,
+        '§5.3',
+        (13.4, 5.6, 24.9, 8.5, 27.8, 9.7, 95.7, 7.5, 95.6, 5.3),
+        (7.9, 6.1, 16.0, 8.5, 21.1, 9.7, 81.3, 22.3, 94.4, 7.1),
+    ),
+    ('small', 6): _reference(
+        30,
+        '§5.3',
+        (11.6, 4.3, 19.7, 7.6, 22.2, 7.3, 93.9, 11.6, 92.7, 7.6),
+        (7.1, 4.9, 15.3, 7.3, 18.9, 8.5, 75.4, 27.2, 90.7, 9.8),
+    ),
+    ('small', 4): _reference(
+        30,
+        '§5.3',
+        (7.7, 4.6, 14.6, 8.1, 15.3, 6.2, 93.7, 10.7, 91.3, 8.6),
+        (5.8, 4.4, 11.6, 4.8, 13.7, 6.4, 71.3, 22.0, 89.1, 12.9),
+    ),
+    ('small', 2): _reference(
+        30,
+        '§5.3',
+        (5.8, 3.7, 7.6, 5.2, 7.3, 3.9, 82.2, 15.8, 72.9, 19.3),
+        (3.8, 3.6, 6.7, 4.0, 7.1, 4.2, 72.2, 21.5, 59.4, 25.1),
+    ),
+    ('medium', 10): _reference(
+        20,
+        '§5.2',
+        (14.00, 4.52, 17.25, 4.63, 19.25, 4.55, 93.75, 5.62, 92.25, 4.51),
+        (10.75, 3.63, 13.50, 5.05, 13.83, 6.28, 74.75, 27.09, 88.25, 6.66),
+    ),
+    ('big', 10): _reference(
+        10,
+        '§5.4',
+        (11.58, 3.81, 8.58, 1.40, 10.17, 2.13, 92.75, 3.12, 85.17, 4.39),
+        (8.25, 2.78, 5.42, 3.06, 7.00, 2.18, 76.42, 18.37, 80.58, 8.43),
+    ),
 }
+
+
+def reference_for(config: str, robots: int, actions: int | None) -> ReferenceSweep | None:
+    """The authors' figures comparable with a sweep, or None (other robots or budget)."""
+    from sim_bridge.site_loading import site_budget_actions
+
+    if actions is not None and actions != site_budget_actions(config):
+        return None
+    return REFERENCE.get((config, robots))
 
 
 @dataclass(frozen=True)
@@ -144,12 +200,15 @@ def _mean_std(values: Sequence[float]) -> tuple[float, float]:
     return mean, math.sqrt(sum((v - mean) ** 2 for v in values) / n)
 
 
-def format_table(outcomes: Sequence[Outcome], config: str) -> str:
-    """Markdown table of coverage (mean +- population std over sites) and throughput."""
+def format_table(outcomes: Sequence[Outcome], reference: ReferenceSweep | None) -> str:
+    """Markdown table of coverage (mean +- population std over sites) and throughput.
+
+    ``reference`` fills the authors' column (n/a without one) and a note under the table.
+    """
     groups: dict[tuple[str, str], list[Outcome]] = defaultdict(list)
     for o in outcomes:
         groups[(o.job.departure, o.job.variant)].append(o)
-    reference = REFERENCE.get(config, {})
+    coverage = reference.coverage if reference is not None else {}
     lines = [
         "| departure | variant | runs | coverage % (this suite) | authors' simulator % "
         '| full coverage runs | CPU s/run | wall s/run | robot-m per wall s |',
@@ -161,7 +220,7 @@ def format_table(outcomes: Sequence[Outcome], config: str) -> str:
             if not runs:
                 continue
             mean, std = _mean_std([100.0 * o.coverage for o in runs])
-            ref = reference.get((departure, variant))
+            ref = coverage.get((departure, variant))
             ref_text = f'{ref[0]:.1f} +- {ref[1]:.1f}' if ref else 'n/a'
             full = sum(o.coverage >= 1.0 for o in runs)
             wall = sum(o.wall_time_s for o in runs) / len(runs)
@@ -171,6 +230,15 @@ def format_table(outcomes: Sequence[Outcome], config: str) -> str:
                 f'| {departure} | {variant} | {len(runs)} | {mean:.1f} +- {std:.1f} | {ref_text} '
                 f'| {full} | {cpu:.1f} | {wall:.1f} | {metres:.0f} |'
             )
+    if reference is None:
+        lines.append(
+            "\nNo authors' figures were measured for this configuration, robot count and budget."
+        )
+    else:
+        lines.append(
+            f"\nAuthors' simulator: the same configuration, robot count and Table II budget, "
+            f'{reference.sites} sites (REFERENCE_OABUG_SIM.md {reference.section}).'
+        )
     return '\n'.join(lines)
 
 
@@ -343,7 +411,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         path=args.path,
         parameters=parameters,
     )
-    table = format_table(outcomes, args.config)
+    table = format_table(outcomes, reference_for(args.config, args.robots, args.actions))
     footer = '\n' + format_footer(outcomes, total_s, args)
     print(table + footer)
     if args.out is not None:
