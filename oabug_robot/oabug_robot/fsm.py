@@ -338,13 +338,20 @@ class OABugFsm:
     def _side_from_sound(self, theta_rad: float, yaw_rad: float, default_side: int) -> int:
         """Wall side for turning towards (TOWARD) or away from (AWAY) the peers.
 
-        Turning left (towards theta_opp on the left) keeps the wall on the right (-1).
+        Turning left (towards theta_opp on the left) keeps the wall on the right (-1). A
+        theta_opp within the deadband of straight ahead or behind keeps ``default_side``.
         """
         relative = angle_difference(theta_rad, yaw_rad)
-        if relative == 0.0 or abs(relative) == math.pi:
+        cfg = self._config
+        deadband = (
+            cfg.gas_sound_side_deadband_rad
+            if cfg.variant is Variant.GAS_SOUND
+            else cfg.sound_side_deadband_rad
+        )
+        if abs(relative) <= deadband or abs(relative) >= math.pi - deadband:
             return default_side
         away_side = -1 if relative > 0.0 else 1
-        return away_side if self._config.sound_turn_rule is SoundTurnRule.AWAY else -away_side
+        return away_side if cfg.sound_turn_rule is SoundTurnRule.AWAY else -away_side
 
     def _on_outer_corner(self, snap: SensorSnapshot) -> None:
         mem = self._memory

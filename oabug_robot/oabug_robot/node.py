@@ -130,6 +130,17 @@ PARAMETERS: tuple[tuple[str, Any, str], ...] = (
         'Gas+Sound: the same; first_contact (the paper discussion), every_contact '
         '(Table I) or never',
     ),
+    (
+        'sound_side_deadband_deg',
+        math.degrees(_DEFAULTS.sound_side_deadband_rad),
+        'Sound variant: theta_opp this close to straight ahead or behind picks no side, '
+        'fixed_turn is taken (paper: 0) [deg]',
+    ),
+    (
+        'gas_sound_side_deadband_deg',
+        math.degrees(_DEFAULTS.gas_sound_side_deadband_rad),
+        'Gas+Sound: the same [deg]',
+    ),
     ('sound_weighting', _DEFAULTS.sound_weighting.value, 'distance (paper) or unit'),
     (
         'sound_memory',
@@ -214,6 +225,8 @@ def config_from_parameters(values: dict[str, Any]) -> OABugConfig:
         gas_sound_wall_side=_parse(
             SoundWallSide, 'gas_sound_wall_side', str(values['gas_sound_wall_side'])
         ),
+        sound_side_deadband_rad=math.radians(float(values['sound_side_deadband_deg'])),
+        gas_sound_side_deadband_rad=math.radians(float(values['gas_sound_side_deadband_deg'])),
         sound_weighting=_parse(SoundWeighting, 'sound_weighting', str(values['sound_weighting'])),
         sound_memory=_parse(SoundMemory, 'sound_memory', str(values['sound_memory'])),
         sound_updates_at_corner=bool(values['sound_updates_at_corner']),

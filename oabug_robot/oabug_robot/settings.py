@@ -308,6 +308,15 @@ class OABugConfig:
             the first contact only, the fixed side after it, so followers keep one hand and
             do not meet head on along a wall; measured against every contact and never in
             docs/oabug.md ("The wall side of Gas+Sound").
+        sound_side_deadband_rad: for the Sound variant, a theta_opp within this angle of
+            straight ahead or straight behind gives no side (both turns point equally
+            towards it, and bearing noise decides): such a contact takes ``fixed_turn``.
+            0 (default) lets any offset decide, as the paper and the authors' code do; the
+            Sound variant, which has no scent trail, spreads by those split sides [rad].
+        gas_sound_side_deadband_rad: the same for Gas+Sound. Default 45 deg (not in the
+            paper): robots that leave the centre in a symmetric fan hear their peers behind
+            them, and splitting their sides at random cost Gas+Sound 3-14 points of
+            coverage with 2-8 robots; measured in docs/oabug.md ("Robot count") [rad].
         sound_weighting: see SoundWeighting (paper: distance).
         sound_memory: see SoundMemory; the paper's text says stored, its 180 deg flip
             ("an area symmetrical ... with respect to the departure point") only makes sense
@@ -340,6 +349,8 @@ class OABugConfig:
     sound_turn_rule: SoundTurnRule = SoundTurnRule.AWAY
     sound_wall_side: SoundWallSide = SoundWallSide.EVERY_CONTACT
     gas_sound_wall_side: SoundWallSide = SoundWallSide.FIRST_CONTACT
+    sound_side_deadband_rad: float = 0.0
+    gas_sound_side_deadband_rad: float = math.radians(45.0)
     sound_weighting: SoundWeighting = SoundWeighting.DISTANCE
     sound_memory: SoundMemory = SoundMemory.ONCE
     sound_updates_at_corner: bool = True
@@ -383,4 +394,11 @@ class OABugConfig:
             math.isfinite(self.pump_min_speed_mps) and self.pump_min_speed_mps >= 0.0,
             'pump_min_speed_mps must be >= 0',
         )
+        for name in ('sound_side_deadband_rad', 'gas_sound_side_deadband_rad'):
+            deadband = getattr(self, name)
+            _require(
+                0.0 <= deadband <= math.pi / 2,
+                f'{name.removesuffix("_rad")} must be in [0, 90] deg, '
+                f'got {math.degrees(deadband)} deg',
+            )
         _require(self.seed >= 0, 'seed must be >= 0')

@@ -573,6 +573,60 @@ def test_sound_variants_choose_the_wall_side_from_the_peers(
     assert math.copysign(1.0, command.angular_radps) == -expected_side
 
 
+@pytest.mark.parametrize(
+    ('peer_deg', 'deadband_deg', 'expected_side'),
+    [
+        (-150.0, 45.0, 1),  # theta_opp 30 deg left of ahead: no side, the fixed right turn
+        (-150.0, 0.0, -1),  # any offset decides: towards theta_opp, wall on the right
+        (-150.0, 25.0, -1),  # 30 deg is outside a 25 deg deadband
+        (20.0, 45.0, 1),  # theta_opp 160 deg right, 20 deg from behind: no side
+        (20.0, 0.0, 1),  # decided: away from the peer ahead-left, wall on the left
+        (-20.0, 0.0, -1),
+        (-20.0, 45.0, 1),
+        (-90.0, 45.0, -1),  # theta_opp square to the left: the sound decides
+    ],
+)
+@pytest.mark.parametrize('variant', [Variant.SOUND, Variant.GAS_SOUND])
+def test_sound_gives_no_wall_side_when_theta_opp_is_near_ahead_or_behind(
+    variant: Variant, peer_deg: float, deadband_deg: float, expected_side: int
+) -> None:
+    """Each variant reads its own deadband; the other variant's is set to the opposite."""
+    own, other = (
+        ('gas_sound_side_deadband_rad', 'sound_side_deadband_rad')
+        if variant is Variant.GAS_SOUND
+        else ('sound_side_deadband_rad', 'gas_sound_side_deadband_rad')
+    )
+    fsm = make(
+        variant,
+        robot_count=2,
+        fixed_turn=TurnDirection.RIGHT,
+        sound_turn_rule=SoundTurnRule.AWAY,
+        gas_sound_wall_side=SoundWallSide.EVERY_CONTACT,
+        **{own: math.radians(deadband_deg), other: math.radians(45.0 - deadband_deg)},
+    )
+    assert first_wall_side(fsm, peer_deg) == expected_side
+
+
+def first_wall_side(fsm: OABugFsm, peer_deg: float) -> int:
+    """Wall side taken at the first wall contact, heading 0, with one peer heard at peer_deg."""
+    script = Script(fsm, yaw_rad=0.0)
+    script.step(free(), yaw_rad=fsm.memory.preferred_direction_rad)
+    script.step(free(), yaw_rad=0.0)
+    script.hear([peer_deg])
+    script.step(wall_ahead())
+    assert fsm.memory.state is FsmState.FOLLOWING_WALL
+    return fsm.memory.wall_side
+
+
+def test_by_default_only_gas_sound_ignores_a_theta_opp_near_straight_ahead() -> None:
+    # theta_opp 30 deg left of ahead: the Sound variant turns towards it (wall on the
+    # right), Gas+Sound takes the fixed right turn (wall on the left).
+    assert first_wall_side(make(Variant.SOUND, robot_count=2), -150.0) == -1
+    assert first_wall_side(make(Variant.GAS_SOUND, robot_count=2), -150.0) == 1
+    # Square to the left, both follow the sound.
+    assert first_wall_side(make(Variant.GAS_SOUND, robot_count=2), -90.0) == -1
+
+
 def test_sound_turn_side_uses_bearings_rotated_into_the_current_heading() -> None:
     fsm = make(Variant.SOUND, robot_count=2, sound_turn_rule=SoundTurnRule.AWAY)
     script = Script(fsm, yaw_rad=0.0)

@@ -216,6 +216,8 @@ def test_scent_above_the_threshold_shows_in_the_state(make_harness) -> None:
         ('robot_index', 5, 'robot_index'),
         ('sound_turn_rule', 'sideways', 'sound_turn_rule'),
         ('gas_sound_wall_side', 'second_contact', 'gas_sound_wall_side'),
+        ('sound_side_deadband_deg', 120.0, 'sound_side_deadband'),
+        ('gas_sound_side_deadband_deg', -5.0, 'gas_sound_side_deadband'),
         ('control_rate_hz', 0.0, 'control_rate_hz'),
     ],
 )
