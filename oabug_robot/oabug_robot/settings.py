@@ -399,6 +399,6 @@ class OABugConfig:
             _require(
                 0.0 <= deadband <= math.pi / 2,
                 f'{name.removesuffix("_rad")} must be in [0, 90] deg, '
-                f'got {math.degrees(deadband)} deg',
+                f'got {math.degrees(deadband):g} deg',
             )
         _require(self.seed >= 0, 'seed must be >= 0')
