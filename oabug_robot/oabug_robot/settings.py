@@ -223,7 +223,7 @@ class MotionConfig:
             authors' grid robots hug their wall at 0.1-0.2 m centre to wall; 0.15 m is the
             middle of that range and the closest a lidar with the RPLidar A1's 0.15 m minimum
             range still measures (nearer returns read -inf, i.e. at the minimum range).
-            Measured against 0.16, 0.18 and 0.2 m in docs/oabug.md (Results).
+            Measured against 0.16, 0.18 and 0.2 m in docs/oabug_measurements.md.
         wall_distance_gain_radps_per_m: yaw rate per metre of wall-distance error [rad/(s m)].
         wall_angle_gain_per_s: yaw rate per radian of wall-direction error [1/s].
         random_step_m: the Random variant redraws its heading with probability
