@@ -10,6 +10,9 @@ targets uniform, robots starting in a 30 m disc at the centre, Table I parameter
   the three CCTs in the paper's order (proposed < msc_pf < msc), CPU and wall time per
   run (CPU time of the process that ran it: the better figure on a shared machine);
 * robots: CCT against the robot count (sensitivity);
+* search: the eq. (1) search alone (no targets): when 50 / 90 / 99 / 100 % of the field
+  first lies within the detection range (about 292 m) of some robot's path, per seed and
+  mean +- std (the search decides most of the CCT);
 * pf: time of one particle-filter step of 20 targets x 5041 particles from one observation
   (the update and the convergence test, median over repeats), and of one fused step of 3
   observers; the filters start on their lattice and take fresh noisy samples every repeat.
@@ -42,12 +45,17 @@ from msc_pf.particle_filter import ParticleFilterBank, resolve_backend  # noqa: 
 from msc_pf.schemes import Scheme  # noqa: E402
 from msc_pf.settings import MscPfConfig, ParticleFilterConfig, RadioConfig  # noqa: E402
 from sim_bridge.errors import ConfigurationError  # noqa: E402
-from sim_bridge.msc_pf_batch import BatchScenario, run_batch  # noqa: E402
+from sim_bridge.msc_pf_batch import (  # noqa: E402
+    BatchScenario,
+    SearchCoverage,
+    run_batch,
+    search_coverage,
+)
 from sim_bridge.node_overrides import parse_overrides  # noqa: E402
 
 SCHEMES = ('proposed', 'msc_pf', 'msc')
 CSV_HEADER = 'scheme,targets,robots,seed,cct_s,finished,wall_s,mean_capture_s,cpu_s\n'
-EXPERIMENTS = ('main', 'robots', 'pf')
+EXPERIMENTS = ('main', 'robots', 'search', 'pf')
 
 
 @dataclass(frozen=True)
@@ -153,6 +161,44 @@ def _stats(outcomes: list[RunOutcome]) -> tuple[float, float, int, str]:
     cpu = [o.cpu_time_s for o in outcomes if not math.isnan(o.cpu_time_s)]
     cost = f'{np.mean(cpu):.0f}/{wall:.0f}' if cpu else f'-/{wall:.0f}'
     return float(cct.mean()), float(cct.std()), unfinished, cost
+
+
+SearchJob = tuple[int, int, float, Overrides]
+"""(robots, seed, T_max, controller overrides) of one search-coverage run."""
+
+
+def _search_one(job: SearchJob) -> tuple[int, SearchCoverage]:
+    n_robots, seed, max_time_s, overrides = job
+    coverage = search_coverage(
+        n_robots, seed, max_time_s=max_time_s, controller=controller_config(overrides)
+    )
+    times = ', '.join('-' if math.isnan(t) else f'{t:.0f}' for t in coverage.times_s)
+    print(f'  search {n_robots:2d} robots seed {seed:2d}: {times} s', flush=True)
+    return seed, coverage
+
+
+def search_table(results: list[tuple[int, SearchCoverage]], n_robots: int) -> list[str]:
+    """Markdown table: time to each coverage fraction, mean +- std over seeds."""
+    fractions = results[0][1].fractions
+    lines = [
+        f'Search only (no targets), {n_robots} robots, {len(results)} seeds: time until the '
+        'given share of the field lies within the detection range of some path [s]',
+        '',
+        '| covered | mean +- std | min | max | not reached |',
+        '|---|---|---|---|---|',
+    ]
+    for i, fraction in enumerate(fractions):
+        times = np.array([coverage.times_s[i] for _, coverage in results])
+        reached = times[~np.isnan(times)]
+        if reached.size:
+            cells = (
+                f'{reached.mean():.0f} +- {reached.std():.0f} | {reached.min():.0f} | '
+                f'{reached.max():.0f}'
+            )
+        else:
+            cells = '- | - | -'
+        lines.append(f'| {100 * fraction:g} % | {cells} | {times.size - reached.size} |')
+    return [*lines, '']
 
 
 def pf_update_time_ms(
@@ -353,6 +399,7 @@ def run(
     sweep_targets: int = 10,
     runs: int = 10,
     sweep_runs: int = 5,
+    search_runs: int = 10,
     schemes: tuple[str, ...] = SCHEMES,
     max_time_s: float = 20000.0,
     first_seed: int = 0,
@@ -364,7 +411,7 @@ def run(
     """Run the experiments; return the report (markdown) and every run's outcome.
 
     With ``csv_path``, every outcome is appended to that CSV file as soon as it is known;
-    ``overrides`` change controller settings of the main and robots experiments.
+    ``overrides`` change controller settings of the main, robots and search experiments.
     """
     controller_config(overrides)  # fail before any run on a bad setting
     lines: list[str] = []
@@ -389,6 +436,14 @@ def run(
         sweep = _run_all(jobs, workers, csv_path)
         outcomes += sweep
         lines += robot_table(sweep, sweep_targets, schemes)
+    if 'search' in experiments:
+        search_jobs = [(robots, first_seed + s, max_time_s, overrides) for s in range(search_runs)]
+        if workers <= 1:
+            searched = [_search_one(job) for job in search_jobs]
+        else:
+            with ProcessPoolExecutor(max_workers=workers) as pool:
+                searched = list(pool.map(_search_one, search_jobs))
+        lines += search_table(searched, robots)
     if 'pf' in experiments:
         for backend in pf_backends:
             lines += pf_table(backend)
@@ -405,6 +460,9 @@ def main() -> None:
     parser.add_argument('--sweep-targets', type=int, default=10)
     parser.add_argument('--runs', type=int, default=10)
     parser.add_argument('--sweep-runs', type=int, default=5)
+    parser.add_argument(
+        '--search-runs', type=int, default=10, help='seeds of the search experiment'
+    )
     parser.add_argument('--schemes', nargs='+', choices=SCHEMES, default=list(SCHEMES))
     parser.add_argument('--max-time', type=float, default=20000.0, help='T_max per run [s]')
     parser.add_argument('--first-seed', type=int, default=0)
@@ -451,6 +509,7 @@ def main() -> None:
         sweep_targets=args.sweep_targets,
         runs=args.runs,
         sweep_runs=args.sweep_runs,
+        search_runs=args.search_runs,
         schemes=tuple(args.schemes),
         max_time_s=args.max_time,
         first_seed=args.first_seed,

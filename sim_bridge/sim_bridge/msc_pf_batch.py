@@ -18,6 +18,7 @@ robots through cmd_vel instead, which is what the agreement test checks.
 
 from __future__ import annotations
 
+import itertools
 import math
 import time
 from collections.abc import Callable
@@ -31,7 +32,7 @@ from msc_pf.settings import MscPfConfig
 
 from sim_bridge.rssi_targets import RssiTargetConfig, RssiTargetField, place_robots
 
-__all__ = ['BatchResult', 'BatchScenario', 'run_batch']
+__all__ = ['BatchResult', 'BatchScenario', 'SearchCoverage', 'run_batch', 'search_coverage']
 
 
 @dataclass(frozen=True)
@@ -178,3 +179,77 @@ def run_batch(
         paths_m=np.array(paths) if paths is not None else None,
         phases=np.array(phases) if phases is not None else None,
     )
+
+
+@dataclass(frozen=True)
+class SearchCoverage:
+    """How fast the eq. (1) search alone brings the field within earshot of a robot.
+
+    Attributes:
+        fractions: the coverage fractions asked for, ascending.
+        times_s: first check time [s] at which each fraction of the field was within the
+            detection range of some robot's path; NaN if not reached by the end.
+        duration_s: simulated time [s].
+    """
+
+    fractions: tuple[float, ...]
+    times_s: tuple[float, ...]
+    duration_s: float
+
+
+def search_coverage(
+    n_robots: int,
+    seed: int,
+    *,
+    max_time_s: float,
+    controller: MscPfConfig | None = None,
+    fractions: tuple[float, ...] = (0.5, 0.9, 0.99, 1.0),
+    check_period_s: float = 10.0,
+    cell_size_m: float = 20.0,
+) -> SearchCoverage:
+    """Run the search with no targets and time how fast it covers the field.
+
+    A cell of ``cell_size_m`` counts as covered once its centre has been within the radio
+    model's detection range (about 292 m) of some robot, checked every ``check_period_s``.
+    Robots start as in :func:`run_batch` (the same seed gives the same starts); without
+    targets every scheme only searches, so the scheme does not matter. The run stops when
+    the last fraction is reached or at ``max_time_s``.
+    """
+    ascending = all(a < b for a, b in itertools.pairwise(fractions))
+    if not fractions or not ascending or not all(0.0 < f <= 1.0 for f in fractions):
+        msg = f'fractions must ascend within (0, 1], got {fractions!r}'
+        raise ValueError(msg)
+    config = controller if controller is not None else MscPfConfig()
+    size = config.field_size_m
+    world_rng = np.random.default_rng([seed, 0])
+    positions = place_robots(n_robots, (size / 2.0, size / 2.0), 30.0, world_rng)
+    controllers = [RobotController(i, config, seed) for i in range(n_robots)]
+    centres = (np.arange(math.ceil(size / cell_size_m)) + 0.5) * cell_size_m
+    cell_x, cell_y = np.meshgrid(centres, centres)
+    covered = np.zeros(cell_x.shape, dtype=bool)
+    reach_sq = config.radio.detection_range_m**2
+    times = [math.nan] * len(fractions)
+    inbox: list[list[PeerInfo]] = [[] for _ in controllers]
+    steps_per_check = max(1, round(check_period_s / config.period_s))
+    now, step = 0.0, 0
+    while now < max_time_s and math.isnan(times[-1]):
+        now += config.period_s
+        step += 1
+        outputs = [
+            controller.step(now, positions[i], {}, inbox[i], [], with_estimates=False)
+            for i, controller in enumerate(controllers)
+        ]
+        broadcast_positions = positions.copy()
+        moves = np.array([out.displacement_m for out in outputs])
+        positions = np.clip(positions + moves, 0.0, size)
+        inbox = _deliver(outputs, broadcast_positions, config.swarm.comm_range_m, 0.0, world_rng)
+        if step % steps_per_check:
+            continue
+        for x, y in positions:
+            covered |= (cell_x - x) ** 2 + (cell_y - y) ** 2 < reach_sq
+        share = float(covered.mean())
+        times = [
+            now if math.isnan(t) and share >= f else t
+            for t, f in zip(times, fractions, strict=True)
+        ]
+    return SearchCoverage(tuple(fractions), tuple(times), now)

@@ -50,3 +50,15 @@ def test_a_bad_setting_stops_the_benchmark_before_any_run(bench, monkeypatch, ca
         bench.main()
     assert exit_info.value.code == 2
     assert 'expected true or false' in capsys.readouterr().err
+
+
+def test_search_table_averages_the_seeds_that_reached_each_share(bench):
+    from sim_bridge.msc_pf_batch import SearchCoverage
+
+    results = [
+        (0, SearchCoverage((0.5, 1.0), (800.0, 9000.0), 9000.0)),
+        (1, SearchCoverage((0.5, 1.0), (1000.0, float('nan')), 20000.0)),
+    ]
+    table = bench.search_table(results, 15)
+    assert '| 50 % | 900 +- 100 | 800 | 1000 | 0 |' in table
+    assert '| 100 % | 9000 +- 0 | 9000 | 9000 | 1 |' in table

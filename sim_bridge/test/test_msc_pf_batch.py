@@ -126,3 +126,28 @@ def test_batch_run_matches_the_plain_robot_by_robot_loop(scheme):
     capture_times, final_xy = plain_run(scenario)
     np.testing.assert_array_equal(result.capture_times_s, capture_times)
     np.testing.assert_array_equal(result.paths_m[-1], final_xy)
+
+
+def test_search_coverage_grows_as_the_swarm_moves_and_repeats_from_its_seed():
+    from sim_bridge.msc_pf_batch import search_coverage
+
+    def run():
+        return search_coverage(3, 5, max_time_s=400.0, fractions=(0.05, 0.1, 1.0))
+
+    first = run()
+    # At the first check the robots' 292 m earshot around the centre already covers
+    # pi 292^2 / 2000^2 = 6.7 % of the field; 10 % needs a few hundred metres of travel,
+    # the whole field far more than 400 s.
+    assert first.times_s[0] == 10.0
+    assert 10.0 < first.times_s[1] < 400.0
+    assert math.isnan(first.times_s[2])
+    assert first.duration_s == 400.0
+    assert run() == first
+
+
+@pytest.mark.parametrize('fractions', [(), (0.9, 0.5), (0.5, 0.5), (0.5, 1.5), (0.0,), (-0.1, 0.5)])
+def test_search_coverage_rejects_fractions_that_do_not_ascend_within_0_1(fractions):
+    from sim_bridge.msc_pf_batch import search_coverage
+
+    with pytest.raises(ValueError, match='fractions'):
+        search_coverage(2, 0, max_time_s=10.0, fractions=fractions)
