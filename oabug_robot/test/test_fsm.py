@@ -573,6 +573,12 @@ def test_sound_variants_choose_the_wall_side_from_the_peers(
     assert math.copysign(1.0, command.angular_radps) == -expected_side
 
 
+def own_and_other_field(variant: Variant, suffix: str) -> tuple[str, str]:
+    """Config fields ``sound_<suffix>`` and ``gas_sound_<suffix>``: the variant's own first."""
+    sound, gas_sound = f'sound_{suffix}', f'gas_sound_{suffix}'
+    return (gas_sound, sound) if variant is Variant.GAS_SOUND else (sound, gas_sound)
+
+
 @pytest.mark.parametrize(
     ('peer_deg', 'deadband_deg', 'expected_side'),
     [
@@ -591,11 +597,7 @@ def test_sound_gives_no_wall_side_when_theta_opp_is_near_ahead_or_behind(
     variant: Variant, peer_deg: float, deadband_deg: float, expected_side: int
 ) -> None:
     """Each variant reads its own deadband; the other variant's is set to the opposite."""
-    own, other = (
-        ('gas_sound_side_deadband_rad', 'sound_side_deadband_rad')
-        if variant is Variant.GAS_SOUND
-        else ('sound_side_deadband_rad', 'gas_sound_side_deadband_rad')
-    )
+    own, other = own_and_other_field(variant, 'side_deadband_rad')
     fsm = make(
         variant,
         robot_count=2,
@@ -823,11 +825,7 @@ def test_wall_side_rule_decides_which_contacts_take_the_side_from_the_sound(
     other = (
         SoundWallSide.NEVER if rule is SoundWallSide.EVERY_CONTACT else SoundWallSide.EVERY_CONTACT
     )
-    own, others = (
-        ('gas_sound_wall_side', 'sound_wall_side')
-        if variant is Variant.GAS_SOUND
-        else ('sound_wall_side', 'gas_sound_wall_side')
-    )
+    own, others = own_and_other_field(variant, 'wall_side')
     fsm = make(
         variant,
         robot_count=2,
