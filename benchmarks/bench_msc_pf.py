@@ -34,10 +34,11 @@ import argparse  # noqa: E402
 import itertools  # noqa: E402
 import math  # noqa: E402
 import time  # noqa: E402
-from collections.abc import Sequence  # noqa: E402
+from collections.abc import Callable, Iterator, Sequence  # noqa: E402
 from concurrent.futures import ProcessPoolExecutor  # noqa: E402
 from dataclasses import dataclass  # noqa: E402
 from pathlib import Path  # noqa: E402
+from typing import TypeVar  # noqa: E402
 
 import numpy as np  # noqa: E402
 from msc_pf.parameters import config_from_parameters, parameter_defaults  # noqa: E402
@@ -74,9 +75,11 @@ class RunOutcome:
 
 
 Overrides = tuple[tuple[str, object], ...]
-"""Controller settings changed from the defaults: ('section.field', value as text)."""
+"""Controller settings changed from the defaults: ('section.field', typed value), sorted."""
 
 Job = tuple[str, int, int, int, float, Overrides]
+J = TypeVar('J')
+R = TypeVar('R')
 
 
 def controller_overrides(items: Sequence[str]) -> Overrides:
@@ -147,11 +150,17 @@ def _csv_row(o: RunOutcome) -> str:
     )
 
 
-def _run_all(jobs: list[Job], workers: int, csv_path: Path | None) -> list[RunOutcome]:
+def _map(function: Callable[[J], R], jobs: Sequence[J], workers: int) -> Iterator[R]:
+    """``function`` over ``jobs`` in order, in ``workers`` processes (here when 1)."""
     if workers <= 1:
-        return [_log(_run_one(job), csv_path) for job in jobs]
+        yield from map(function, jobs)
+        return
     with ProcessPoolExecutor(max_workers=workers) as pool:
-        return [_log(outcome, csv_path) for outcome in pool.map(_run_one, jobs)]
+        yield from pool.map(function, jobs)
+
+
+def _run_all(jobs: list[Job], workers: int, csv_path: Path | None) -> list[RunOutcome]:
+    return [_log(outcome, csv_path) for outcome in _map(_run_one, jobs, workers)]
 
 
 def _stats(outcomes: list[RunOutcome]) -> tuple[float, float, int, str]:
@@ -438,12 +447,7 @@ def run(
         lines += robot_table(sweep, sweep_targets, schemes)
     if 'search' in experiments:
         search_jobs = [(robots, first_seed + s, max_time_s, overrides) for s in range(search_runs)]
-        if workers <= 1:
-            searched = [_search_one(job) for job in search_jobs]
-        else:
-            with ProcessPoolExecutor(max_workers=workers) as pool:
-                searched = list(pool.map(_search_one, search_jobs))
-        lines += search_table(searched, robots)
+        lines += search_table(list(_map(_search_one, search_jobs, workers)), robots)
     if 'pf' in experiments:
         for backend in pf_backends:
             lines += pf_table(backend)

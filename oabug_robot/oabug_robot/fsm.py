@@ -317,8 +317,7 @@ class OABugFsm:
 
     def _sound_picks_wall_side(self) -> bool:
         """Whether this wall contact takes its side from theta_opp (sound variants only)."""
-        cfg = self._config
-        rule = cfg.gas_sound_wall_side if cfg.variant is Variant.GAS_SOUND else cfg.sound_wall_side
+        rule = self._config.active_wall_side
         if rule is SoundWallSide.EVERY_CONTACT:
             return True
         return rule is SoundWallSide.FIRST_CONTACT and self._memory.wall_contacts == 0
@@ -342,16 +341,11 @@ class OABugFsm:
         theta_opp within the deadband of straight ahead or behind keeps ``default_side``.
         """
         relative = angle_difference(theta_rad, yaw_rad)
-        cfg = self._config
-        deadband = (
-            cfg.gas_sound_side_deadband_rad
-            if cfg.variant is Variant.GAS_SOUND
-            else cfg.sound_side_deadband_rad
-        )
+        deadband = self._config.active_side_deadband_rad
         if abs(relative) <= deadband or abs(relative) >= math.pi - deadband:
             return default_side
         away_side = -1 if relative > 0.0 else 1
-        return away_side if cfg.sound_turn_rule is SoundTurnRule.AWAY else -away_side
+        return away_side if self._config.sound_turn_rule is SoundTurnRule.AWAY else -away_side
 
     def _on_outer_corner(self, snap: SensorSnapshot) -> None:
         mem = self._memory

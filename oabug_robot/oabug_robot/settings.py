@@ -402,3 +402,17 @@ class OABugConfig:
                 f'got {math.degrees(deadband):g} deg',
             )
         _require(self.seed >= 0, 'seed must be >= 0')
+
+    @property
+    def active_wall_side(self) -> SoundWallSide:
+        """The wall-side rule of the configured sound variant (Gas+Sound's or Sound's)."""
+        if self.variant is Variant.GAS_SOUND:
+            return self.gas_sound_wall_side
+        return self.sound_wall_side
+
+    @property
+    def active_side_deadband_rad(self) -> float:
+        """The side deadband of the configured sound variant (Gas+Sound's or Sound's) [rad]."""
+        if self.variant is Variant.GAS_SOUND:
+            return self.gas_sound_side_deadband_rad
+        return self.sound_side_deadband_rad

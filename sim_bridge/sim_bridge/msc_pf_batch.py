@@ -42,7 +42,7 @@ class BatchScenario:
     Attributes:
         scheme: msc, msc_pf or proposed.
         n_robots: number of robots (spec 0.2 default 15).
-        n_targets: number of targets.
+        n_targets: number of targets; 0 runs the search alone until ``max_time_s``.
         seed: seeds target placement, robot placement, noise and every controller.
         max_time_s: stop here if not every target is captured [s].
         start_radius_m: robots start uniformly in this disc at the field centre [m].
@@ -109,14 +109,15 @@ def run_batch(
     scenario: BatchScenario,
     *,
     record: bool = False,
-    on_step: Callable[[float, np.ndarray, list[StepOutput]], None] | None = None,
+    on_step: Callable[[float, np.ndarray, list[StepOutput]], bool | None] | None = None,
 ) -> BatchResult:
     """Simulate ``scenario`` and return its CCT and per-target capture times.
 
     Args:
         scenario: the run.
         record: keep every robot position and phase (for plots).
-        on_step: called after every step with (time, positions, controller outputs).
+        on_step: called after every step with (time, positions, controller outputs); a
+            true return ends the run there.
     """
     start_wall = time.perf_counter()
     config = replace(scenario.controller, scheme=Scheme(scenario.scheme))
@@ -140,7 +141,8 @@ def run_batch(
     phases: list[list[int]] | None = [] if record else None
 
     now = 0.0
-    while not targets.all_captured and now < scenario.max_time_s:
+    search_only = scenario.n_targets == 0
+    while (search_only or not targets.all_captured) and now < scenario.max_time_s:
         now += dt
         samples = targets.sample_rssi(positions, world_rng)
         outputs = []
@@ -165,8 +167,8 @@ def run_batch(
         if paths is not None and phases is not None:
             paths.append(positions.copy())
             phases.append([int(out.status.phase) for out in outputs])
-        if on_step is not None:
-            on_step(now, positions, outputs)
+        if on_step is not None and on_step(now, positions, outputs):
+            break
 
     captured = targets.capture_time_s
     cct = float(np.max(captured)) if targets.all_captured and captured.size else math.nan
@@ -211,45 +213,36 @@ def search_coverage(
 
     A cell of ``cell_size_m`` counts as covered once its centre has been within the radio
     model's detection range (about 292 m) of some robot, checked every ``check_period_s``.
-    Robots start as in :func:`run_batch` (the same seed gives the same starts); without
-    targets every scheme only searches, so the scheme does not matter. The run stops when
-    the last fraction is reached or at ``max_time_s``.
+    It is a :func:`run_batch` run without targets (the same seed gives the same starts);
+    without targets every scheme only searches, so the scheme does not matter. The run
+    stops when the last fraction is reached or at ``max_time_s``.
     """
     ascending = all(a < b for a, b in itertools.pairwise(fractions))
     if not fractions or not ascending or not all(0.0 < f <= 1.0 for f in fractions):
         msg = f'fractions must ascend within (0, 1], got {fractions!r}'
         raise ValueError(msg)
     config = controller if controller is not None else MscPfConfig()
-    size = config.field_size_m
-    world_rng = np.random.default_rng([seed, 0])
-    positions = place_robots(n_robots, (size / 2.0, size / 2.0), 30.0, world_rng)
-    controllers = [RobotController(i, config, seed) for i in range(n_robots)]
-    centres = (np.arange(math.ceil(size / cell_size_m)) + 0.5) * cell_size_m
+    centres = (np.arange(math.ceil(config.field_size_m / cell_size_m)) + 0.5) * cell_size_m
     cell_x, cell_y = np.meshgrid(centres, centres)
     covered = np.zeros(cell_x.shape, dtype=bool)
     reach_sq = config.radio.detection_range_m**2
     times = [math.nan] * len(fractions)
-    inbox: list[list[PeerInfo]] = [[] for _ in controllers]
     steps_per_check = max(1, round(check_period_s / config.period_s))
-    now, step = 0.0, 0
-    while now < max_time_s and math.isnan(times[-1]):
-        now += config.period_s
-        step += 1
-        outputs = [
-            controller.step(now, positions[i], {}, inbox[i], [], with_estimates=False)
-            for i, controller in enumerate(controllers)
-        ]
-        broadcast_positions = positions.copy()
-        moves = np.array([out.displacement_m for out in outputs])
-        positions = np.clip(positions + moves, 0.0, size)
-        inbox = _deliver(outputs, broadcast_positions, config.swarm.comm_range_m, 0.0, world_rng)
-        if step % steps_per_check:
-            continue
+    steps = itertools.count(1)
+
+    def track(now_s: float, positions: np.ndarray, _outputs: list[StepOutput]) -> bool:
+        if next(steps) % steps_per_check:
+            return False
         for x, y in positions:
-            covered |= (cell_x - x) ** 2 + (cell_y - y) ** 2 < reach_sq
+            np.logical_or(covered, (cell_x - x) ** 2 + (cell_y - y) ** 2 < reach_sq, out=covered)
         share = float(covered.mean())
-        times = [
-            now if math.isnan(t) and share >= f else t
-            for t, f in zip(times, fractions, strict=True)
-        ]
-    return SearchCoverage(tuple(fractions), tuple(times), now)
+        for i, fraction in enumerate(fractions):
+            if math.isnan(times[i]) and share >= fraction:
+                times[i] = now_s
+        return not math.isnan(times[-1])
+
+    scenario = BatchScenario(
+        n_robots=n_robots, n_targets=0, seed=seed, max_time_s=max_time_s, controller=config
+    )
+    result = run_batch(scenario, on_step=track)
+    return SearchCoverage(tuple(fractions), tuple(times), result.duration_s)
