@@ -151,3 +151,18 @@ def test_search_coverage_rejects_fractions_that_do_not_ascend_within_0_1(fractio
 
     with pytest.raises(ValueError, match='fractions'):
         search_coverage(2, 0, max_time_s=10.0, fractions=fractions)
+
+
+def test_search_coverage_ends_the_run_once_the_last_share_is_reached():
+    from sim_bridge.msc_pf_batch import search_coverage
+
+    coverage = search_coverage(3, 5, max_time_s=400.0, fractions=(0.05,))
+    assert coverage.times_s == (10.0,)
+    assert coverage.duration_s == 10.0
+
+
+def test_a_scenario_without_targets_searches_until_max_time():
+    result = run_batch(BatchScenario(n_robots=2, n_targets=0, seed=1, max_time_s=30.0))
+    assert result.duration_s == 30.0
+    assert math.isnan(result.cct_s)
+    assert result.capture_times_s.shape == (0,)
