@@ -10,7 +10,8 @@ the world model of :mod:`sim_bridge.rssi_targets`, with the paper's discrete set
 * robots standing still within D_th of a target work on it; the robots working on a target
   when it is captured learn its ID, and the others learn it from their peers;
 * the run ends when every target is captured (the capture completion time, CCT) or at
-  ``max_time_s``.
+  ``max_time_s``; a scenario without targets searches until ``max_time_s``
+  (:func:`search_coverage` times that search).
 
 Positions are holonomic, as in the paper's simulation; the ROS path drives the bridge's
 robots through cmd_vel instead, which is what the agreement test checks.
