@@ -3,7 +3,7 @@
 States: JUST_STARTED (heading out along a direction, or still on a wall it is about to
 leave) and FOLLOWING_WALL. Triggers, checked every control step in this order:
 
-* hitting others (a peer return in the front cone): turn right by 90 deg (``fixed_turn``),
+* hitting others (a peer return in the front cone): turn right by 90 deg (``robot_hit_turn``),
   JUST_STARTED;
 * hitting a wall while heading out: take up the wall on a side (fixed, or chosen from the
   sound direction), FOLLOWING_WALL;
@@ -158,6 +158,7 @@ class OABugFsm:
         self._memory = FsmMemory(preferred_direction_rad=phi, target_yaw_rad=phi)
         # Right turn: clockwise, and the wall ends up on the left.
         self._fixed_turn_sign = -1 if config.fixed_turn is TurnDirection.RIGHT else 1
+        self._robot_hit_turn_sign = -1 if config.robot_hit_turn is TurnDirection.RIGHT else 1
 
     @property
     def config(self) -> OABugConfig:
@@ -275,19 +276,19 @@ class OABugFsm:
         return mem.arc_without_wall_rad >= self._config.motion.lost_wall_arc_rad
 
     def _on_hit_robot(self, snap: SensorSnapshot) -> None:
-        """Hitting others: turn right by 90 deg and start again (paper).
+        """Hitting others: turn by 90 deg (``robot_hit_turn``, paper: right) and start again.
 
         Two robots jammed in a corner can hit each other, turn into the wall, turn back and
-        hit each other again for ever (the authors' robots moved one at a time on a grid and
-        did not jam). A hit within ``robot_hit_repeat_s`` of the previous one therefore turns
-        to a random heading instead, which breaks the symmetry.
+        hit each other again for ever (on the authors' grid, where nothing is random, such
+        pairs stay locked to the end of the run). A hit within ``robot_hit_repeat_s`` of the
+        previous one therefore turns to a random heading instead, which breaks the symmetry.
         """
         mem = self._memory
         repeat_s = self._config.robot_hit_repeat_s
         if snap.time_s - mem.last_robot_hit_s <= repeat_s:
             heading = float(self._rng.uniform(-math.pi, math.pi))
         else:
-            heading = snap.yaw_rad + self._fixed_turn_sign * math.pi / 2
+            heading = snap.yaw_rad + self._robot_hit_turn_sign * math.pi / 2
         mem.last_robot_hit_s = snap.time_s
         self._turn_to(wrap_angle(heading))
         mem.state = FsmState.JUST_STARTED

@@ -107,7 +107,12 @@ PARAMETERS: tuple[tuple[str, Any, str], ...] = (
         _DEFAULTS.wall_end_face_m,
         'an outer corner this soon after a wrap is the same wall end: keep wrapping [m]',
     ),
-    ('fixed_turn', _DEFAULTS.fixed_turn.value, 'left or right: turn at walls and robots'),
+    ('fixed_turn', _DEFAULTS.fixed_turn.value, 'left or right: turn at a wall without sound'),
+    (
+        'robot_hit_turn',
+        _DEFAULTS.robot_hit_turn.value,
+        'left or right: 90 deg turn after hitting another robot (paper: right)',
+    ),
     (
         'robot_hit_repeat_s',
         _DEFAULTS.robot_hit_repeat_s,
@@ -219,6 +224,7 @@ def config_from_parameters(values: dict[str, Any]) -> OABugConfig:
         inner_corner_resumes_following=bool(values['inner_corner_resumes_following']),
         wall_end_face_m=float(values['wall_end_face_m']),
         fixed_turn=_parse(TurnDirection, 'fixed_turn', str(values['fixed_turn'])),
+        robot_hit_turn=_parse(TurnDirection, 'robot_hit_turn', str(values['robot_hit_turn'])),
         robot_hit_repeat_s=float(values['robot_hit_repeat_s']),
         sound_turn_rule=_parse(SoundTurnRule, 'sound_turn_rule', str(values['sound_turn_rule'])),
         sound_wall_side=_parse(SoundWallSide, 'sound_wall_side', str(values['sound_wall_side'])),

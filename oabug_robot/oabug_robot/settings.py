@@ -292,10 +292,16 @@ class OABugConfig:
             0.2 m of driving after a wrap (68 of them within 0.15 m: end faces, 2.5 cm), none
             between 0.2 and 0.25 m, and the rest from 0.25 m on (faces of one cell, 0.27 m,
             or longer).
-        fixed_turn: side turned to at a first wall contact without sound, and after hitting
-            another robot (paper: "all turn right").
+        fixed_turn: side turned to at a first wall contact without sound (paper: "turns in
+            the same direction (e.g., right)"); right keeps the wall on the left.
+        robot_hit_turn: side turned to by 90 deg after hitting another robot (paper: "all
+            turn right"). Turning towards the followed wall, as the authors' simulator does
+            (fixed_turn left, walls on the right, robot hits right), can lock two robots
+            for good: turn into the wall, turn back to the peer, hit it again (measured in
+            docs/oabug.md, "Why Gas trails Gas+Sound from the edge on the authors' grid").
         robot_hit_repeat_s: a robot hit this soon after the previous one turns to a random
-            heading instead of right, to break jams of two robots (0 disables) [s].
+            heading instead of ``robot_hit_turn``, to break jams of two robots (0
+            disables) [s].
         sound_turn_rule: see SoundTurnRule. Table I has the robot update phi'_i = theta_opp
             and turn "according to its direction", i.e. towards theta_opp, away from the
             peers, as the authors' robot does (default); their simulator turns toward the
@@ -345,6 +351,7 @@ class OABugConfig:
     inner_corner_resumes_following: bool = True
     wall_end_face_m: float = 0.15
     fixed_turn: TurnDirection = TurnDirection.RIGHT
+    robot_hit_turn: TurnDirection = TurnDirection.RIGHT
     robot_hit_repeat_s: float = 4.0
     sound_turn_rule: SoundTurnRule = SoundTurnRule.AWAY
     sound_wall_side: SoundWallSide = SoundWallSide.EVERY_CONTACT

@@ -207,6 +207,34 @@ def test_robot_hits_far_apart_in_time_both_turn_right() -> None:
     assert abs(fsm.memory.target_yaw_rad) == pytest.approx(math.pi)
 
 
+@pytest.mark.parametrize(
+    ('fixed_turn', 'hit_turn', 'expected_yaw'),
+    [
+        (TurnDirection.RIGHT, TurnDirection.RIGHT, -math.pi / 2),
+        (TurnDirection.LEFT, TurnDirection.RIGHT, -math.pi / 2),
+        (TurnDirection.RIGHT, TurnDirection.LEFT, math.pi / 2),
+        (TurnDirection.LEFT, TurnDirection.LEFT, math.pi / 2),
+    ],
+)
+def test_a_robot_hit_turns_to_the_robot_hit_side_whatever_the_wall_side(
+    fixed_turn: TurnDirection, hit_turn: TurnDirection, expected_yaw: float
+) -> None:
+    fsm = make(Variant.GAS, fixed_turn=fixed_turn, robot_hit_turn=hit_turn)
+    script = Script(fsm, yaw_rad=0.0)
+    script.step(free())
+    script.step(robot_ahead())
+    assert fsm.memory.event is Event.HIT_ROBOT
+    assert fsm.memory.target_yaw_rad == pytest.approx(expected_yaw)
+
+
+def test_the_wall_side_follows_fixed_turn_not_the_robot_hit_side() -> None:
+    fsm = make(Variant.GAS, fixed_turn=TurnDirection.LEFT, robot_hit_turn=TurnDirection.RIGHT)
+    script = Script(fsm)
+    reach_wall(script)
+    assert fsm.memory.state is FsmState.FOLLOWING_WALL
+    assert fsm.memory.wall_side == -1, 'a left turn keeps the wall on the right'
+
+
 def test_a_peer_ahead_while_turning_away_from_a_wall_is_not_hit() -> None:
     fsm = make(Variant.GAS)
     script = Script(fsm)

@@ -215,6 +215,7 @@ def test_scent_above_the_threshold_shows_in_the_state(make_harness) -> None:
         ('departure', 'roof', 'center or edge'),
         ('robot_index', 5, 'robot_index'),
         ('sound_turn_rule', 'sideways', 'sound_turn_rule'),
+        ('robot_hit_turn', 'back', 'robot_hit_turn'),
         ('gas_sound_wall_side', 'second_contact', 'gas_sound_wall_side'),
         ('sound_side_deadband_deg', 120.0, 'sound_side_deadband'),
         ('gas_sound_side_deadband_deg', -5.0, 'gas_sound_side_deadband'),
