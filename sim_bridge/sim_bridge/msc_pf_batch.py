@@ -70,6 +70,9 @@ class BatchResult:
     Attributes:
         cct_s: capture completion time [s]; NaN when not every target was captured.
         capture_times_s: (n_targets,) capture time of each target [s] (NaN if not captured).
+        first_heard_s: (n_targets,) first time some robot heard each target, i.e. took a
+            sample above the detection threshold [s] (NaN if nobody did). The CCT is the
+            last of these plus what the approaches after it took.
         target_positions_m: (n_targets, 2) target positions [m].
         duration_s: simulated time [s].
         wall_time_s: wall-clock time of the run [s].
@@ -79,6 +82,7 @@ class BatchResult:
 
     cct_s: float
     capture_times_s: np.ndarray
+    first_heard_s: np.ndarray
     target_positions_m: np.ndarray
     duration_s: float
     wall_time_s: float
@@ -142,10 +146,13 @@ def run_batch(
     phases: list[list[int]] | None = [] if record else None
 
     now = 0.0
+    first_heard = np.full(scenario.n_targets, np.nan)
     search_only = scenario.n_targets == 0
     while (search_only or not targets.all_captured) and now < scenario.max_time_s:
         now += dt
         samples = targets.sample_rssi(positions, world_rng)
+        heard_now = ~np.isnan(samples).all(axis=0)
+        first_heard[heard_now & np.isnan(first_heard)] = now
         outputs = []
         for i, (controller, row) in enumerate(zip(controllers, samples.tolist(), strict=True)):
             heard = {t: value for t, value in enumerate(row) if value == value}  # not NaN
@@ -176,6 +183,7 @@ def run_batch(
     return BatchResult(
         cct_s=cct,
         capture_times_s=captured.copy(),
+        first_heard_s=first_heard,
         target_positions_m=targets.positions_m.copy(),
         duration_s=now,
         wall_time_s=time.perf_counter() - start_wall,

@@ -62,3 +62,26 @@ def test_search_table_averages_the_seeds_that_reached_each_share(bench):
     table = bench.search_table(results, 15)
     assert '| 50 % | 900 +- 100 | 800 | 1000 | 0 |' in table
     assert '| 100 % | 9000 +- 0 | 9000 | 9000 | 1 |' in table
+
+
+def test_the_last_first_hearing_survives_the_csv(bench, tmp_path):
+    outcome = bench.RunOutcome('msc', 10, 15, 3, 7000.0, True, 12.0, 2900.0, 11.5, 5100.0)
+    path = tmp_path / 'runs.csv'
+    path.write_text(bench.CSV_HEADER + bench._csv_row(outcome))
+    assert bench.read_outcomes(path) == [outcome]
+
+
+def test_search_floor_table_splits_the_cct_at_the_last_first_hearing(bench):
+    def run(scheme, seed, cct, heard, finished=True):
+        return bench.RunOutcome(scheme, 10, 15, seed, cct, finished, 1.0, 1.0, 1.0, heard)
+
+    rows = [
+        run('proposed', 0, 5000.0, 4000.0),
+        run('proposed', 1, 7000.0, 4000.0),
+        run('proposed', 2, 20000.0, 9000.0, finished=False),
+        run('msc', 0, 6000.0, 4500.0),
+        run('msc', 1, 8000.0, 5500.0),
+    ]
+    table = bench.search_floor_table(rows, ('proposed', 'msc'))
+    # proposed: heard at 4000 in both finished runs, then 1000 and 3000 s; msc: 1500, 2500 s.
+    assert '| 10 | 4000 +- 0 / 2000 / 2000 (n=2) | 5000 +- 500 / 2000 / 2000 (n=2) | 4200 |' in table

@@ -166,3 +166,15 @@ def test_a_scenario_without_targets_searches_until_max_time():
     assert result.duration_s == 30.0
     assert math.isnan(result.cct_s)
     assert result.capture_times_s.shape == (0,)
+
+
+def test_first_heard_times_mark_the_first_step_a_target_was_within_earshot():
+    # One target 150 m from the start disc (heard at once), one 1270 m away (never, in 5 s).
+    scenario = scenario_with(
+        Scheme.MSC,
+        max_time_s=5.0,
+        target_positions_m=np.array([[1150.0, 1000.0], [100.0, 100.0]]),
+    )
+    result = run_batch(scenario)
+    assert result.first_heard_s[0] == 1.0
+    assert math.isnan(result.first_heard_s[1])
