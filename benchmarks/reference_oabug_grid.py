@@ -32,6 +32,7 @@ import math
 import multiprocessing
 import os
 import random
+import statistics
 import sys
 import time
 from collections.abc import Callable, Sequence
@@ -245,17 +246,14 @@ def summary(runs: Sequence[GridRun]) -> list[str]:
             rows = [r for r in runs if r.departure == departure and r.variant == variant]
             if not rows:
                 continue
-            values = sorted(r.coverage_pct for r in rows)
-            mean = sum(values) / len(values)
-            std = math.sqrt(sum((v - mean) ** 2 for v in values) / len(values))
-            half = len(values) // 2
-            median = values[half] if len(values) % 2 else (values[half - 1] + values[half]) / 2
+            values = [r.coverage_pct for r in rows]
             full = sum(v >= 100.0 - 1e-9 for v in values)
-            locked = sum(r.locked_robots for r in rows) / len(rows)
-            wall = sum(r.wall_s for r in rows) / len(rows)
+            locked = statistics.fmean(r.locked_robots for r in rows)
+            wall = statistics.fmean(r.wall_s for r in rows)
             lines.append(
-                f'| {departure} | {variant} | {len(rows)} | {mean:.1f} +- {std:.1f} | '
-                f'{median:.1f} | {full} | {locked:.2f} | {wall:.2f} |'
+                f'| {departure} | {variant} | {len(rows)} | {statistics.fmean(values):.1f} +- '
+                f'{statistics.pstdev(values):.1f} | {statistics.median(values):.1f} | {full} | '
+                f'{locked:.2f} | {wall:.2f} |'
             )
     for departure in DEPARTURES:
         by_site = {
@@ -270,8 +268,8 @@ def summary(runs: Sequence[GridRun]) -> list[str]:
         if len(sites) < 2:
             continue
         diffs = [by_site['gas_sound'][s] - by_site['gas'][s] for s in sites]
-        mean = sum(diffs) / len(diffs)
-        sd = math.sqrt(sum((d - mean) ** 2 for d in diffs) / (len(diffs) - 1))
+        mean = statistics.fmean(diffs)
+        sd = statistics.stdev(diffs)
         better = sum(d > 0 for d in diffs)
         worse = sum(d < 0 for d in diffs)
         lines.append(

@@ -43,7 +43,6 @@ from oabug_robot.settings import (
     SoundMemory,
     SoundTurnRule,
     SoundWallSide,
-    TurnDirection,
     Variant,
 )
 from oabug_robot.sound import PeerBearings, opposite_direction
@@ -156,9 +155,6 @@ class OABugFsm:
             config.robot_index, config.robot_count, config.departure, config.heading_bias_rad
         )
         self._memory = FsmMemory(preferred_direction_rad=phi, target_yaw_rad=phi)
-        # Right turn: clockwise, and the wall ends up on the left.
-        self._fixed_turn_sign = -1 if config.fixed_turn is TurnDirection.RIGHT else 1
-        self._robot_hit_turn_sign = -1 if config.robot_hit_turn is TurnDirection.RIGHT else 1
 
     @property
     def config(self) -> OABugConfig:
@@ -288,7 +284,7 @@ class OABugFsm:
         if snap.time_s - mem.last_robot_hit_s <= repeat_s:
             heading = float(self._rng.uniform(-math.pi, math.pi))
         else:
-            heading = snap.yaw_rad + self._robot_hit_turn_sign * math.pi / 2
+            heading = snap.yaw_rad + self._config.robot_hit_turn.yaw_sign * math.pi / 2
         mem.last_robot_hit_s = snap.time_s
         self._turn_to(wrap_angle(heading))
         mem.state = FsmState.JUST_STARTED
@@ -298,7 +294,7 @@ class OABugFsm:
         """Just Started -> Following Wall: pick the side to keep the wall on."""
         mem = self._memory
         # Turning right (clockwise) away from the wall leaves it on the left.
-        side = -self._fixed_turn_sign
+        side = -self._config.fixed_turn.yaw_sign
         if self._config.variant.uses_sound:
             theta = self._sound_direction(snap)
             if theta is not None:

@@ -83,6 +83,11 @@ class TurnDirection(Enum):
     LEFT = 'left'
     RIGHT = 'right'
 
+    @property
+    def yaw_sign(self) -> int:
+        """Sign of the yaw change of this turn: +1 left (counter-clockwise), -1 right."""
+        return 1 if self is TurnDirection.LEFT else -1
+
 
 class SoundTurnRule(Enum):
     """How a sound variant picks the wall-following side when the sound picks it."""

@@ -601,6 +601,17 @@ def test_sound_variants_choose_the_wall_side_from_the_peers(
     assert math.copysign(1.0, command.angular_radps) == -expected_side
 
 
+def sound_pair(variant: Variant, **overrides) -> OABugFsm:
+    """A sound variant with one peer, turning right by default and away from the peers."""
+    return make(
+        variant,
+        robot_count=2,
+        fixed_turn=TurnDirection.RIGHT,
+        sound_turn_rule=SoundTurnRule.AWAY,
+        **overrides,
+    )
+
+
 def own_and_other_field(variant: Variant, suffix: str) -> tuple[str, str]:
     """Config fields ``sound_<suffix>`` and ``gas_sound_<suffix>``: the variant's own first."""
     sound, gas_sound = f'sound_{suffix}', f'gas_sound_{suffix}'
@@ -626,11 +637,8 @@ def test_sound_gives_no_wall_side_when_theta_opp_is_near_ahead_or_behind(
 ) -> None:
     """Each variant reads its own deadband; the other variant's is set to the opposite."""
     own, other = own_and_other_field(variant, 'side_deadband_rad')
-    fsm = make(
+    fsm = sound_pair(
         variant,
-        robot_count=2,
-        fixed_turn=TurnDirection.RIGHT,
-        sound_turn_rule=SoundTurnRule.AWAY,
         gas_sound_wall_side=SoundWallSide.EVERY_CONTACT,
         **{own: math.radians(deadband_deg), other: math.radians(45.0 - deadband_deg)},
     )
@@ -854,13 +862,7 @@ def test_wall_side_rule_decides_which_contacts_take_the_side_from_the_sound(
         SoundWallSide.NEVER if rule is SoundWallSide.EVERY_CONTACT else SoundWallSide.EVERY_CONTACT
     )
     own, others = own_and_other_field(variant, 'wall_side')
-    fsm = make(
-        variant,
-        robot_count=2,
-        fixed_turn=TurnDirection.RIGHT,
-        sound_turn_rule=SoundTurnRule.AWAY,
-        **{own: rule, others: other},
-    )
+    fsm = sound_pair(variant, **{own: rule, others: other})
     assert wall_sides_of_two_contacts(fsm) == expected_sides
 
 
