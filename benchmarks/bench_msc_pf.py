@@ -55,7 +55,10 @@ from sim_bridge.msc_pf_batch import (  # noqa: E402
 from sim_bridge.node_overrides import parse_overrides  # noqa: E402
 
 SCHEMES = ('proposed', 'msc_pf', 'msc')
-CSV_HEADER = 'scheme,targets,robots,seed,cct_s,finished,wall_s,mean_capture_s,cpu_s,last_heard_s\n'
+CSV_HEADER = (
+    'scheme,targets,robots,seed,cct_s,finished,wall_s,mean_capture_s,cpu_s,last_heard_s,'
+    'approach_s,approach_ratio\n'
+)
 EXPERIMENTS = ('main', 'robots', 'search', 'pf')
 
 
@@ -74,6 +77,11 @@ class RunOutcome:
     cpu_time_s: float = math.nan
     last_heard_s: float = math.nan
     """When the last target was first heard by some robot [s]; NaN if one never was."""
+    approach_s: float = math.nan
+    """Median over the captured targets of the time from first hearing to capture [s]."""
+    approach_ratio: float = math.nan
+    """Median over the captured targets of that time over the straight drive at full speed
+    from the nearest robot that first heard the target (1 = straight there, work included)."""
 
 
 Overrides = tuple[tuple[str, object], ...]
@@ -125,6 +133,12 @@ def _run_one(job: Job) -> RunOutcome:
     mean_capture = float(times.mean()) if times.size else math.nan
     heard = result.first_heard_s
     last_heard = float(heard.max()) if heard.size and not np.isnan(heard).any() else math.nan
+    approach_s, approach_ratio = approach_medians(
+        result.first_heard_s,
+        result.first_heard_range_m,
+        result.capture_times_s,
+        controller_config(overrides).max_speed_m_s,
+    )
     return RunOutcome(
         scheme,
         n_targets,
@@ -136,7 +150,29 @@ def _run_one(job: Job) -> RunOutcome:
         mean_capture,
         cpu,
         last_heard,
+        approach_s,
+        approach_ratio,
     )
+
+
+def approach_medians(
+    first_heard_s: np.ndarray,
+    first_heard_range_m: np.ndarray,
+    capture_times_s: np.ndarray,
+    max_speed_m_s: float,
+) -> tuple[float, float]:
+    """Median first-hearing-to-capture time [s] and its median ratio to the straight drive.
+
+    Over the targets that were heard and captured; NaN, NaN when there are none. The ratio
+    divides each target's time by ``range / max_speed``: the paper's MSC "moves back and
+    forth" where the PF schemes head for an estimate, and this is where that shows.
+    """
+    done = ~np.isnan(first_heard_s) & ~np.isnan(capture_times_s)
+    if not done.any():
+        return math.nan, math.nan
+    took = capture_times_s[done] - first_heard_s[done]
+    straight = np.maximum(first_heard_range_m[done], 1.0) / max_speed_m_s
+    return float(np.median(took)), float(np.median(took / straight))
 
 
 def _log(outcome: RunOutcome, csv_path: Path | None) -> RunOutcome:
@@ -159,7 +195,8 @@ def _log(outcome: RunOutcome, csv_path: Path | None) -> RunOutcome:
 def _csv_row(o: RunOutcome) -> str:
     return (
         f'{o.scheme},{o.n_targets},{o.n_robots},{o.seed},{o.cct_s:.0f},{o.finished:d},'
-        f'{o.wall_time_s:.1f},{o.mean_capture_s:.0f},{o.cpu_time_s:.1f},{o.last_heard_s:.0f}\n'
+        f'{o.wall_time_s:.1f},{o.mean_capture_s:.0f},{o.cpu_time_s:.1f},{o.last_heard_s:.0f},'
+        f'{o.approach_s:.0f},{o.approach_ratio:.3f}\n'
     )
 
 
@@ -339,7 +376,7 @@ def main_table(outcomes: list[RunOutcome], robots: int, schemes: tuple[str, ...]
                 else '-'
             )
         lines.append(f'| {n} | ' + ' | '.join(cells) + ' |')
-    return [*lines, '', *search_floor_table(rows, schemes)]
+    return [*lines, '', *search_floor_table(rows, schemes), *approach_table(rows, schemes)]
 
 
 def search_floor_table(rows: list[RunOutcome], schemes: tuple[str, ...]) -> list[str]:
@@ -383,6 +420,41 @@ def search_floor_table(rows: list[RunOutcome], schemes: tuple[str, ...]) -> list
     return [*lines, '']
 
 
+def approach_table(rows: list[RunOutcome], schemes: tuple[str, ...]) -> list[str]:
+    """Per-target approach: first hearing to capture, and its ratio to the straight drive.
+
+    Each run contributes its medians over its captured targets; the table gives the mean +-
+    std of those over the runs that recorded them (markdown lines).
+    """
+    lines = [
+        '### Per-target approach: first heard to captured [s], and over the straight drive',
+        '',
+        '(per run the median over its captured targets; mean +- std of those over the runs)',
+        '',
+        '| targets | ' + ' | '.join(f'{s} time / ratio' for s in schemes) + ' |',
+        '|---' * (len(schemes) + 1) + '|',
+    ]
+    for n in sorted({o.n_targets for o in rows}):
+        cells = []
+        for scheme in schemes:
+            runs = [
+                o
+                for o in rows
+                if o.n_targets == n and o.scheme == scheme and not math.isnan(o.approach_s)
+            ]
+            if not runs:
+                cells.append('-')
+                continue
+            took = np.array([o.approach_s for o in runs])
+            ratio = np.array([o.approach_ratio for o in runs])
+            cells.append(
+                f'{took.mean():.0f} +- {took.std():.0f} / {ratio.mean():.2f} +-'
+                f' {ratio.std():.2f} (n={len(runs)})'
+            )
+        lines.append(f'| {n} | ' + ' | '.join(cells) + ' |')
+    return [*lines, '']
+
+
 def robot_table(outcomes: list[RunOutcome], n_targets: int, schemes: tuple[str, ...]) -> list[str]:
     """CCT per robot count and scheme at ``n_targets`` targets (markdown lines)."""
     rows = [o for o in outcomes if o.n_targets == n_targets]
@@ -407,8 +479,8 @@ def robot_table(outcomes: list[RunOutcome], n_targets: int, schemes: tuple[str, 
 def read_outcomes(path: Path) -> list[RunOutcome]:
     """Outcomes from a CSV written by :func:`run` (e.g. of an interrupted benchmark).
 
-    Columns are found by name; files from before the mean capture time, the CPU time or the
-    last first hearing were recorded read those as NaN.
+    Columns are found by name; files from before the mean capture time, the CPU time, the
+    last first hearing or the approach medians were recorded read those as NaN.
     """
     header, *lines = path.read_text().splitlines()
     names = header.split(',')
@@ -427,6 +499,8 @@ def read_outcomes(path: Path) -> list[RunOutcome]:
                 float(row.get('mean_capture_s', 'nan')),
                 float(row.get('cpu_s', 'nan')),
                 float(row.get('last_heard_s', 'nan')),
+                float(row.get('approach_s', 'nan')),
+                float(row.get('approach_ratio', 'nan')),
             )
         )
     return outcomes

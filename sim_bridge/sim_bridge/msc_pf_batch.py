@@ -73,6 +73,9 @@ class BatchResult:
         first_heard_s: (n_targets,) first time some robot heard each target, i.e. took a
             sample above the detection threshold [s] (NaN if nobody did). The CCT is the
             last of these plus what the approaches after it took.
+        first_heard_range_m: (n_targets,) distance to each target of the nearest robot that
+            heard it at that first time [m] (NaN if nobody did): the straight-line length of
+            the approach that started there.
         target_positions_m: (n_targets, 2) target positions [m].
         duration_s: simulated time [s].
         wall_time_s: wall-clock time of the run [s].
@@ -83,6 +86,7 @@ class BatchResult:
     cct_s: float
     capture_times_s: np.ndarray
     first_heard_s: np.ndarray
+    first_heard_range_m: np.ndarray
     target_positions_m: np.ndarray
     duration_s: float
     wall_time_s: float
@@ -108,6 +112,15 @@ def _deliver(
     return [
         [m for m, heard in zip(messages, row, strict=True) if heard] for row in in_range.tolist()
     ]
+
+
+def _nearest_hearer_m(
+    positions: np.ndarray, target_positions: np.ndarray, samples: np.ndarray
+) -> np.ndarray:
+    """Per target (columns of ``samples``), the distance of the nearest robot that heard it."""
+    diff = positions[:, None, :] - target_positions[None, :, :]
+    distance = np.hypot(diff[..., 0], diff[..., 1])
+    return np.where(np.isnan(samples), np.inf, distance).min(axis=0)
 
 
 def run_batch(
@@ -147,12 +160,18 @@ def run_batch(
 
     now = 0.0
     first_heard = np.full(scenario.n_targets, np.nan)
+    first_heard_range = np.full(scenario.n_targets, np.nan)
     search_only = scenario.n_targets == 0
     while (search_only or not targets.all_captured) and now < scenario.max_time_s:
         now += dt
         samples = targets.sample_rssi(positions, world_rng)
         heard_now = ~np.isnan(samples).all(axis=0)
-        first_heard[heard_now & np.isnan(first_heard)] = now
+        first_time = heard_now & np.isnan(first_heard)
+        if first_time.any():
+            first_heard[first_time] = now
+            first_heard_range[first_time] = _nearest_hearer_m(
+                positions, targets.positions_m[first_time], samples[:, first_time]
+            )
         outputs = []
         for i, (controller, row) in enumerate(zip(controllers, samples.tolist(), strict=True)):
             heard = {t: value for t, value in enumerate(row) if value == value}  # not NaN
@@ -184,6 +203,7 @@ def run_batch(
         cct_s=cct,
         capture_times_s=captured.copy(),
         first_heard_s=first_heard,
+        first_heard_range_m=first_heard_range,
         target_positions_m=targets.positions_m.copy(),
         duration_s=now,
         wall_time_s=time.perf_counter() - start_wall,

@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import math
+
+import numpy as np
 import pytest
 from sim_bridge.errors import ConfigurationError
 
@@ -64,11 +67,55 @@ def test_search_table_averages_the_seeds_that_reached_each_share(bench):
     assert '| 100 % | 9000 +- 0 | 9000 | 9000 | 1 |' in table
 
 
-def test_the_last_first_hearing_survives_the_csv(bench, tmp_path):
-    outcome = bench.RunOutcome('msc', 10, 15, 3, 7000.0, True, 12.0, 2900.0, 11.5, 5100.0)
+def test_the_last_first_hearing_and_the_approach_survive_the_csv(bench, tmp_path):
+    outcome = bench.RunOutcome(
+        'msc', 10, 15, 3, 7000.0, True, 12.0, 2900.0, 11.5, 5100.0, 812.0, 2.375
+    )
     path = tmp_path / 'runs.csv'
     path.write_text(bench.CSV_HEADER + bench._csv_row(outcome))
     assert bench.read_outcomes(path) == [outcome]
+
+
+def test_a_csv_from_before_the_approach_columns_reads_them_as_nan(bench, tmp_path):
+    path = tmp_path / 'old.csv'
+    path.write_text(
+        'scheme,targets,robots,seed,cct_s,finished,wall_s,mean_capture_s,cpu_s,last_heard_s\n'
+        'msc,10,15,3,7000,1,12.0,2900,11.5,5100\n'
+    )
+    (outcome,) = bench.read_outcomes(path)
+    assert outcome.last_heard_s == 5100.0
+    assert math.isnan(outcome.approach_s)
+    assert math.isnan(outcome.approach_ratio)
+
+
+def test_approach_medians_skip_targets_not_heard_or_not_captured(bench):
+    heard = np.array([100.0, 200.0, np.nan, 300.0, 400.0])
+    ranges = np.array([250.0, 100.0, np.nan, 290.0, 0.2])
+    captured = np.array([600.0, 500.0, 900.0, np.nan, 420.0])
+    # Counted: 500 s over 250 m (2.0), 300 s over 100 m (3.0), 20 s over 1 m (floor: 20.0).
+    took, ratio = bench.approach_medians(heard, ranges, captured, max_speed_m_s=1.0)
+    assert took == 300.0
+    assert ratio == 3.0
+    took, ratio = bench.approach_medians(heard, ranges, captured, max_speed_m_s=2.0)
+    assert ratio == 6.0
+    nothing = bench.approach_medians(heard[2:3], ranges[2:3], captured[2:3], 1.0)
+    assert all(math.isnan(v) for v in nothing)
+
+
+def test_approach_table_averages_the_run_medians(bench):
+    def run(scheme, seed, took, ratio):
+        return bench.RunOutcome(
+            scheme, 15, 15, seed, 6000.0, True, 1.0, 1.0, 1.0, 4000.0, took, ratio
+        )
+
+    rows = [
+        run('proposed', 0, 500.0, 1.5),
+        run('proposed', 1, 700.0, 2.5),
+        run('msc', 0, 800.0, 2.0),
+        run('msc', 1, math.nan, math.nan),
+    ]
+    table = bench.approach_table(rows, ('proposed', 'msc'))
+    assert '| 15 | 600 +- 100 / 2.00 +- 0.50 (n=2) | 800 +- 0 / 2.00 +- 0.00 (n=1) |' in table
 
 
 def test_search_floor_table_splits_the_cct_at_the_last_first_hearing(bench):

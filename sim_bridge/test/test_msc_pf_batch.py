@@ -178,3 +178,19 @@ def test_first_heard_times_mark_the_first_step_a_target_was_within_earshot():
     result = run_batch(scenario)
     assert result.first_heard_s[0] == 1.0
     assert math.isnan(result.first_heard_s[1])
+    assert math.isnan(result.first_heard_range_m[1])
+
+
+def test_first_heard_range_is_the_distance_of_the_nearest_robot_that_heard():
+    # Every robot of the start disc is 120-180 m from the first target (RSSI about -93 dBm,
+    # 8 dB above the detection threshold), so all hear it at the first step, where they stand.
+    scenario = scenario_with(
+        Scheme.MSC,
+        max_time_s=3.0,
+        target_positions_m=np.array([[1150.0, 1000.0], [100.0, 100.0]]),
+    )
+    result = run_batch(scenario, record=True)
+    start = result.paths_m[0]
+    nearest = np.hypot(*(start - result.target_positions_m[0]).T).min()
+    assert result.first_heard_range_m[0] == pytest.approx(nearest)
+    assert 120.0 <= result.first_heard_range_m[0] <= 180.0
