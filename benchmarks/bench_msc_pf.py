@@ -379,6 +379,21 @@ def main_table(outcomes: list[RunOutcome], robots: int, schemes: tuple[str, ...]
     return [*lines, '', *search_floor_table(rows, schemes), *approach_table(rows, schemes)]
 
 
+def _cells_per_target_count(
+    rows: list[RunOutcome],
+    schemes: tuple[str, ...],
+    keep: Callable[[RunOutcome], bool],
+    describe: Callable[[list[RunOutcome]], str],
+) -> Iterator[tuple[int, list[str]]]:
+    """Per target count (ascending), one cell per scheme: ``describe`` of its kept runs, or -."""
+    for n in sorted({o.n_targets for o in rows}):
+        cells = []
+        for scheme in schemes:
+            runs = [o for o in rows if o.n_targets == n and o.scheme == scheme and keep(o)]
+            cells.append(describe(runs) if runs else '-')
+        yield n, cells
+
+
 def search_floor_table(rows: list[RunOutcome], schemes: tuple[str, ...]) -> list[str]:
     """Where the CCT goes: the last first hearing of a target and the approaches after it.
 
@@ -394,26 +409,19 @@ def search_floor_table(rows: list[RunOutcome], schemes: tuple[str, ...]) -> list
         '| targets | ' + ' | '.join(f'{s} heard / then' for s in schemes) + ' | 0.6 x msc CCT |',
         '|---' * (len(schemes) + 2) + '|',
     ]
-    for n in sorted({o.n_targets for o in rows}):
-        cells = []
-        for scheme in schemes:
-            runs = [
-                o
-                for o in rows
-                if o.n_targets == n
-                and o.scheme == scheme
-                and o.finished
-                and not math.isnan(o.last_heard_s)
-            ]
-            if not runs:
-                cells.append('-')
-                continue
-            heard = np.array([o.last_heard_s for o in runs])
-            rest = np.array([o.cct_s for o in runs]) - heard
-            cells.append(
-                f'{heard.mean():.0f} +- {heard.std():.0f} / {rest.mean():.0f} /'
-                f' {np.median(rest):.0f} (n={len(runs)})'
-            )
+
+    def describe(runs: list[RunOutcome]) -> str:
+        heard = np.array([o.last_heard_s for o in runs])
+        rest = np.array([o.cct_s for o in runs]) - heard
+        return (
+            f'{heard.mean():.0f} +- {heard.std():.0f} / {rest.mean():.0f} /'
+            f' {np.median(rest):.0f} (n={len(runs)})'
+        )
+
+    def keep(o: RunOutcome) -> bool:
+        return o.finished and not math.isnan(o.last_heard_s)
+
+    for n, cells in _cells_per_target_count(rows, schemes, keep, describe):
         msc = [o.cct_s for o in rows if o.n_targets == n and o.scheme == 'msc']
         goal = f'{0.6 * np.mean(msc):.0f}' if msc else '-'
         lines.append(f'| {n} | ' + ' | '.join(cells) + f' | {goal} |')
@@ -434,23 +442,18 @@ def approach_table(rows: list[RunOutcome], schemes: tuple[str, ...]) -> list[str
         '| targets | ' + ' | '.join(f'{s} time / ratio' for s in schemes) + ' |',
         '|---' * (len(schemes) + 1) + '|',
     ]
-    for n in sorted({o.n_targets for o in rows}):
-        cells = []
-        for scheme in schemes:
-            runs = [
-                o
-                for o in rows
-                if o.n_targets == n and o.scheme == scheme and not math.isnan(o.approach_s)
-            ]
-            if not runs:
-                cells.append('-')
-                continue
-            took = np.array([o.approach_s for o in runs])
-            ratio = np.array([o.approach_ratio for o in runs])
-            cells.append(
-                f'{took.mean():.0f} +- {took.std():.0f} / {ratio.mean():.2f} +-'
-                f' {ratio.std():.2f} (n={len(runs)})'
-            )
+
+    def describe(runs: list[RunOutcome]) -> str:
+        took = np.array([o.approach_s for o in runs])
+        ratio = np.array([o.approach_ratio for o in runs])
+        return (
+            f'{took.mean():.0f} +- {took.std():.0f} / {ratio.mean():.2f} +-'
+            f' {ratio.std():.2f} (n={len(runs)})'
+        )
+
+    for n, cells in _cells_per_target_count(
+        rows, schemes, lambda o: not math.isnan(o.approach_s), describe
+    ):
         lines.append(f'| {n} | ' + ' | '.join(cells) + ' |')
     return [*lines, '']
 
