@@ -376,7 +376,61 @@ def main_table(outcomes: list[RunOutcome], robots: int, schemes: tuple[str, ...]
                 else '-'
             )
         lines.append(f'| {n} | ' + ' | '.join(cells) + ' |')
-    return [*lines, '', *search_floor_table(rows, schemes), *approach_table(rows, schemes)]
+    return [
+        *lines,
+        '',
+        *paired_table(rows, schemes),
+        *search_floor_table(rows, schemes),
+        *approach_table(rows, schemes),
+    ]
+
+
+def paired_difference(
+    rows: list[RunOutcome], n_targets: int, better: str, worse: str
+) -> tuple[float, float, int, int] | None:
+    """CCT of ``worse`` minus that of ``better`` over the seeds both ran at ``n_targets``.
+
+    Returns (mean, standard error of the mean, seeds ``better`` wins, seeds), or None when
+    no seed has both. Pairing removes the seed-to-seed spread of the targets' positions,
+    which dominates the unpaired standard deviations.
+    """
+    cct = {(o.scheme, o.seed): o.cct_s for o in rows if o.n_targets == n_targets}
+    seeds = sorted(seed for scheme, seed in cct if scheme == better and (worse, seed) in cct)
+    if not seeds:
+        return None
+    gaps = np.array([cct[(worse, seed)] - cct[(better, seed)] for seed in seeds])
+    error = float(gaps.std(ddof=1) / math.sqrt(gaps.size)) if gaps.size > 1 else math.nan
+    return float(gaps.mean()), error, int((gaps > 0).sum()), gaps.size
+
+
+def paired_table(rows: list[RunOutcome], schemes: tuple[str, ...]) -> list[str]:
+    """Paired CCT differences of the paper's pairs of schemes, per target count (markdown)."""
+    pairs = [
+        (a, b)
+        for a, b in (('proposed', 'msc'), ('msc_pf', 'msc'), ('proposed', 'msc_pf'))
+        if a in schemes and b in schemes
+    ]
+    if not pairs:
+        return []
+    lines = [
+        '### Paired by seed: CCT of the second scheme minus the first [s]',
+        '',
+        '(mean +- standard error; the seeds the first scheme wins)',
+        '',
+        '| targets | ' + ' | '.join(f'{a} vs {b}' for a, b in pairs) + ' |',
+        '|---' * (len(pairs) + 1) + '|',
+    ]
+    for n in sorted({o.n_targets for o in rows}):
+        cells = []
+        for a, b in pairs:
+            paired = paired_difference(rows, n, a, b)
+            if paired is None:
+                cells.append('-')
+                continue
+            mean, error, wins, seeds = paired
+            cells.append(f'{mean:.0f} +- {error:.0f} ({wins}/{seeds})')
+        lines.append(f'| {n} | ' + ' | '.join(cells) + ' |')
+    return [*lines, '']
 
 
 def _cells_per_target_count(

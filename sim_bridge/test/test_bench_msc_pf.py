@@ -133,3 +133,27 @@ def test_search_floor_table_splits_the_cct_at_the_last_first_hearing(bench):
     # proposed: heard at 4000 in both finished runs, then 1000 and 3000 s; msc: 1500, 2500 s.
     row = '| 10 | 4000 +- 0 / 2000 / 2000 (n=2) | 5000 +- 500 / 2000 / 2000 (n=2) | 4200 |'
     assert row in table
+
+
+def test_paired_differences_use_only_the_seeds_both_schemes_ran(bench):
+    def run(scheme, seed, cct):
+        return bench.RunOutcome(scheme, 10, 15, seed, cct, True, 1.0)
+
+    rows = [
+        run('proposed', 0, 5000.0),
+        run('proposed', 1, 6000.0),
+        run('proposed', 2, 9000.0),
+        run('proposed', 3, 1000.0),  # no msc run of seed 3
+        run('msc', 0, 7000.0),
+        run('msc', 1, 7000.0),
+        run('msc', 2, 6000.0),
+    ]
+    # Gaps 2000, 1000, -3000: mean 0, sample std 2646, standard error 1528; 2 wins of 3.
+    mean, error, wins, seeds = bench.paired_difference(rows, 10, 'proposed', 'msc')
+    assert mean == 0.0
+    assert error == pytest.approx(2645.75 / math.sqrt(3), rel=1e-4)
+    assert (wins, seeds) == (2, 3)
+    assert bench.paired_difference(rows, 15, 'proposed', 'msc') is None
+    table = bench.paired_table(rows, ('proposed', 'msc'))
+    assert '| 10 | 0 +- 1528 (2/3) |' in table
+    assert bench.paired_table(rows, ('msc',)) == []
