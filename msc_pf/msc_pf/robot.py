@@ -142,6 +142,8 @@ class RobotController:
         self._work_since_s = 0.0
         self._work_blocked_until_s = -math.inf
         self._far_since_s: float | None = None
+        self._goal_track: deque[tuple[float, float]] = deque()
+        self._goal_track_target = NO_TARGET
         self._swarm_changes: tuple[str, ...] = ()
         self._with_estimates = True
         self._events: list[str] = []
@@ -474,18 +476,27 @@ class RobotController:
             self._committed = choice
             events.append(f'target {captured} captured: re-targets {choice} from {kind}')
 
-    def _abandon(self, target: int, *, heard: bool, why: str = 'at its estimate') -> None:
+    def _abandon(
+        self,
+        target: int,
+        *,
+        heard: bool,
+        why: str = 'at its estimate',
+        restart_note: str | None = None,
+    ) -> None:
         """Forget ``target``'s filter (it restarts from the next sample of the target).
 
         When the target is not heard at all the robot also stops pursuing it; ``why`` says
-        where it was not heard (for the event note).
+        where it was not heard, ``restart_note`` why a heard target's filter restarts (the
+        event notes).
         """
         assert self._bank is not None
         self._bank.forget(target)
         if self._committed == target:
             self._committed = NO_TARGET
         if heard:
-            self._events.append(f'target {target} is weak at its estimate: filter restarted')
+            note = restart_note or f'target {target} is weak at its estimate: filter restarted'
+            self._events.append(note)
             return
         self._events.append(f'target {target} not heard {why}: estimate dropped')
         self.target_id = NO_TARGET
@@ -521,16 +532,28 @@ class RobotController:
         if scheme.uses_direct_approach and bank is not None and bank.is_converged(target):
             goal = bank.estimate(target).position_m
             near = float(np.hypot(*(goal - position))) < phases.task_area_m
-            if not near:
+            if near:
+                # At the estimate but the target is not louder than gamma2: the estimate is
+                # wrong (or the target was captured by robots out of range). A converged flag
+                # never clears by itself, so drop the filter instead of circling the wrong
+                # point; it restarts from the next sample of the target.
+                self._abandon(target, heard=mean is not None)
+            elif self._goal_retreats(now_s, position, target, goal):
+                # Driving at the estimate did not bring it closer: the filter follows the
+                # swarm from the wrong side of the target. Localise again from scratch.
+                self._abandon(
+                    target,
+                    heard=mean is not None,
+                    why='where its retreating estimate led',
+                    restart_note=f'target {target}: its estimate retreats while approached,'
+                    ' filter restarted',
+                )
+            else:
                 self._goal = goal
                 return Phase.DIRECT_APPROACH
-            # At the estimate but the target is not louder than gamma2: the estimate is wrong
-            # (or the target was captured by robots out of range). A converged flag never
-            # clears by itself, so drop the filter instead of circling the wrong point; it
-            # restarts from the next sample of the target.
-            self._abandon(target, heard=mean is not None)
             if mean is None:
                 return Phase.SEARCH
+        self._goal_track.clear()
         if scheme.uses_far_formation and bank is not None and bank.is_tracked(target):
             if mean is None:
                 # A recorded (unconverged) estimate approached without hearing the target.
@@ -544,6 +567,35 @@ class RobotController:
             if mean is None or mean < far_below:
                 return Phase.FAR_LOCALISATION
         return Phase.MSC_APPROACH if mean is not None else Phase.SEARCH
+
+    def _goal_retreats(
+        self, now_s: float, position: np.ndarray, target: int, goal: np.ndarray
+    ) -> bool:
+        """True when eq. (8) toward ``goal`` gained less than goal_progress_min_m in a window.
+
+        The distances to the goal of the steps spent in DIRECT_APPROACH on ``target`` are
+        kept for ``phases.goal_progress_window_s`` (0: never true); leaving the phase or
+        changing the target starts a new record.
+        """
+        phases = self.config.phases
+        window = phases.goal_progress_window_s
+        if window <= 0.0:
+            return False
+        track = self._goal_track
+        if self._goal_track_target != target or self.phase != Phase.DIRECT_APPROACH:
+            track.clear()
+            self._goal_track_target = target
+        distance = float(np.hypot(*(goal - position)))
+        track.append((now_s, distance))
+        while track and track[0][0] < now_s - window:
+            track.popleft()
+        started_s, then_m = track[0]
+        if now_s - started_s < window or distance <= phases.goal_progress_min_m:
+            return False
+        if then_m - distance >= phases.goal_progress_min_m:
+            return False
+        track.clear()
+        return True
 
     # ------------------------------------------------------------------ motion
     def _personal_best(self, now_s: float, position: np.ndarray) -> np.ndarray:

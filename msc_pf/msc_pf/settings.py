@@ -351,6 +351,13 @@ class PhaseConfig:
         unheard_exhausted_share: with ``unheard_updates``, a filter of which less than this
             share of the belief survives one step's non-detections is dropped (the robot has
             covered the ground the filter allowed without hearing the target).
+        goal_progress_window_s: a leader that has driven toward a converged estimate with
+            eq. (8) for this long and come less than ``goal_progress_min_m`` closer to it
+            restarts that target's filter [s]; 0 turns the check off. A filter whose
+            particles all sit on the wrong side of the ring of distances can follow the
+            swarm: the swarm drives away from the target, the RSSI falls, the estimate moves
+            out with it, and the swarm chases it out of earshot.
+        goal_progress_min_m: the least approach to the goal over that window [m].
     """
 
     gamma1_dbm: float = -78.0
@@ -370,6 +377,8 @@ class PhaseConfig:
     unheard_give_up_m: float = 100.0
     unheard_updates: bool = False
     unheard_exhausted_share: float = 0.01
+    goal_progress_window_s: float = 0.0
+    goal_progress_min_m: float = 15.0
 
     def __post_init__(self) -> None:
         _require_finite(self)
@@ -387,6 +396,8 @@ class PhaseConfig:
             0.0 <= self.unheard_exhausted_share < 1.0,
             'unheard_exhausted_share must be in [0, 1)',
         )
+        _require(self.goal_progress_window_s >= 0.0, 'goal_progress_window_s must be >= 0')
+        _require(self.goal_progress_min_m > 0.0, 'goal_progress_min_m must be positive')
 
 
 @dataclass(frozen=True)

@@ -158,6 +158,56 @@ def test_robot_drops_an_estimate_where_nothing_is_heard_and_searches_again():
     assert any('not heard at its estimate' in e for e in out.events)
 
 
+def hold_in_direct_approach(robot, out, until_s):
+    """Step a robot in DIRECT_APPROACH held at HOME (it makes no progress) until ``until_s``.
+
+    Returns the last output and the time the robot left DIRECT_APPROACH (None if it did not).
+    """
+    for t in range(41, int(until_s) + 1):
+        if out.status.phase is not Phase.DIRECT_APPROACH:
+            return out, float(t - 1)
+        out = robot.step(float(t), HOME, {})
+    return out, None
+
+
+def test_a_leader_that_gets_no_closer_to_its_converged_goal_restarts_localisation():
+    # The goal check: a robot that drove at its converged estimate for 60 s and came no
+    # closer (here: held in place, as when the estimate slides along with the swarm) gives
+    # the filter up instead of following it.
+    phases = PhaseConfig(work_timeout_s=100.0, goal_progress_window_s=60.0)
+    robot, out = run_capture_scenario('proposed', phases=phases)
+    assert out.status.phase is Phase.DIRECT_APPROACH
+    out, left_s = hold_in_direct_approach(robot, out, 200.0)
+    assert left_s == 100.0  # entered at 40 s, 60 s without progress
+    assert out.status.phase is Phase.SEARCH
+    assert not robot.filters.is_tracked(2)
+    assert any('retreating estimate' in e for e in out.events)
+
+
+def test_the_goal_check_leaves_an_approach_that_makes_progress_alone():
+    phases = PhaseConfig(work_timeout_s=100.0, goal_progress_window_s=60.0)
+    robot, out = run_capture_scenario('proposed', phases=phases)
+    events = []
+    position = HOME.copy()
+    for t in range(41, 400):
+        if out.status.phase is not Phase.DIRECT_APPROACH:
+            break
+        position = position + out.displacement_m
+        out = robot.step(float(t), position, {})
+        events += out.events
+    # It drives the whole 150 m and drops the estimate only there, where nothing is heard.
+    assert np.hypot(*(position - HOME)) > 140.0
+    assert any('not heard at its estimate' in e for e in events)
+    assert not any('retreat' in e for e in events)
+
+
+def test_the_goal_check_is_off_by_default():
+    robot, out = run_capture_scenario('proposed')
+    out, left_s = hold_in_direct_approach(robot, out, 200.0)
+    assert left_s is None
+    assert out.status.phase is Phase.DIRECT_APPROACH
+
+
 def test_robot_does_not_keep_a_converged_estimate_that_contradicts_what_it_hears():
     # Standing on the converged estimate of target 2, the robot hears it at -89 dBm (the
     # target is really ~120 m away): the estimate must not survive as "converged".

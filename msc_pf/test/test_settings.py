@@ -49,6 +49,8 @@ def test_scheme_is_parsed_from_its_name_and_unknown_names_are_rejected():
     [
         (lambda: PhaseConfig(gamma2_dbm=-90.0), 'gamma1 < gamma2 < gamma3'),
         (lambda: PhaseConfig(retarget_penalty=10.0), 'negative'),
+        (lambda: PhaseConfig(goal_progress_window_s=-1.0), 'goal_progress_window_s'),
+        (lambda: PhaseConfig(goal_progress_min_m=0.0), 'goal_progress_min_m'),
         (lambda: ParticleFilterConfig(n_particles=2), 'at least 4'),
         (lambda: ParticleFilterConfig(resampling='stratified'), 'resampling'),
         (lambda: ParticleFilterConfig(r_conv_m=float('nan')), 'finite'),
