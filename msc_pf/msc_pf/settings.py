@@ -377,7 +377,7 @@ class PhaseConfig:
     unheard_give_up_m: float = 100.0
     unheard_updates: bool = False
     unheard_exhausted_share: float = 0.01
-    goal_progress_window_s: float = 0.0
+    goal_progress_window_s: float = 60.0
     goal_progress_min_m: float = 15.0
 
     def __post_init__(self) -> None:

@@ -201,8 +201,9 @@ def test_the_goal_check_leaves_an_approach_that_makes_progress_alone():
     assert not any('retreat' in e for e in events)
 
 
-def test_the_goal_check_is_off_by_default():
-    robot, out = run_capture_scenario('proposed')
+def test_a_zero_goal_progress_window_turns_the_goal_check_off():
+    phases = PhaseConfig(work_timeout_s=100.0, goal_progress_window_s=0.0)
+    robot, out = run_capture_scenario('proposed', phases=phases)
     out, left_s = hold_in_direct_approach(robot, out, 200.0)
     assert left_s is None
     assert out.status.phase is Phase.DIRECT_APPROACH
