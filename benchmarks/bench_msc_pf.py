@@ -115,6 +115,7 @@ def controller_config(overrides: Overrides) -> MscPfConfig:
 
 def _run_one(job: Job) -> RunOutcome:
     scheme, n_targets, n_robots, seed, max_time_s, overrides = job
+    controller = controller_config(overrides)
     start_cpu = time.process_time()
     result = run_batch(
         BatchScenario(
@@ -123,7 +124,7 @@ def _run_one(job: Job) -> RunOutcome:
             n_targets=n_targets,
             seed=seed,
             max_time_s=max_time_s,
-            controller=controller_config(overrides),
+            controller=controller,
         )
     )
     cpu = time.process_time() - start_cpu
@@ -137,7 +138,7 @@ def _run_one(job: Job) -> RunOutcome:
         result.first_heard_s,
         result.first_heard_range_m,
         result.capture_times_s,
-        controller_config(overrides).max_speed_m_s,
+        controller.max_speed_m_s,
     )
     return RunOutcome(
         scheme,
@@ -385,6 +386,18 @@ def main_table(outcomes: list[RunOutcome], robots: int, schemes: tuple[str, ...]
     ]
 
 
+def _table_head(title: str, note: str, columns: Sequence[str]) -> list[str]:
+    """Markdown lines of a report table's title, note and header: 'targets', then ``columns``."""
+    return [
+        f'### {title}',
+        '',
+        f'({note})',
+        '',
+        '| targets | ' + ' | '.join(columns) + ' |',
+        '|---' * (len(columns) + 1) + '|',
+    ]
+
+
 def paired_difference(
     rows: list[RunOutcome], n_targets: int, better: str, worse: str
 ) -> tuple[float, float, int, int] | None:
@@ -412,14 +425,11 @@ def paired_table(rows: list[RunOutcome], schemes: tuple[str, ...]) -> list[str]:
     ]
     if not pairs:
         return []
-    lines = [
-        '### Paired by seed: CCT of the second scheme minus the first [s]',
-        '',
-        '(mean +- standard error; the seeds the first scheme wins)',
-        '',
-        '| targets | ' + ' | '.join(f'{a} vs {b}' for a, b in pairs) + ' |',
-        '|---' * (len(pairs) + 1) + '|',
-    ]
+    lines = _table_head(
+        'Paired by seed: CCT of the second scheme minus the first [s]',
+        'mean +- standard error; the seeds the first scheme wins',
+        [f'{a} vs {b}' for a, b in pairs],
+    )
     for n in sorted({o.n_targets for o in rows}):
         cells = []
         for a, b in pairs:
@@ -454,15 +464,12 @@ def search_floor_table(rows: list[RunOutcome], schemes: tuple[str, ...]) -> list
     A scheme cannot end before its last target is first heard, whatever its approach does;
     the last column compares that floor with the goal proposed <= 0.6 msc (markdown lines).
     """
-    lines = [
-        '### Where the CCT goes: last target first heard, then the time to the end [s]',
-        '',
-        '(mean +- std over the finished runs that recorded it; the end minus the last first'
-        ' hearing as mean / median)',
-        '',
-        '| targets | ' + ' | '.join(f'{s} heard / then' for s in schemes) + ' | 0.6 x msc CCT |',
-        '|---' * (len(schemes) + 2) + '|',
-    ]
+    lines = _table_head(
+        'Where the CCT goes: last target first heard, then the time to the end [s]',
+        'mean +- std over the finished runs that recorded it; the end minus the last first'
+        ' hearing as mean / median',
+        [*(f'{s} heard / then' for s in schemes), '0.6 x msc CCT'],
+    )
 
     def describe(runs: list[RunOutcome]) -> str:
         heard = np.array([o.last_heard_s for o in runs])
@@ -488,14 +495,11 @@ def approach_table(rows: list[RunOutcome], schemes: tuple[str, ...]) -> list[str
     Each run contributes its medians over its captured targets; the table gives the mean +-
     std of those over the runs that recorded them (markdown lines).
     """
-    lines = [
-        '### Per-target approach: first heard to captured [s], and over the straight drive',
-        '',
-        '(per run the median over its captured targets; mean +- std of those over the runs)',
-        '',
-        '| targets | ' + ' | '.join(f'{s} time / ratio' for s in schemes) + ' |',
-        '|---' * (len(schemes) + 1) + '|',
-    ]
+    lines = _table_head(
+        'Per-target approach: first heard to captured [s], and over the straight drive',
+        'per run the median over its captured targets; mean +- std of those over the runs',
+        [f'{s} time / ratio' for s in schemes],
+    )
 
     def describe(runs: list[RunOutcome]) -> str:
         took = np.array([o.approach_s for o in runs])

@@ -553,7 +553,6 @@ class RobotController:
                 return Phase.DIRECT_APPROACH
             if mean is None:
                 return Phase.SEARCH
-        self._goal_track.clear()
         if scheme.uses_far_formation and bank is not None and bank.is_tracked(target):
             if mean is None:
                 # A recorded (unconverged) estimate approached without hearing the target.
