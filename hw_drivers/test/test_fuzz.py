@@ -65,7 +65,8 @@ def test_sample_decoder_accounts_for_every_byte_and_emits_only_valid_samples(par
         assert np.all((out.angle_deg >= 0.0) & (out.angle_deg < 360.0))
         assert np.all(out.distance_mm >= 0.0)
     pending = total - 5 * accepted - decoder.rejected_bytes
-    assert 0 <= pending <= 4
+    assert pending == decoder.pending_bytes
+    assert 0 <= pending <= 5 * decoder.config.compare_samples + 3
 
 
 @FUZZ
