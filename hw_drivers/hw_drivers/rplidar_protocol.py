@@ -1,4 +1,4 @@
-"""Slamtec RPLidar A1 serial protocol: pure encode/decode functions (HARDWARE.md §2).
+"""Slamtec RPLidar A1 serial protocol: pure encode/decode functions.
 
 Nothing here touches a port. Requests are bytes, responses are decoded into frozen
 dataclasses, and the endless scan stream is decoded incrementally by
@@ -55,7 +55,7 @@ _EMPTY = np.zeros(0, dtype=np.uint8)
 
 
 class Command(IntEnum):
-    """Request command bytes (HARDWARE.md §2.2)."""
+    """Request command bytes."""
 
     STOP = 0x25
     RESET = 0x40
@@ -226,8 +226,9 @@ class ResyncConfig:
         edge_distance_abs_mm: ...or within this many millimetres [mm].
         edge_quality_step: ...and its quality within this many steps of that return's.
         edge_reference_samples: how far into the run that nearest return is looked for.
-        compare_samples: after junk, the runs starting at five consecutive offsets are
-            compared over this many samples and the longest is taken.
+        compare_samples: after junk, the runs starting at ``compare_offsets`` consecutive
+            offsets are compared over this many samples and the longest is taken...
+        compare_offsets: ...from the first offset where a run starts on.
     """
 
     min_run: int = 4
@@ -237,6 +238,7 @@ class ResyncConfig:
     edge_quality_step: int = 24
     edge_reference_samples: int = 3
     compare_samples: int = 8
+    compare_offsets: int = 15
 
     def __post_init__(self) -> None:
         if self.min_run < 3:
@@ -246,6 +248,9 @@ class ResyncConfig:
             raise ConfigurationError(msg)
         if self.edge_distance_rel < 0.0 or self.edge_distance_abs_mm < 0.0:
             raise ConfigurationError('edge distance tolerances must be >= 0')
+        if self.compare_offsets < SAMPLE_SIZE:
+            msg = f'compare_offsets must be >= {SAMPLE_SIZE}, got {self.compare_offsets}'
+            raise ConfigurationError(msg)
         if self.compare_samples < self.min_run:
             msg = f'compare_samples must be >= min_run, got {self.compare_samples}'
             raise ConfigurationError(msg)
@@ -306,7 +311,8 @@ class SampleStreamDecoder:
 
     Feed it whatever the port delivered; decisions wait until the bytes they need have
     arrived, so the output does not depend on how the stream was split into reads. At most
-    ``5 * compare_samples + 3`` bytes stay pending between calls (:attr:`pending_bytes`).
+    ``5 * compare_samples + compare_offsets - 2`` bytes stay pending between calls
+    (:attr:`pending_bytes`).
     """
 
     def __init__(self, config: ResyncConfig | None = None) -> None:
@@ -369,26 +375,27 @@ class SampleStreamDecoder:
         n_links: int,
         found: int,
     ) -> int | None:
-        """Of the run starting at ``found`` and those at the next 4 offsets, the best one.
+        """Of the runs starting at ``found`` and the next ``compare_offsets - 1`` offsets, the best.
 
         Bytes where junk meets real samples can form a run shifted against the real samples
-        by a few bytes. Its angles come from the samples' quality and distance bytes, which
-        change slowly, so it barely turns; the real samples form the longer run, or one as
-        long that turns more. Runs are compared over up to ``compare_samples`` samples by
-        length, then by the angle they turn through. None when the bytes needed to decide
-        have not all arrived.
+        by a few bytes, sometimes led in by a junk window or two. Its angles come from the
+        samples' quality and distance bytes, which change slowly, so it barely turns; the
+        real samples form the longer run, or one as long that turns more. Runs are compared
+        over up to ``compare_samples`` samples by length, then by the angle they turn
+        through. None when the bytes needed to decide have not all arrived.
         """
         cap = self.config.compare_samples - 1  # links
-        if found + SAMPLE_SIZE - 1 + SAMPLE_SIZE * (cap - 1) >= n_links:
+        width = self.config.compare_offsets
+        if found + width - 1 + SAMPLE_SIZE * (cap - 1) >= n_links:
             return None
-        lengths = np.zeros(SAMPLE_SIZE, dtype=np.int64)
-        turned = np.zeros(SAMPLE_SIZE, dtype=np.int64)
-        alive = np.ones(SAMPLE_SIZE, dtype=bool)
+        lengths = np.zeros(width, dtype=np.int64)
+        turned = np.zeros(width, dtype=np.int64)
+        alive = np.ones(width, dtype=bool)
         for k in range(cap):
             start = found + SAMPLE_SIZE * k
-            alive &= link[start : start + SAMPLE_SIZE]
+            alive &= link[start : start + width]
             lengths += alive
-            turned += np.where(alive, step_q6[start : start + SAMPLE_SIZE], 0)
+            turned += np.where(alive, step_q6[start : start + width], 0)
         best = np.lexsort((-turned, -lengths))[0]  # longest first, then most turned
         return found + int(best)
 
@@ -716,7 +723,7 @@ class ScanBinning:
 
     ROS angle = wrap(zero_offset_rad + angle_direction * device_angle). The defaults
     (direction -1, offset pi) are Slamtec's ROS mapping, which puts laser +x at the device's
-    180° mark (HARDWARE.md §2.7).
+    180° mark.
 
     Attributes:
         bins: number of bins over [-pi, pi).
