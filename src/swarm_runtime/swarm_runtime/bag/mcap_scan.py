@@ -52,6 +52,23 @@ _OP_MESSAGE = 0x05
 _OP_CHUNK = 0x06
 _OP_DATA_END = 0x0F
 _KNOWN_OPS = frozenset(range(0x01, 0x10))
+_RECORD_NAMES = {
+    0x01: 'header',
+    0x02: 'footer',
+    0x03: 'schema',
+    0x04: 'channel',
+    0x05: 'message',
+    0x06: 'chunk',
+    0x07: 'message index',
+    0x08: 'chunk index',
+    0x09: 'attachment',
+    0x0A: 'attachment index',
+    0x0B: 'statistics',
+    0x0C: 'metadata',
+    0x0D: 'metadata index',
+    0x0E: 'summary offset',
+    0x0F: 'data end',
+}
 _USER_OPS_START = 0x80
 _RECORD_HEAD = struct.Struct('<BQ')
 _CHUNK_HEAD = struct.Struct('<QQQII')  # start, end, uncompressed size, crc, compression length
@@ -524,8 +541,8 @@ def _walk_records(layout: McapLayout, data: Any) -> None:
                     Damage(
                         pos,
                         None,
-                        f'the file is cut inside a record (opcode 0x{opcode:02x}, '
-                        f'{size - pos - 9} of {length} bytes present)',
+                        f'the file is cut inside a {_RECORD_NAMES.get(opcode, "user")} record '
+                        f'({size - pos - 9} of its {length} bytes present)',
                     )
                 )
             return

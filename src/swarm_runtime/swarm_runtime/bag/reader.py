@@ -274,7 +274,7 @@ class _Source:
             if layout.damage and not recover:
                 msg = f'{storage_file}: damaged {layout.damage[0].describe()}'
                 raise CorruptBagError(msg, recoverable=True)
-            if layout.summary_problem is not None:
+            if layout.summary_problem is not None and not layout.damage:
                 problem = layout.summary_problem
                 self.notes.append(
                     f'{storage_file}: {problem}; its records were read from the start'

@@ -86,6 +86,7 @@ class _McapStorage:
 
     def close(self, version: int, metadata: str) -> None:
         del version
+        self._mcap.flush()  # the last chunk before the metadata record, as in rosbag2's files
         self._mcap.add_metadata('rosbag2', {'serialized_metadata': metadata})
         self._mcap.finish()
         self._stream.close()
