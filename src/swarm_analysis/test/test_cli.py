@@ -105,7 +105,8 @@ def test_recover_reports_from_what_a_cut_bag_holds_and_says_how_much(tmp_path, c
     captured = capsys.readouterr()
     out = captured.out
     assert 'of 22 recorded messages' in out
-    assert 'damaged ' in out and 'at byte' in out
+    assert 'damaged ' in out
+    assert 'at byte' in out
     # The targets up to the cut: target 0 (40 s) is in, the report is from what was read.
     assert 'target 0: captured at 40 s' in out
     assert 'Warning' not in captured.err  # the loss is summarized once, not warned per chunk

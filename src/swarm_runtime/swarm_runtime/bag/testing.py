@@ -15,14 +15,17 @@ from __future__ import annotations
 
 import os
 import re
+import struct
 import time
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 __all__ = [
     'DOMAIN_BASE_ENV_VAR',
     'dds_test_environment',
     'domain_id_for_tests',
+    'message_record_ends',
     'spin_for',
     'spin_until',
 ]
@@ -75,3 +78,42 @@ def spin_for(executor: Any, clock: Any, duration_s: float, *, step_s: float = 0.
     deadline = time.monotonic() + max(10.0, 10.0 * duration_s)
     while clock.now().nanoseconds < end_ns and time.monotonic() < deadline:
         executor.spin_once(timeout_sec=step_s)
+
+
+def message_record_ends(mcap: Path) -> list[int]:
+    """End offset of every message record of an intact MCAP file with uncompressed chunks.
+
+    Ground truth for recovery tests, independent of this package's MCAP parser: the
+    messages come from the ``mcap`` library's reader, and each one's record bytes are
+    located in the file. A recovery of the file cut at byte ``n`` can at best return the
+    messages whose record ends at or before ``n``.
+
+    Raises:
+        ValueError: a record is not found verbatim (compressed chunks).
+    """
+    from mcap.reader import make_reader
+
+    data = mcap.read_bytes()
+    ends: list[int] = []
+    position = 0
+    with mcap.open('rb') as stream:
+        for _, channel, message in make_reader(stream).iter_messages(log_time_order=False):
+            head = struct.pack(
+                '<BQHIQQ',
+                0x05,
+                22 + len(message.data),
+                channel.id,
+                message.sequence,
+                message.log_time,
+                message.publish_time,
+            )
+            record = head + message.data
+            found = data.find(record, position)
+            if found < 0:
+                found = data.find(record)
+            if found < 0:
+                msg = f'{mcap}: a message record is not in the file verbatim (compressed chunks?)'
+                raise ValueError(msg)
+            ends.append(found + len(record))
+            position = found + 1
+    return sorted(ends)
