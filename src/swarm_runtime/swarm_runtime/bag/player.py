@@ -23,15 +23,12 @@ from typing import Any
 from rosbags.interfaces import Qos, QosDurability, QosHistory, QosReliability
 
 from ..ros import (
-    HistoryPolicy,
     Node,
-    QoSDurabilityPolicy,
     QoSProfile,
-    ReliabilityPolicy,
     message_module,
     rclpy,
 )
-from .conversions import qos_from_rosbags
+from .conversions import matching_profile, qos_from_rosbags
 from .reader import BagMessage, TopicSummary, read_bag_info, read_messages
 
 __all__ = ['CLOCK_TOPIC', 'BagPlayer', 'replay_qos']
@@ -59,18 +56,14 @@ def replay_qos(offered: Sequence[Qos]) -> QoSProfile:
     """
     if not offered:
         return QoSProfile(depth=_DEFAULT_QOS_DEPTH)
-    reliable = all(q.reliability == QosReliability.RELIABLE for q in offered)
     latched = all(q.durability == QosDurability.TRANSIENT_LOCAL for q in offered)
     depths = [q.depth for q in offered if q.history == QosHistory.KEEP_LAST and q.depth > 0]
-    depth = max(depths) if depths else (1 if latched else _DEFAULT_QOS_DEPTH)
     base = qos_from_rosbags(offered[0], rclpy)
-    return QoSProfile(
-        history=HistoryPolicy.KEEP_LAST,
-        depth=depth,
-        reliability=ReliabilityPolicy.RELIABLE if reliable else ReliabilityPolicy.BEST_EFFORT,
-        durability=(
-            QoSDurabilityPolicy.TRANSIENT_LOCAL if latched else QoSDurabilityPolicy.VOLATILE
-        ),
+    return matching_profile(
+        rclpy,
+        all_reliable=all(q.reliability == QosReliability.RELIABLE for q in offered),
+        all_latched=latched,
+        depth=max(depths) if depths else (1 if latched else _DEFAULT_QOS_DEPTH),
         deadline=base.deadline,
         lifespan=base.lifespan,
         liveliness=base.liveliness,

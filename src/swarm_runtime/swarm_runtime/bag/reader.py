@@ -33,7 +33,7 @@ from rosbags.rosbag2.metadata import parse_qos
 from ..messages.errors import MessageError
 from .decoding import Decoder, TypeDecision
 from .errors import BagNotFoundError, BagTypeError, CorruptBagError
-from .mcap_scan import McapLayout, Segment, SegmentDamageError, open_layout, read_segment
+from .mcap_scan import Damage, McapLayout, Segment, SegmentDamageError, open_layout, read_segment
 
 __all__ = [
     'BagDamage',
@@ -73,12 +73,7 @@ class BagDamage:
 
     def describe(self) -> str:
         """'<file>: at byte N: <reason>; reading resumed at byte M' (or: nothing after it)."""
-        tail = (
-            'nothing after it could be read'
-            if self.resumed_at is None
-            else f'reading resumed at byte {self.resumed_at}'
-        )
-        return f'{self.file}: at byte {self.offset}: {self.reason}; {tail}'
+        return f'{self.file}: {Damage(self.offset, self.resumed_at, self.reason).describe()}'
 
 
 @dataclass(frozen=True)

@@ -36,7 +36,6 @@ from pathlib import Path
 from typing import Any
 
 from ..ros import (
-    HistoryPolicy,
     Node,
     Parameter,
     QoSDurabilityPolicy,
@@ -45,7 +44,7 @@ from ..ros import (
     message_module,
     rclpy,
 )
-from .conversions import qos_to_rosbags
+from .conversions import matching_profile, qos_to_rosbags
 from .errors import BagError
 from .writer import BagWriter
 
@@ -328,19 +327,13 @@ class BagRecorder(Node):
     @staticmethod
     def _subscription_qos(offered: list[QoSProfile]) -> QoSProfile:
         """A profile that matches every offered one (best effort/volatile when none is known)."""
-        reliable = bool(offered) and all(
-            q.reliability == ReliabilityPolicy.RELIABLE for q in offered
-        )
-        latched = bool(offered) and all(
-            q.durability == QoSDurabilityPolicy.TRANSIENT_LOCAL for q in offered
-        )
-        return QoSProfile(
-            history=HistoryPolicy.KEEP_LAST,
+        return matching_profile(
+            rclpy,
+            all_reliable=bool(offered)
+            and all(q.reliability == ReliabilityPolicy.RELIABLE for q in offered),
+            all_latched=bool(offered)
+            and all(q.durability == QoSDurabilityPolicy.TRANSIENT_LOCAL for q in offered),
             depth=RECORDER_QUEUE_DEPTH,
-            reliability=ReliabilityPolicy.RELIABLE if reliable else ReliabilityPolicy.BEST_EFFORT,
-            durability=(
-                QoSDurabilityPolicy.TRANSIENT_LOCAL if latched else QoSDurabilityPolicy.VOLATILE
-            ),
         )
 
     def _record(self, topic: str, data: bytes) -> None:
