@@ -236,3 +236,15 @@ def test_real_rclpy_messages_are_written_like_generated_ones(tmp_path: Path) -> 
     assert message.typename == 'sensor_msgs/msg/LaserScan'
     assert list(message.message.ranges) == [1.0, 2.5]
     assert message.message.header.frame_id == 'r0/laser'
+
+
+def test_a_bag_from_rosbags_own_writer_reads_without_chunk_crcs(tmp_path: Path) -> None:
+    """rosbags' MCAP writer stores CRC 0 ("none"): such bags read, checked by CDR alone."""
+    from rosbags.rosbag2 import StoragePlugin, Writer
+
+    std_msgs = get_message_module('std_msgs')
+    with Writer(tmp_path / 'plain', version=9, storage_plugin=StoragePlugin.MCAP) as writer:
+        connection = writer.add_connection('/n', 'std_msgs/msg/Int32', typestore=get_typestore())
+        for value in range(3):
+            writer.write(connection, value, serialize_cdr(std_msgs.Int32(data=value)))
+    assert [m.message.data for m in read_messages(tmp_path / 'plain')] == [0, 1, 2]
