@@ -70,8 +70,10 @@ def _site_geometry(msg: Any) -> tuple[str, np.ndarray, tuple[np.ndarray, ...]]:
     return str(msg.name), walls, rooms
 
 
-def load_run(bag: str | Path) -> RecordedRun:
+def load_run(bag: str | Path, *, allow_truncated: bool = False) -> RecordedRun:
     """Read a run's ground truth from the bag directory ``bag``.
+
+    ``allow_truncated`` reads a damaged bag as far as it can be read.
 
     Raises:
         ReportError: a topic the report needs is missing from the bag.
@@ -84,7 +86,9 @@ def load_run(bag: str | Path) -> RecordedRun:
     poses: list[np.ndarray] = []
     names: tuple[str, ...] = ()
     end_s = 0.0
-    for item in read_messages(bag, [SITE_TOPIC, POSES_TOPIC, COVERAGE_TOPIC, CLOCK_TOPIC]):
+    for item in read_messages(
+        bag, [SITE_TOPIC, POSES_TOPIC, COVERAGE_TOPIC, CLOCK_TOPIC], allow_truncated=allow_truncated
+    ):
         msg = item.message
         if item.topic == SITE_TOPIC and site_msg is None:
             site_msg = msg

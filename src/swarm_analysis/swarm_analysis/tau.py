@@ -133,9 +133,15 @@ def tau_from_tracks(
 
 
 def tau_from_bag(
-    path: str | Path, status_topic: str = STATUS_TOPIC, poses_topic: str = POSES_TOPIC
+    path: str | Path,
+    status_topic: str = STATUS_TOPIC,
+    poses_topic: str = POSES_TOPIC,
+    *,
+    allow_truncated: bool = False,
 ) -> TauResult:
     """tau of a recorded simulated mission (rosbag2 directory or .mcap file).
+
+    ``allow_truncated`` reads a damaged bag as far as it can be read.
 
     Raises:
         TauError: if the bag has no status message or no poses of the status's robots.
@@ -146,7 +152,7 @@ def tau_from_bag(
     reported = math.nan
     times: list[float] = []
     rows: list[dict[str, tuple[float, float]]] = []
-    for item in read_messages(path, [status_topic, poses_topic]):
+    for item in read_messages(path, [status_topic, poses_topic], allow_truncated=allow_truncated):
         msg = item.message
         if item.topic == status_topic:
             status = msg
