@@ -33,6 +33,7 @@ setup(
         # The compiled lidar kernel (simulation only, like pybullet).
         'numba',
         'PyYAML',
+        'swarm_common',
         'swarm_runtime',
         'swarm_analysis',
         # The spawners start these algorithm nodes.

@@ -21,6 +21,7 @@ from dataclasses import dataclass, field, replace
 from typing import Literal
 
 import numpy as np
+from swarm_common.segments import first_entry_fraction
 
 from bayes_swarm.baselines.exhaustive import sweep_paths
 from bayes_swarm.baselines.glowworm import GlowwormSwarm
@@ -126,26 +127,6 @@ class MissionResult:
             robot = self.finder
         lists = self.decisions if robot < 0 else [self.decisions[robot]]
         return np.array([d.compute_time_s for ds in lists for d in ds])
-
-
-def first_entry_fraction(
-    start_m: np.ndarray, end_m: np.ndarray, centre_m: np.ndarray, radius_m: float
-) -> float | None:
-    """First s in [0, 1] with |start + s (end - start) - centre| <= radius, else None."""
-    d = np.asarray(end_m, dtype=float) - start_m
-    f = np.asarray(start_m, dtype=float) - centre_m
-    c = float(f @ f) - radius_m * radius_m
-    if c <= 0.0:
-        return 0.0
-    a = float(d @ d)
-    if a <= 0.0:
-        return None
-    b = 2.0 * float(f @ d)
-    disc = b * b - 4.0 * a * c
-    if disc < 0.0:
-        return None
-    s = (-b - math.sqrt(disc)) / (2.0 * a)
-    return s if 0.0 <= s <= 1.0 else None
 
 
 def robot_start_and_fan(

@@ -19,9 +19,10 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
+from swarm_common.angles import wrap_angle
 
 from sim_bridge.errors import ConfigurationError, WorldGeometryError
-from sim_bridge.geometry import RayCaster, wrap_angle
+from sim_bridge.geometry import RayCaster
 from sim_bridge.ground_truth import CoverageTracker, RoomEntry
 from sim_bridge.sensors.bearings import BearingConfig, BearingCycle, BearingModel, PeerBearings
 from sim_bridge.sensors.gas_sensor import GasSensorConfig, Mp503Model

@@ -16,6 +16,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from swarm_common.angles import wrap_angle
 
 from sim_bridge.errors import WorldGeometryError
 from sim_bridge.raycast_kernel import crossings_kernel, nearest_kernel, scan_kernel
@@ -26,19 +27,9 @@ __all__ = [
     'as_segments',
     'count_crossings',
     'point_segment_distance',
-    'wrap_angle',
 ]
 
 TWO_PI = 2.0 * math.pi
-
-
-def wrap_angle(angle_rad: np.ndarray | float) -> np.ndarray | float:
-    """Wrap angles [rad] to (-pi, pi]."""
-    wrapped = np.mod(np.asarray(angle_rad, dtype=float) + math.pi, TWO_PI) - math.pi
-    wrapped = np.where(wrapped <= -math.pi, wrapped + TWO_PI, wrapped)
-    if np.ndim(angle_rad) == 0:
-        return float(wrapped)
-    return wrapped
 
 
 def as_segments(walls: object) -> np.ndarray:

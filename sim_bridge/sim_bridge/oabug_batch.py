@@ -41,13 +41,13 @@ from typing import Any
 import numpy as np
 from oabug_robot.errors import ScanError
 from oabug_robot.fsm import Command, OABugFsm, SensorSnapshot
-from oabug_robot.heading import yaw_from_quaternion
 from oabug_robot.node import PARAMETERS, config_from_parameters
 from oabug_robot.scan_features import LaserScanData, ScanFeatureExtractor, ScanFeatures
 from oabug_robot.sound import PeerBearings
+from swarm_common.angles import yaw_from_quaternion, yaw_to_quaternion
+from swarm_common.stamps import NS_PER_S, seconds_to_ns
 from swarm_runtime.builtin._messages import cdr_roundtrip_enabled
 
-from sim_bridge.conversions import yaw_to_quaternion
 from sim_bridge.engine import READINGS, EngineConfig, SimEngine, SiteGeometry
 from sim_bridge.errors import ConfigurationError
 from sim_bridge.mission import MissionProgress, MissionResult, MissionSpec, StopReason
@@ -61,13 +61,7 @@ from sim_bridge.spawn import SpawnConfig, SpawnResult, run
 
 __all__ = ['BatchRobot', 'run_oabug_batch', 'run_spawn_batch']
 
-_NS_PER_S = 1_000_000_000
 _STOP = Command(linear_mps=0.0, angular_radps=0.0, pump_on=False)
-
-
-def _stamp_ns(time_s: float) -> int:
-    """Sim time as the nodes' clock holds it: the ``/clock`` stamp in nanoseconds."""
-    return round(time_s * 1e9)
 
 
 @dataclass
@@ -107,7 +101,7 @@ class BatchRobot:
             msg = f'control_rate_hz must be > 0, got {rate_hz}'
             raise ConfigurationError(msg)
         # The node's timer: period in whole nanoseconds, first deadline one period in.
-        self.control_period_ns = int(1.0 / rate_hz * _NS_PER_S)
+        self.control_period_ns = int(1.0 / rate_hz * NS_PER_S)
         self.next_control_ns = self.control_period_ns
         self.own_tag = str(values['own_tag_id']).strip().upper()
         self.fsm = OABugFsm(self.config)
@@ -394,7 +388,7 @@ def _deliver(engine: SimEngine, out: Any, robots: list[BatchRobot], own_tags: np
     """Hand one step's readings to the robots and apply the commands of those whose
     control timer is due (what the executor does between two bridge ticks). ``own_tags``:
     per robot, the index of its own tag (-1 for none)."""
-    now_ns = _stamp_ns(out.time_s)
+    now_ns = seconds_to_ns(out.time_s)  # the nodes' clock: the /clock stamp
     now_s = now_ns * 1e-9
     if out.scans is not None:
         # The message's float32 values, widened once for every robot's feature extractor.

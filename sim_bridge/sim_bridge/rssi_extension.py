@@ -22,6 +22,7 @@ import math
 from typing import Any
 
 import numpy as np
+from swarm_common.stamps import stamp_from_seconds
 from swarm_runtime.ros import message_module, qos_profile_sensor_data
 
 from sim_bridge.extensions import RobotStates
@@ -77,8 +78,7 @@ class RssiExtension:
         self._targets_pub = node.create_publisher(swarm.RssiTargetArray, '/sim/targets', 10)
 
     def _stamp(self, time_s: float) -> Any:
-        ns = round(time_s * 1e9)
-        return self._builtin.Time(sec=int(ns // 1_000_000_000), nanosec=int(ns % 1_000_000_000))
+        return stamp_from_seconds(time_s, self._builtin.Time)
 
     def on_step(self, sim_time_s: float, states: RobotStates) -> None:
         """Work, capture, sample and publish for the physics step ending at ``sim_time_s``."""

@@ -19,6 +19,8 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+from swarm_common.segments import first_entry_fraction
+from swarm_common.stamps import stamp_from_seconds
 from swarm_runtime.ros import message_module, qos_profile_sensor_data
 
 from sim_bridge.extensions import RobotStates
@@ -36,23 +38,6 @@ class SignalSampleBatch:
 
     time_s: float
     values: np.ndarray
-
-
-def _first_entry(p0: np.ndarray, p1: np.ndarray, centre: np.ndarray, radius: float) -> float | None:
-    d = p1 - p0
-    f = p0 - centre
-    c = float(f @ f) - radius * radius
-    if c <= 0.0:
-        return 0.0
-    a = float(d @ d)
-    if a <= 0.0:
-        return None
-    b = 2.0 * float(f @ d)
-    disc = b * b - 4.0 * a * c
-    if disc < 0.0:
-        return None
-    s = (-b - math.sqrt(disc)) / (2.0 * a)
-    return s if 0.0 <= s <= 1.0 else None
 
 
 class SignalMissionModel:
@@ -129,7 +114,7 @@ class SignalMissionModel:
     def _detect(self, time_s: float, pos: np.ndarray) -> None:
         best: tuple[float, int] | None = None
         for i, (p0, p1) in enumerate(zip(self._last_positions, pos, strict=True)):
-            s = _first_entry(p0, p1, self.case.source_m, self.case.detection_radius_m)
+            s = first_entry_fraction(p0, p1, self.case.source_m, self.case.detection_radius_m)
             if s is not None:
                 t_hit = self._last_time_s + s * (time_s - self._last_time_s)
                 if best is None or t_hit < best[0]:
@@ -169,8 +154,7 @@ class SignalExtension:
         )
 
     def _stamp(self, time_s: float) -> Any:
-        ns = round(time_s * 1e9)
-        return self._builtin.Time(sec=int(ns // 1_000_000_000), nanosec=int(ns % 1_000_000_000))
+        return stamp_from_seconds(time_s, self._builtin.Time)
 
     def on_step(self, sim_time_s: float, states: RobotStates) -> None:
         self._time_s = sim_time_s

@@ -17,9 +17,10 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from swarm_common.angles import wrap_angle
 
 from sim_bridge.errors import ConfigurationError, WorldGeometryError
-from sim_bridge.geometry import WallGrid, as_segments, wrap_angle
+from sim_bridge.geometry import WallGrid, as_segments
 from sim_bridge.world_kernel import world_step_kernel
 
 __all__ = ['BodyConfig', 'World']

@@ -16,9 +16,10 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from swarm_common.angles import wrap_angle
 
 from sim_bridge.errors import ConfigurationError
-from sim_bridge.geometry import as_segments, count_crossings, padded_walls, wrap_angle
+from sim_bridge.geometry import as_segments, count_crossings, padded_walls
 from sim_bridge.raycast_kernel import sight_lines_kernel
 
 __all__ = ['BearingConfig', 'BearingCycle', 'BearingModel', 'PeerBearings']

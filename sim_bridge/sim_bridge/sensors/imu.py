@@ -12,9 +12,9 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from swarm_common.angles import wrap_angle
 
 from sim_bridge.errors import ConfigurationError
-from sim_bridge.geometry import wrap_angle
 from sim_bridge.sensors_kernel import imu_update_kernel
 
 __all__ = ['GyroYawModel', 'ImuConfig']

@@ -10,9 +10,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from swarm_common.angles import wrap_angle
 
 from sim_bridge.errors import ConfigurationError
-from sim_bridge.geometry import wrap_angle
 
 __all__ = ['OdometryConfig', 'WheelOdometry']
 

@@ -13,6 +13,7 @@ import math
 from typing import Any
 
 import numpy as np
+from swarm_common.stamps import stamp_from_seconds
 from swarm_runtime.ros import message_module
 
 from sim_bridge.sites.errors import SiteError
@@ -30,10 +31,7 @@ def _floats(values: np.ndarray | tuple[float, ...]) -> list[float]:
 
 def _stamp(time_s: float) -> Any:
     builtin_interfaces = message_module('builtin_interfaces')
-    nanoseconds = round(time_s * 1e9)
-    return builtin_interfaces.Time(
-        sec=nanoseconds // 1_000_000_000, nanosec=nanoseconds % 1_000_000_000
-    )
+    return stamp_from_seconds(time_s, builtin_interfaces.Time)
 
 
 def _door_to_msg(door: Door) -> Any:
