@@ -46,8 +46,8 @@ from typing import Any  # noqa: E402
 import numpy as np  # noqa: E402
 from bayes_swarm.batch_sim import MissionSpec, run_mission  # noqa: E402
 from bayes_swarm.messages import DecisionKind  # noqa: E402
-from sim_bridge.signal_fields import avalanche_case, get_case  # noqa: E402
-from sim_bridge.spawn_bayes_swarm import batch_mission_spec  # noqa: E402
+from swarm_experiments.spawn_bayes_swarm import batch_mission_spec  # noqa: E402
+from swarm_sim.signal_fields import avalanche_case, get_case  # noqa: E402
 
 EXPERIMENTS = (
     'main',

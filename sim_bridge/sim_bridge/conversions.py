@@ -17,10 +17,9 @@ import numpy as np
 from swarm_common.angles import yaw_from_unit_quaternion, yaw_to_quaternion
 from swarm_common.stamps import stamp_from_seconds, stamp_to_seconds
 from swarm_runtime.ros import message_module
-
-from sim_bridge.ground_truth import RoomEntry
-from sim_bridge.sensors.bearings import PeerBearings
-from sim_bridge.sensors.lidar import LidarConfig
+from swarm_sim.ground_truth import RoomEntry
+from swarm_sim.sensors.bearings import PeerBearings
+from swarm_sim.sensors.lidar import LidarConfig
 
 __all__ = [
     'RoomVisitRecord',

@@ -1,6 +1,6 @@
 """RSSI targets in the sim bridge (MSC + PF mission), as a SimExtension.
 
-The ROS-free model is :class:`sim_bridge.rssi_targets.RssiTargetField`. This adapter, every
+The ROS-free model is :class:`swarm_sim.rssi_targets.RssiTargetField`. This adapter, every
 physics step:
 
 * lets robots that stand still within D_th of a target work on it (R_w load/s each) and,
@@ -24,9 +24,9 @@ from typing import Any
 import numpy as np
 from swarm_common.stamps import stamp_from_seconds
 from swarm_runtime.ros import message_module, qos_profile_sensor_data
+from swarm_sim.rssi_targets import Capture, RssiTargetField
 
 from sim_bridge.extensions import RobotStates
-from sim_bridge.rssi_targets import Capture, RssiTargetField
 
 __all__ = ['RssiExtension']
 
