@@ -40,6 +40,8 @@ from swarm_sim.signal_fields import CASE_NAMES, SignalCase, UnknownCaseError, ge
 from swarm_sim.signal_mission import SignalMissionModel
 from swarm_sim.world import BodyConfig
 
+from swarm_experiments.bayes_batch import MissionSpec as BatchMissionSpec
+from swarm_experiments.bayes_batch import depot_fan
 from swarm_experiments.cli_args import points_argument
 from swarm_experiments.errors import ExperimentError
 from swarm_experiments.mission import MissionSpec, RecordingSpec, RobotNodeSpec, run_mission
@@ -202,16 +204,7 @@ def _engine_config(case: SignalCase, seed: int) -> EngineConfig:
 
 def _robot_layout(case: SignalCase, n: int) -> list[tuple[np.ndarray, int, int, float]]:
     """Start, first-decision fan index (1-based), fan size and offset of every robot."""
-    depots = case.depots_m
-    layout = []
-    for i in range(n):
-        depot = i % depots.shape[0]
-        fan_size = len(range(depot, n, depots.shape[0]))
-        offsets = case.depot_direction_offsets_deg
-        layout.append(
-            (depots[depot], i // depots.shape[0] + 1, fan_size, offsets[depot % len(offsets)])
-        )
-    return layout
+    return [depot_fan(case.depots_m, case.depot_direction_offsets_deg, n, i) for i in range(n)]
 
 
 def node_parameter_overrides(items: Sequence[str]) -> dict[str, Any]:
@@ -269,13 +262,12 @@ def batch_mission_spec(
     partition: str = 'strips',
     planner_options: dict[str, Any] | None = None,
 ) -> Any:
-    """The case as a spec of the ROS-free batch simulator (``bayes_swarm.batch_sim``).
+    """The case as a spec of the ROS-free batch simulator (:mod:`swarm_experiments.bayes_batch`).
 
     The planners get the case's settings (arena, V, T, f_Hz, eps, T_max, delta theta, M, L),
     never its source; ``planner_options`` override BayesSwarmConfig fields. With measurement
     noise the GP noise term is raised to it unless ``planner_options`` sets ``gp``.
     """
-    from bayes_swarm.batch_sim import MissionSpec as BatchMissionSpec
     from bayes_swarm.settings import Arena, BayesSwarmConfig, ExhaustiveConfig
 
     planner = BayesSwarmConfig(

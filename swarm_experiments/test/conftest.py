@@ -8,9 +8,32 @@ from collections.abc import Callable
 from pathlib import Path
 from types import ModuleType
 
+import numpy as np
 import pytest
+from bayes_swarm.settings import BayesSwarmConfig
+from swarm_experiments.bayes_batch import MissionSpec
 
 BENCHMARKS = Path(__file__).resolve().parents[2] / 'benchmarks'
+CASE1_SOURCE = np.array([1.0, 2.0])
+
+
+def case1_field(points):
+    """Bayes-Swarm Case 1 (Appendix C, Eq. 19)."""
+    p = np.asarray(points, dtype=float).reshape(-1, 2)
+    return np.exp(-((p - CASE1_SOURCE) ** 2).sum(1) / 3.0) + 0.5 * np.exp(
+        -2.0 * ((p - [2.0, 0.5]) ** 2).sum(1)
+    )
+
+
+@pytest.fixture
+def case1_spec():
+    """A Bayes-Swarm batch mission on Case 1 from one depot at the origin."""
+    return MissionSpec(
+        field=case1_field,
+        source_m=CASE1_SOURCE,
+        depots_m=np.array([[0.0, 0.0]]),
+        planner=BayesSwarmConfig(),
+    )
 
 
 @pytest.fixture(scope='session')

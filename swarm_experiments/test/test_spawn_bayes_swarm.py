@@ -5,11 +5,11 @@ import math
 
 import numpy as np
 import pytest
-from bayes_swarm.batch_sim import MissionSpec as HarnessSpec
-from bayes_swarm.batch_sim import run_mission as run_harness
 from bayes_swarm.messages import DecisionKind
 from bayes_swarm.settings import Arena, BayesSwarmConfig
 from swarm_analysis.tau import tau_from_bag
+from swarm_experiments.bayes_batch import MissionSpec as HarnessSpec
+from swarm_experiments.bayes_batch import run_mission as run_harness
 from swarm_experiments.errors import ExperimentError
 from swarm_experiments.spawn_bayes_swarm import SpawnSettings, batch_mission_spec, main, run
 from swarm_sim.signal_fields import get_case

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 from swarm_common.segments import first_entry_fraction
 
+from swarm_sim.point_robots import noisy_samples
 from swarm_sim.signal_fields import SignalCase
 
 __all__ = ['SignalMissionModel', 'SignalSampleBatch']
@@ -79,11 +80,9 @@ class SignalMissionModel:
 
     def sample(self, positions_m: np.ndarray) -> np.ndarray:
         """(N,) noisy field values at (N, 2) positions."""
-        values = np.asarray(self.case.field(positions_m), dtype=float)
-        std = self.noise_std + self.relative_noise * np.abs(values)
-        if np.any(std > 0.0):
-            values = values + std * self._rng.standard_normal(values.shape)
-        return values
+        return noisy_samples(
+            self.case.field, positions_m, self.noise_std, self.relative_noise, self._rng
+        )
 
     def step(self, time_s: float, positions_m: np.ndarray) -> SignalSampleBatch | None:
         """Advance to ``time_s`` with the robots at (N, 2) positions; samples if one is due."""

@@ -1,13 +1,14 @@
-"""Fast ROS-free mission simulator for Bayes-Swarm and its baselines.
+"""Batch runner of Bayes-Swarm missions and their baselines, without the runtime.
 
-It steps the same planner objects the ROS node uses, with the paper's motion model: robots
-fly straight legs at V, sample the field at every tick of the observation clock
-(t = k / f_Hz, all robots), decide on arrival at their waypoint (so decisions are
-asynchronous) and broadcast a :class:`~bayes_swarm.messages.PeerUpdate`, delivered at once to
-every robot within ``comm_range_m`` unless dropped with probability ``loss_probability``.
-Detection is continuous: a mission succeeds at the first instant any robot comes within eps
-of the source along its straight leg. Glowworm runs after the first dispersal leg as a
-synchronous iteration at its own decision rate.
+It steps the same planner objects the ROS node uses in the paper's motion model
+(:class:`swarm_sim.point_robots.PointRobotField`): robots fly straight legs at V, sample the
+field at every tick of the observation clock (t = k / f_Hz, all robots), decide on arrival at
+their waypoint (so decisions are asynchronous) and broadcast a
+:class:`~bayes_swarm.messages.PeerUpdate`, delivered at once to every robot within
+``comm_range_m`` unless dropped with probability ``loss_probability``. Detection is
+continuous: a mission succeeds at the first instant any robot comes within eps of the source
+along its straight leg. Glowworm runs after the first dispersal leg as a synchronous
+iteration at its own decision rate.
 
 Decisions take no simulated time; their wall-clock duration is recorded per robot.
 """
@@ -16,13 +17,10 @@ from __future__ import annotations
 
 import math
 from abc import ABC, abstractmethod
-from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from typing import Literal
 
 import numpy as np
-from swarm_common.segments import first_entry_fraction
-
 from bayes_swarm.baselines.exhaustive import sweep_paths
 from bayes_swarm.baselines.glowworm import GlowwormSwarm
 from bayes_swarm.baselines.levy import LevyWalk
@@ -36,19 +34,19 @@ from bayes_swarm.settings import (
     GlowwormConfig,
     LevyConfig,
 )
+from swarm_sim.point_robots import FieldFunction, PointRobotField
 
 __all__ = [
     'ALGORITHMS',
     'MissionResult',
     'MissionSpec',
-    'first_entry_fraction',
+    'depot_fan',
     'robot_start_and_fan',
     'run_mission',
 ]
 
 Algorithm = Literal['bayes_swarm_p', 'bayes_swarm_o', 'glowworm', 'levy', 'exhaustive']
 ALGORITHMS: tuple[str, ...] = ('bayes_swarm_p', 'bayes_swarm_o', 'glowworm', 'levy', 'exhaustive')
-FieldFunction = Callable[[np.ndarray], np.ndarray]
 _TIME_EPS = 1e-9
 
 
@@ -129,75 +127,48 @@ class MissionResult:
         return np.array([d.compute_time_s for ds in lists for d in ds])
 
 
+def depot_fan(
+    depots_m: np.ndarray, offsets_deg: tuple[float, ...], n_robots: int, robot: int
+) -> tuple[np.ndarray, int, int, float]:
+    """Depot (2,), first-decision fan index (1-based), fan size and heading offset of a robot:
+    robot i starts at depot i mod d, and the robots of one depot share its fan."""
+    n_depots = depots_m.shape[0]
+    depot = robot % n_depots
+    fan_size = len(range(depot, n_robots, n_depots))
+    fan_index = robot // n_depots + 1
+    return depots_m[depot], fan_index, fan_size, offsets_deg[depot % len(offsets_deg)]
+
+
 def robot_start_and_fan(
     spec: MissionSpec, n_robots: int, robot: int
 ) -> tuple[np.ndarray, int, int, float]:
     """Start (2,), first-decision fan index (1-based), fan size and heading offset of a robot."""
-    n_depots = spec.depots_m.shape[0]
-    depot = robot % n_depots
-    fan_size = len(range(depot, n_robots, n_depots))
-    fan_index = robot // n_depots + 1
-    offsets = spec.depot_direction_offsets_deg
-    return spec.depots_m[depot].astype(float), fan_index, fan_size, offsets[depot % len(offsets)]
+    depot, fan_index, fan_size, offset = depot_fan(
+        spec.depots_m, spec.depot_direction_offsets_deg, n_robots, robot
+    )
+    return depot.astype(float), fan_index, fan_size, offset
 
 
-class _World:
-    """Robot kinematics, sampling and detection shared by the event loops."""
+def _world(spec: MissionSpec, n_robots: int, rng: np.random.Generator) -> PointRobotField:
+    starts = np.array([robot_start_and_fan(spec, n_robots, i)[0] for i in range(n_robots)])
+    return PointRobotField(
+        starts,
+        spec.field,
+        spec.source_m,
+        spec.planner.detection_radius_m,
+        rng,
+        noise_std=spec.noise_std,
+        relative_noise=spec.relative_noise,
+    )
 
-    def __init__(self, spec: MissionSpec, n_robots: int, rng: np.random.Generator) -> None:
-        self.spec = spec
-        self.rng = rng
-        self.starts = np.array([robot_start_and_fan(spec, n_robots, i)[0] for i in range(n_robots)])
-        self.positions = self.starts.copy()
-        self.trajectories: list[list[np.ndarray]] = [[p.copy()] for p in self.starts]
-        self.found_time = math.nan
-        self.finder = -1
 
-    def sample(self, points: np.ndarray) -> np.ndarray:
-        values = np.asarray(self.spec.field(points), dtype=float)
-        std = self.spec.noise_std + self.spec.relative_noise * np.abs(values)
-        if np.any(std > 0.0):
-            values = values + std * self.rng.standard_normal(values.shape)
-        return values
-
-    def move(self, targets: np.ndarray, t0: float, t1: float, speed: float) -> bool:
-        """Move every robot toward its target for t1 - t0 seconds; True on detection."""
-        spec = self.spec
-        budget = speed * (t1 - t0)
-        best: tuple[float, int] | None = None
-        new_positions = self.positions.copy()
-        for i, (p, target) in enumerate(zip(self.positions, targets, strict=True)):
-            delta = target - p
-            dist = float(np.hypot(*delta))
-            if dist <= 0.0 or budget <= 0.0:
-                end = p
-            else:
-                end = target if dist <= budget + 1e-12 else p + delta * (budget / dist)
-            frac = first_entry_fraction(p, end, spec.source_m, spec.planner.detection_radius_m)
-            if frac is not None:
-                travelled = frac * float(np.hypot(*(end - p)))
-                t_hit = t0 + travelled / speed
-                if best is None or t_hit < best[0]:
-                    best = (t_hit, i)
-            new_positions[i] = end
-        if best is not None:
-            self.found_time, self.finder = best
-            hit_budget = speed * (best[0] - t0)
-            for i, (p, target) in enumerate(zip(self.positions, targets, strict=True)):
-                delta = target - p
-                dist = float(np.hypot(*delta))
-                step = min(dist, hit_budget)
-                self.positions[i] = p if dist <= 0 else p + delta * (step / dist)
-            return True
-        self.positions = new_positions
-        return False
-
-    def tau(self) -> float:
-        if self.finder < 0:
-            return math.nan
-        ideal = float(np.hypot(*(self.spec.source_m - self.starts[self.finder])))
-        ideal /= self.spec.planner.velocity_mps
-        return (self.found_time - ideal) / ideal
+def _tau(spec: MissionSpec, world: PointRobotField) -> float:
+    """Relative completion time (Eq. 12) of the finder, NaN if none."""
+    if world.finder < 0:
+        return math.nan
+    ideal = float(np.hypot(*(spec.source_m - world.starts[world.finder])))
+    ideal /= spec.planner.velocity_mps
+    return (world.found_time_s - ideal) / ideal
 
 
 def run_mission(
@@ -212,7 +183,7 @@ def run_mission(
         raise ConfigError(msg)
     seeds = np.random.SeedSequence(seed).spawn(n_robots + 1)
     world_rng = np.random.default_rng(seeds[0])
-    world = _World(spec, n_robots, world_rng)
+    world = _world(spec, n_robots, world_rng)
     if algorithm == 'glowworm':
         return _run_glowworm(spec, world, n_robots, seeds)
     agents = _make_agents(spec, algorithm, n_robots, seeds, world)
@@ -287,7 +258,7 @@ def _make_agents(
     algorithm: str,
     n_robots: int,
     seeds: list[np.random.SeedSequence],
-    world: _World,
+    world: PointRobotField,
 ) -> list[_Agent]:
     if algorithm == 'levy':
         return [
@@ -320,7 +291,7 @@ def _make_agents(
 
 # ----------------------------------------------------------------------- event loop
 def _deliver(
-    spec: MissionSpec, world: _World, agents: list[_Agent], sender: int, update: PeerUpdate
+    spec: MissionSpec, world: PointRobotField, agents: list[_Agent], sender: int, update: PeerUpdate
 ) -> None:
     for j, agent in enumerate(agents):
         if j == sender:
@@ -335,7 +306,7 @@ def _deliver(
 
 
 def _run_events(
-    spec: MissionSpec, world: _World, agents: list[_Agent], keep_planners: bool
+    spec: MissionSpec, world: PointRobotField, agents: list[_Agent], keep_planners: bool
 ) -> MissionResult:
     cfg = spec.planner
     n = len(agents)
@@ -375,7 +346,7 @@ def _run_events(
         t_next = min(next_tick, float(np.min(arrivals[moving])) if np.any(moving) else math.inf)
         t_next = min(t_next, t_max)
         if world.move(waypoints, t, t_next, speed):
-            t = world.found_time
+            t = world.found_time_s
             break
         t = t_next
         if abs(t - next_tick) <= _TIME_EPS:
@@ -389,9 +360,9 @@ def _run_events(
     planners = [a.planner for a in agents if a.planner is not None] if keep_planners else []
     return MissionResult(
         found=world.finder >= 0,
-        found_time_s=world.found_time,
+        found_time_s=world.found_time_s,
         finder=world.finder,
-        tau=world.tau(),
+        tau=_tau(spec, world),
         decisions=decisions,
         trajectories=[np.array(tr) for tr in world.trajectories],
         planners=planners,
@@ -400,7 +371,7 @@ def _run_events(
 
 
 def _run_glowworm(
-    spec: MissionSpec, world: _World, n_robots: int, seeds: list[np.random.SeedSequence]
+    spec: MissionSpec, world: PointRobotField, n_robots: int, seeds: list[np.random.SeedSequence]
 ) -> MissionResult:
     cfg = spec.planner
     speed = cfg.velocity_mps
@@ -432,7 +403,7 @@ def _run_glowworm(
             k += 1
             t_next = t_disperse + k * period
             if world.move(new_positions.copy(), t, t_next, speed):
-                t = world.found_time
+                t = world.found_time_s
                 break
             world.positions = new_positions.copy()
             t = t_next
@@ -440,9 +411,9 @@ def _run_glowworm(
         world.trajectories[i].append(world.positions[i].copy())
     return MissionResult(
         found=world.finder >= 0,
-        found_time_s=world.found_time,
+        found_time_s=world.found_time_s,
         finder=world.finder,
-        tau=world.tau(),
+        tau=_tau(spec, world),
         decisions=decisions,
         trajectories=[np.array(tr) for tr in world.trajectories],
         end_time_s=t,

@@ -1,11 +1,12 @@
-"""End-to-end runs of the ROS-free mission simulator."""
+"""End-to-end runs of the Bayes-Swarm batch runner."""
 
 from dataclasses import replace
 
 import numpy as np
 import pytest
-from bayes_swarm.batch_sim import first_entry_fraction, run_mission
 from bayes_swarm.errors import ConfigError
+from swarm_common.segments import first_entry_fraction
+from swarm_experiments.bayes_batch import run_mission
 
 
 def test_detection_happens_at_the_first_entry_into_the_epsilon_disc():
