@@ -1,7 +1,8 @@
 """The sim bridge node: publishes every robot's sensor topics from the simulated world.
 
 Per robot ``<name>`` (r0, r1, ...) it publishes ``/<name>/scan``, ``gas``, ``bearings``,
-``imu`` and ``odom`` (sensor-data QoS) and subscribes ``/<name>/cmd_vel`` and ``pump``;
+``imu`` and ``odom`` (sensor-data QoS; only the sensors of the engine configuration's
+``sensors``, all by default) and subscribes ``/<name>/cmd_vel`` and ``pump``;
 swarm-wide it publishes ``/clock`` and the ground truth ``/sim/poses``, ``/sim/coverage``
 (and ``/sim/site`` when the site model can be converted). With ``peer_msg_type`` set it
 relays ``/<name>/peers/out`` to the other robots' ``peers/in`` within ``comm_range_m``.
@@ -116,25 +117,28 @@ class SimBridgeNode(Node):
         self._poses_pub = self.create_publisher(_swarm.TruePoseArray, '/sim/poses', 10)
         self._coverage_pub = self.create_publisher(_swarm.Coverage, '/sim/coverage', _LATCHED)
         sensor_qos = qos_profile_sensor_data
-        self._scan_pubs = []
-        self._gas_pubs = []
-        self._bearing_pubs = []
-        self._imu_pubs = []
-        self._odom_pubs = []
+        sensors = self.engine.sensors
+        # Per robot, a publisher of each sensor the mission runs (None: not simulated).
+        self._scan_pubs: list[Any] = []
+        self._gas_pubs: list[Any] = []
+        self._bearing_pubs: list[Any] = []
+        self._imu_pubs: list[Any] = []
+        self._odom_pubs: list[Any] = []
+        topics = (
+            ('scan', self._scan_pubs, _sensor.LaserScan),
+            ('gas', self._gas_pubs, _swarm.GasReading),
+            ('bearings', self._bearing_pubs, _swarm.PeerBearingArray),
+            ('imu', self._imu_pubs, _sensor.Imu),
+            ('odometry', self._odom_pubs, _nav.Odometry),
+        )
         for i, name in enumerate(self.robot_names):
-            self._scan_pubs.append(
-                self.create_publisher(_sensor.LaserScan, f'/{name}/scan', sensor_qos)
-            )
-            self._gas_pubs.append(
-                self.create_publisher(_swarm.GasReading, f'/{name}/gas', sensor_qos)
-            )
-            self._bearing_pubs.append(
-                self.create_publisher(_swarm.PeerBearingArray, f'/{name}/bearings', sensor_qos)
-            )
-            self._imu_pubs.append(self.create_publisher(_sensor.Imu, f'/{name}/imu', sensor_qos))
-            self._odom_pubs.append(
-                self.create_publisher(_nav.Odometry, f'/{name}/odom', sensor_qos)
-            )
+            for sensor, pubs, msg_type in topics:
+                topic = f'/{name}/{"odom" if sensor == "odometry" else sensor}'
+                pubs.append(
+                    self.create_publisher(msg_type, topic, sensor_qos)
+                    if sensor in sensors
+                    else None
+                )
             self.create_subscription(
                 _geometry.Twist, f'/{name}/cmd_vel', self._make_cmd_callback(i), 10
             )

@@ -32,6 +32,7 @@ relay (OA-Bug uses neither): it is for sweeps. The ROS path stays the product.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from collections.abc import Callable, Mapping, Sequence
@@ -48,7 +49,7 @@ from oabug_robot.sound import PeerBearings
 from swarm_common.angles import yaw_from_quaternion, yaw_to_quaternion
 from swarm_common.stamps import NS_PER_S, seconds_to_ns
 from swarm_runtime.builtin._messages import cdr_roundtrip_enabled
-from swarm_sim.engine import READINGS, EngineConfig, SimEngine, SiteGeometry
+from swarm_sim.engine import EngineConfig, SimEngine, SiteGeometry
 from swarm_sim.errors import ConfigurationError
 from swarm_sim.sensors.bearings import BearingCycle
 from swarm_sim.sensors.bearings import PeerBearings as BearingReport
@@ -324,8 +325,7 @@ def run_oabug_batch(
     engine = SimEngine(
         geometry,
         np.asarray(spec.initial_poses, dtype=float),
-        engine_config,
-        readings=READINGS - unused,
+        dataclasses.replace(engine_config, sensors=engine_config.sensors - unused),
         bearing_cycles=True,
     )
     n = engine.num_robots

@@ -31,14 +31,8 @@ from sim_bridge.signal_extension import SignalExtension
 from swarm_common.errors import SwarmError
 from swarm_sim.engine import EngineConfig, SiteGeometry
 from swarm_sim.errors import ConfigurationError
-from swarm_sim.sensors.bearings import BearingConfig
-from swarm_sim.sensors.gas_sensor import GasSensorConfig
-from swarm_sim.sensors.imu import ImuConfig
-from swarm_sim.sensors.lidar import LidarConfig
-from swarm_sim.sensors.odometry import OdometryConfig
 from swarm_sim.signal_fields import CASE_NAMES, SignalCase, UnknownCaseError, get_case
 from swarm_sim.signal_mission import SignalMissionModel
-from swarm_sim.world import BodyConfig
 
 from swarm_experiments.bayes_batch import MissionSpec as BatchMissionSpec
 from swarm_experiments.bayes_batch import depot_fan
@@ -46,6 +40,7 @@ from swarm_experiments.cli_args import points_argument
 from swarm_experiments.errors import ExperimentError
 from swarm_experiments.mission import MissionSpec, RecordingSpec, RobotNodeSpec, run_mission
 from swarm_experiments.node_overrides import parse_overrides
+from swarm_experiments.open_field import point_robot_engine_config
 
 __all__ = [
     'ALGORITHMS',
@@ -76,9 +71,7 @@ DEFAULT_RECORD_TOPICS = (
     '/r*/state',
     '/r*/peers/out',
 )
-_UNUSED_SENSOR_RATE_HZ = 0.01
 GLOWWORM_RATE_HZ = 100.0
-_POINT_ROBOT_RADIUS_M = 1e-3
 
 
 @dataclass(frozen=True)
@@ -185,20 +178,8 @@ def _arena_site(case: SignalCase) -> SiteGeometry:
 
 
 def _engine_config(case: SignalCase, seed: int) -> EngineConfig:
-    slow = _UNUSED_SENSOR_RATE_HZ
-    return EngineConfig(
-        physics_rate_hz=20.0,
-        seed=seed,
-        body=BodyConfig(
-            robot_radius_m=_POINT_ROBOT_RADIUS_M,
-            max_linear_speed_mps=1.05 * case.velocity_mps,
-            max_angular_speed_radps=2.0,
-        ),
-        lidar=LidarConfig(rate_hz=slow, num_bins=8),
-        gas=GasSensorConfig(rate_hz=slow),
-        bearings=BearingConfig(rate_hz=slow),
-        imu=ImuConfig(rate_hz=slow),
-        odometry=OdometryConfig(rate_hz=20.0),
+    return point_robot_engine_config(
+        physics_rate_hz=20.0, seed=seed, max_linear_speed_mps=1.05 * case.velocity_mps
     )
 
 

@@ -33,12 +33,6 @@ from swarm_common.errors import SwarmError
 from swarm_sim.engine import EngineConfig, SiteGeometry
 from swarm_sim.errors import ConfigurationError
 from swarm_sim.rssi_targets import RssiTargetConfig, RssiTargetField, place_robots
-from swarm_sim.sensors.bearings import BearingConfig
-from swarm_sim.sensors.gas_sensor import GasSensorConfig
-from swarm_sim.sensors.imu import ImuConfig
-from swarm_sim.sensors.lidar import LidarConfig
-from swarm_sim.sensors.odometry import OdometryConfig
-from swarm_sim.world import BodyConfig
 
 from swarm_experiments.cli_args import points_argument
 from swarm_experiments.errors import ExperimentError
@@ -50,6 +44,7 @@ from swarm_experiments.mission import (
     run_mission,
 )
 from swarm_experiments.node_overrides import parse_overrides
+from swarm_experiments.open_field import point_robot_engine_config
 
 __all__ = ['SCHEMES', 'MscPfRun', 'SpawnSettings', 'controller_parameter_overrides', 'main', 'run']
 
@@ -59,8 +54,6 @@ SPAWNER_PARAMETERS = ('scheme', 'seed', 'robot_id', 'field_size_m', 'swarm.comm_
 SCHEMES = ('proposed', 'msc_pf', 'msc')
 PEER_TYPE = 'swarm_interfaces/msg/MscPeer'
 DEFAULT_RECORD_TOPICS = ('/clock', '/sim/poses', '/sim/targets', '/r*/state', '/r*/peers/out')
-_UNUSED_SENSOR_RATE_HZ = 0.01
-_POINT_ROBOT_RADIUS_M = 1e-3
 
 
 @dataclass(frozen=True)
@@ -143,20 +136,8 @@ def _check(settings: SpawnSettings) -> None:
 
 
 def _engine_config(settings: SpawnSettings) -> EngineConfig:
-    slow = _UNUSED_SENSOR_RATE_HZ
-    return EngineConfig(
-        physics_rate_hz=settings.physics_rate_hz,
-        seed=settings.seed,
-        body=BodyConfig(
-            robot_radius_m=_POINT_ROBOT_RADIUS_M,
-            max_linear_speed_mps=1.05,
-            max_angular_speed_radps=2.0,
-        ),
-        lidar=LidarConfig(rate_hz=slow, num_bins=8),
-        gas=GasSensorConfig(rate_hz=slow),
-        bearings=BearingConfig(rate_hz=slow),
-        imu=ImuConfig(rate_hz=slow),
-        odometry=OdometryConfig(rate_hz=settings.physics_rate_hz),
+    return point_robot_engine_config(
+        physics_rate_hz=settings.physics_rate_hz, seed=settings.seed, max_linear_speed_mps=1.05
     )
 
 

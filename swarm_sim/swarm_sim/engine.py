@@ -32,10 +32,11 @@ from swarm_sim.sensors.odometry import OdometryConfig, WheelOdometry
 from swarm_sim.sensors.scent import PumpDepositor, ScentConfig, ScentField
 from swarm_sim.world import BodyConfig, World
 
-__all__ = ['READINGS', 'EngineConfig', 'SimEngine', 'SiteGeometry', 'StepOutput']
+__all__ = ['SENSORS', 'EngineConfig', 'SimEngine', 'SiteGeometry', 'StepOutput']
 
-# The per-robot readings the engine produces (the bridge's sensor topics).
-READINGS = frozenset({'scan', 'gas', 'bearings', 'imu', 'odometry'})
+# The per-robot sensors the engine can simulate (the bridge's sensor topics): lidar scan, gas
+# (the MP503 over the scent field), AoA bearings of peers, IMU yaw, wheel odometry.
+SENSORS = frozenset({'scan', 'gas', 'bearings', 'imu', 'odometry'})
 
 
 @dataclass(frozen=True)
@@ -68,6 +69,10 @@ class EngineConfig:
         pump_offset_m: pump nozzle distance behind the robot's centre [m].
         ground_truth_rate_hz: rate of the true-pose output [Hz].
         seed: seed of every random draw in the world.
+        sensors: the sensors the mission runs (a subset of :data:`SENSORS`, all by default).
+            Each model draws from its own random stream, so leaving one out changes none of
+            the others; a sensor left out is not built and costs nothing. Without ``gas``
+            there is no scent field either (pumps then lay nothing).
     """
 
     physics_rate_hz: float = 10.0
@@ -76,6 +81,7 @@ class EngineConfig:
     pump_offset_m: float = 0.12
     ground_truth_rate_hz: float = 2.0
     seed: int = 0
+    sensors: frozenset[str] = SENSORS
     body: BodyConfig = field(default_factory=BodyConfig)
     lidar: LidarConfig = field(default_factory=LidarConfig)
     scent: ScentConfig = field(default_factory=ScentConfig)
@@ -95,6 +101,11 @@ class EngineConfig:
         if self.seed < 0:
             msg = f'seed must be >= 0, got {self.seed}'
             raise ConfigurationError(msg)
+        unknown = set(self.sensors) - SENSORS
+        if unknown:
+            msg = f'unknown sensors {sorted(unknown)}; choose from {sorted(SENSORS)}'
+            raise ConfigurationError(msg)
+        object.__setattr__(self, 'sensors', frozenset(self.sensors))
 
     @property
     def physics_period_s(self) -> float:
@@ -165,7 +176,6 @@ class SimEngine:
         initial_poses: np.ndarray,
         config: EngineConfig | None = None,
         *,
-        readings: frozenset[str] = READINGS,
         bearing_cycles: bool = False,
     ) -> None:
         """Build the world and its models.
@@ -173,22 +183,11 @@ class SimEngine:
         Args:
             site: walls and rooms.
             initial_poses: (N, 3) start poses x [m], y [m], yaw [rad].
-            config: the world's configuration.
-            readings: the readings to produce (all by default). Each model draws from its
-                own random stream, so leaving one out changes none of the others; a caller
-                that consumes no odometry (the OA-Bug batch path) saves its cost.
+            config: the world's configuration, with the sensors to run.
             bearing_cycles: hand the bearings over as one :class:`BearingCycle` of flat
                 arrays (``StepOutput.bearing_cycle``) instead of a report per robot (the
                 same values and random draws).
-
-        Raises:
-            ConfigurationError: an unknown reading is named.
         """
-        unknown = set(readings) - READINGS
-        if unknown:
-            msg = f'unknown readings {sorted(unknown)}; choose from {sorted(READINGS)}'
-            raise ConfigurationError(msg)
-        self.readings = frozenset(readings)
         self._bearing_cycles = bearing_cycles
         self.config = config or EngineConfig()
         cfg = self.config
@@ -197,20 +196,34 @@ class SimEngine:
         n = self.world.num_robots
         streams = np.random.SeedSequence(cfg.seed).spawn(5)
         rngs = [np.random.default_rng(s) for s in streams]
-        caster = RayCaster(
-            self.world.walls,
-            wall_thickness_m=cfg.body.wall_thickness_m,
-            robot_radius_m=cfg.body.robot_radius_m,
-            num_bins=cfg.lidar.num_bins,
-        )
-        self.lidar = LidarModel(caster, cfg.lidar, rngs[0])
-        self.scent = ScentField(cfg.scent, self.world.walls)
-        self._depositor = PumpDepositor(self.scent, n)
-        self.gas = Mp503Model(n, cfg.gas, rngs[1])
-        self.bearing_model = BearingModel(n, cfg.bearings, rngs[2], self.world.walls)
+        self.sensors = cfg.sensors
         poses = self.world.poses
-        self.imu = GyroYawModel(poses[:, 2], cfg.imu, rngs[3])
-        self.odometry = WheelOdometry(poses, cfg.odometry, rngs[4])
+        # One random stream per sensor, in a fixed order, whichever sensors run.
+        self.lidar: LidarModel | None = None
+        self.scent: ScentField | None = None
+        self._depositor: PumpDepositor | None = None
+        self.gas: Mp503Model | None = None
+        self.bearing_model: BearingModel | None = None
+        self.imu: GyroYawModel | None = None
+        self.odometry: WheelOdometry | None = None
+        if 'scan' in self.sensors:
+            caster = RayCaster(
+                self.world.walls,
+                wall_thickness_m=cfg.body.wall_thickness_m,
+                robot_radius_m=cfg.body.robot_radius_m,
+                num_bins=cfg.lidar.num_bins,
+            )
+            self.lidar = LidarModel(caster, cfg.lidar, rngs[0])
+        if 'gas' in self.sensors:
+            self.scent = ScentField(cfg.scent, self.world.walls)
+            self._depositor = PumpDepositor(self.scent, n)
+            self.gas = Mp503Model(n, cfg.gas, rngs[1])
+        if 'bearings' in self.sensors:
+            self.bearing_model = BearingModel(n, cfg.bearings, rngs[2], self.world.walls)
+        if 'imu' in self.sensors:
+            self.imu = GyroYawModel(poses[:, 2], cfg.imu, rngs[3])
+        if 'odometry' in self.sensors:
+            self.odometry = WheelOdometry(poses, cfg.odometry, rngs[4])
         self.coverage = CoverageTracker(
             site.room_rects, cfg.body.robot_radius_m, site.room_index_at
         )
@@ -331,33 +344,33 @@ class SimEngine:
         self.distance_travelled_m += np.hypot(*(poses[:, :2] - before[:, :2]).T)
         # The headings serve the nozzles and the gas sensors: computed once, when needed.
         headings = None
-        if self._depositor.busy(pumping):
+        depositor = self._depositor
+        if depositor is not None and depositor.busy(pumping):
             headings = _headings(poses)
-            self._depositor.step(pumping, self.nozzle_positions(poses, headings), self.time_s, dt)
+            depositor.step(pumping, self.nozzle_positions(poses, headings), self.time_s, dt)
         out = StepOutput(time_s=self.time_s, poses=poses)
         out.new_room_entries = self.coverage.update(poses, self.time_s)
         sched = self._schedules
-        wanted = self.readings
-        if sched['scan'].due(self.time_s)[0] and 'scan' in wanted:
+        if sched['scan'].due(self.time_s)[0] and self.lidar is not None:
             out.scans = self.lidar.measure(poses)
         due, elapsed = sched['gas'].due(self.time_s)
-        if due and 'gas' in wanted:
+        if due and self.gas is not None and self.scent is not None:
             if headings is None:
                 headings = _headings(poses)
             c = self.scent.concentration(self.gas_sensor_positions(poses, headings), self.time_s)
             out.gas_raw = self.gas.update(c, elapsed)
-        if sched['bearings'].due(self.time_s)[0] and 'bearings' in wanted:
+        if sched['bearings'].due(self.time_s)[0] and self.bearing_model is not None:
             if self._bearing_cycles:
                 out.bearing_cycle = self.bearing_model.measure_cycle(poses)
             else:
                 out.bearings = self.bearing_model.measure(poses)
         due, elapsed = sched['imu'].due(self.time_s)
-        if due and 'imu' in wanted:
+        if due and self.imu is not None:
             change = np.asarray(wrap_angle(poses[:, 2] - self._imu_last_yaw), dtype=float)
             self._imu_last_yaw = poses[:, 2].copy()
             out.imu = self.imu.update(change, elapsed)
         due, elapsed = sched['odometry'].due(self.time_s)
-        if due and 'odometry' in wanted:
+        if due and self.odometry is not None:
             out.odometry = self.odometry.update(poses, elapsed)
         out.ground_truth_due = sched['ground_truth'].due(self.time_s)[0]
         return out

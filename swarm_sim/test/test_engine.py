@@ -4,7 +4,7 @@ import math
 
 import numpy as np
 import pytest
-from swarm_sim.engine import EngineConfig, SimEngine, SiteGeometry
+from swarm_sim.engine import SENSORS, EngineConfig, SimEngine, SiteGeometry
 from swarm_sim.errors import ConfigurationError, WorldGeometryError
 from swarm_sim.ground_truth import CoverageTracker
 
@@ -126,15 +126,16 @@ def test_coverage_counts_a_room_only_once_the_body_is_inside():
 
 
 def test_leaving_a_reading_out_changes_none_of_the_others():
-    def outputs(**kwargs):
+    def outputs(sensors=SENSORS):
         site = SiteGeometry(walls=WALLS, room_rects=ROOM, name='hall')
-        engine = SimEngine(site, np.array([[1.0, 1.5, 0.0], [2.0, 0.5, 1.0]]), **kwargs)
+        config = EngineConfig(sensors=sensors)
+        engine = SimEngine(site, np.array([[1.0, 1.5, 0.0], [2.0, 0.5, 1.0]]), config)
         for i in range(2):
             engine.set_pump(i, True)
         return run(engine, 3.0, command=(0.2, 0.3))
 
     full = outputs()
-    lean = outputs(readings=frozenset({'scan', 'gas', 'bearings', 'imu'}))
+    lean = outputs(frozenset({'scan', 'gas', 'bearings', 'imu'}))
     assert all(o.odometry is None for o in lean)
     assert any(o.odometry is not None for o in full)
     for a, b in zip(full, lean, strict=True):
@@ -150,7 +151,32 @@ def test_leaving_a_reading_out_changes_none_of_the_others():
                 r.azimuth_rad.tolist() for r in b.bearings
             ]
     with pytest.raises(ConfigurationError, match='sonar'):
-        outputs(readings=frozenset({'scan', 'sonar'}))
+        outputs(frozenset({'scan', 'sonar'}))
+
+
+def test_a_mission_runs_only_the_sensors_it_chooses():
+    """An odometry-only world builds no lidar, gas, scent, bearings or IMU model, and its
+    odometry and poses equal those of a world running every sensor (per-sensor streams)."""
+
+    def run_with(sensors):
+        site = SiteGeometry(walls=WALLS, room_rects=ROOM, name='hall')
+        config = EngineConfig(sensors=sensors, seed=5)
+        engine = SimEngine(site, np.array([[1.0, 1.5, 0.0], [2.0, 0.5, 1.0]]), config)
+        engine.set_pump(0, True)
+        return engine, run(engine, 3.0, command=(0.2, 0.3))
+
+    lean_engine, lean = run_with(frozenset({'odometry'}))
+    _, full = run_with(SENSORS)
+    models = ('lidar', 'gas', 'scent', 'bearing_model', 'imu')
+    assert all(getattr(lean_engine, name) is None for name in models)
+    assert lean_engine.sensors == frozenset({'odometry'})
+    assert any(o.odometry is not None for o in lean)
+    for a, b in zip(full, lean, strict=True):
+        assert (b.scans, b.gas_raw, b.bearings, b.imu) == (None, None, None, None)
+        assert np.array_equal(a.poses, b.poses)
+        assert (a.odometry is None) == (b.odometry is None)
+        if a.odometry is not None:
+            assert all(np.array_equal(x, y) for x, y in zip(a.odometry, b.odometry, strict=True))
 
 
 def test_commands_set_together_equal_commands_set_one_by_one():
