@@ -166,9 +166,9 @@ def quiet_garbage_collector() -> None:
 def run_job(job: Job) -> Outcome:
     """Run one job headless (called in a worker process)."""
     from swarm_experiments.oabug_batch import run_spawn_batch
-    from swarm_experiments.spawn import SpawnConfig, run
+    from swarm_experiments.spawn import SpawnSettings, run
 
-    config = SpawnConfig(
+    config = SpawnSettings(
         site=job.config,
         site_seed=job.site_seed,
         variant=job.variant,

@@ -58,7 +58,7 @@ from swarm_sim.sensors_kernel import imu_message_yaw_kernel
 from swarm_sim.site_geometry import geometry_from_site
 
 from swarm_experiments.mission import MissionProgress, MissionResult, MissionSpec, StopReason
-from swarm_experiments.spawn import SpawnConfig, SpawnResult, run
+from swarm_experiments.spawn import OABugRun, SpawnSettings, run
 
 __all__ = ['BatchRobot', 'run_oabug_batch', 'run_spawn_batch']
 
@@ -507,9 +507,9 @@ def _near_peers(
 
 
 def run_spawn_batch(
-    config: SpawnConfig, *, progress: Callable[[MissionProgress], None] | None = None
-) -> SpawnResult:
-    """:func:`swarm_experiments.spawn.run` on the batch path: the same run, figures included.
+    config: SpawnSettings, *, progress: Callable[[MissionProgress], None] | None = None
+) -> OABugRun:
+    """:func:`swarm_experiments.spawn.run` on the batch path: the same run, plots included.
 
     Raises:
         ConfigurationError: ``config.record`` is set (the batch path records no bags).

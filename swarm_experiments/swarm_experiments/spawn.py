@@ -24,6 +24,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+from swarm_common.cli import EXIT_SUCCESS, fail
 from swarm_common.errors import SwarmError
 from swarm_sim.departure import departure_poses
 from swarm_sim.engine import EngineConfig
@@ -45,8 +46,8 @@ __all__ = [
     'ACTION_LENGTH_M',
     'DEFAULT_RECORD_TOPICS',
     'VARIANTS',
-    'SpawnConfig',
-    'SpawnResult',
+    'OABugRun',
+    'SpawnSettings',
     'main',
     'oabug_parameter_overrides',
     'run',
@@ -70,7 +71,7 @@ SPAWNER_PARAMETERS = (
 
 
 @dataclass(frozen=True)
-class SpawnConfig:
+class SpawnSettings:
     """One OA-Bug run.
 
     Attributes:
@@ -87,7 +88,7 @@ class SpawnConfig:
         speed_mps: the robots' cruise speed [m/s].
         record: bag directory to write, or None.
         record_robot_topics: also record each robot's state, cmd_vel and pump topics.
-        out_dir: directory for the PNGs, or None for no figures.
+        out_dir: directory for the PNGs, or None for no plots.
         robot_parameters: extra OA-Bug node parameters for every robot.
         engine: world configuration (its seed is replaced by ``seed``).
     """
@@ -136,20 +137,20 @@ class SpawnConfig:
 
 
 @dataclass(frozen=True)
-class SpawnResult:
+class OABugRun:
     """A finished run.
 
     Attributes:
-        config: what was run.
+        settings: what was run.
         mission: the mission runner's result.
         heading_bias_rad: the fan's common bias used [rad].
-        figures: PNG files written.
+        plots: PNG files written.
     """
 
-    config: SpawnConfig
+    settings: SpawnSettings
     mission: MissionResult
     heading_bias_rad: float
-    figures: tuple[Path, ...] = ()
+    plots: tuple[Path, ...] = ()
 
     @property
     def coverage(self) -> float:
@@ -196,7 +197,7 @@ def _oabug_factory() -> Callable[..., object]:
     return OABugNode
 
 
-def build_mission(config: SpawnConfig) -> tuple[MissionSpec, float]:
+def build_mission(config: SpawnSettings) -> tuple[MissionSpec, float]:
     """The mission spec of ``config`` and the heading bias it uses."""
     site = load_site(config.site, seed=config.site_seed)
     try:
@@ -240,7 +241,7 @@ def build_mission(config: SpawnConfig) -> tuple[MissionSpec, float]:
     return spec, bias
 
 
-def write_figures(result: MissionResult, out_dir: Path, stem: str) -> tuple[Path, ...]:
+def write_plots(result: MissionResult, out_dir: Path, stem: str) -> tuple[Path, ...]:
     """Write the Fig.-6 PNG and the coverage-over-time PNG of a run; return their paths."""
     from swarm_analysis.plots import plot_coverage_curves, plot_site_paths
 
@@ -264,7 +265,7 @@ def write_figures(result: MissionResult, out_dir: Path, stem: str) -> tuple[Path
     return paths, curve
 
 
-def format_summary(result: SpawnResult) -> str:
+def format_summary(result: OABugRun) -> str:
     """The text summary printed at the end of a run."""
     from swarm_analysis.coverage import CoverageSummary, RoomFirstVisit
 
@@ -276,7 +277,7 @@ def format_summary(result: SpawnResult) -> str:
     summary = CoverageSummary.build(
         mission.rooms_total, visits, mission.sim_time_s, mission.robot_names
     )
-    cfg = result.config
+    cfg = result.settings
     head = (
         f'{cfg.variant}, {cfg.robots} robots from the {cfg.departure}, site {cfg.site} '
         f'(seed {cfg.site_seed}), run seed {cfg.seed}: stopped by {mission.stop_reason} '
@@ -286,11 +287,11 @@ def format_summary(result: SpawnResult) -> str:
 
 
 def run(
-    config: SpawnConfig,
+    config: SpawnSettings,
     *,
     progress: Callable[[MissionProgress], None] | None = None,
     runner: Callable[..., MissionResult] = run_mission,
-) -> SpawnResult:
+) -> OABugRun:
     """Run one OA-Bug mission headless and return its result (no printing).
 
     ``runner`` runs the mission spec: the node path :func:`swarm_experiments.mission.run_mission`,
@@ -298,11 +299,11 @@ def run(
     """
     spec, bias = build_mission(config)
     mission = runner(spec, progress=progress)
-    figures: tuple[Path, ...] = ()
+    plots: tuple[Path, ...] = ()
     if config.out_dir is not None:
         stem = f'oabug_{config.variant}_{config.departure}_{mission.site.name}_seed{config.seed}'
-        figures = write_figures(mission, Path(config.out_dir), stem)
-    return SpawnResult(config=config, mission=mission, heading_bias_rad=bias, figures=figures)
+        plots = write_plots(mission, Path(config.out_dir), stem)
+    return OABugRun(settings=config, mission=mission, heading_bias_rad=bias, plots=plots)
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -310,7 +311,7 @@ def _parser() -> argparse.ArgumentParser:
         prog='spawn',
         description=(
             'Run an OA-Bug swarm search in the pybullet simulation until every room is covered '
-            'or the action budget ends; print the coverage summary and write the figures.'
+            'or the action budget ends; print the coverage summary and write the plots.'
         ),
         formatter_class=argparse.ArgumentDefaultsHelpFormatter,
     )
@@ -337,9 +338,9 @@ def _parser() -> argparse.ArgumentParser:
     parser.add_argument('--speed', type=float, default=0.3, help='robot cruise speed [m/s]')
     parser.add_argument('--record', type=Path, default=None, help='write a rosbag2 bag here')
     parser.add_argument(
-        '--out-dir', type=Path, default=Path('oabug_results'), help='directory for the PNGs'
+        '--out', type=Path, default=Path('oabug_results'), help='directory for the PNGs'
     )
-    parser.add_argument('--no-figures', action='store_true', help='do not write PNGs')
+    parser.add_argument('--no-plots', action='store_true', help='do not write PNGs')
     parser.add_argument('--quiet', action='store_true', help='no progress lines')
     parser.add_argument(
         '--param',
@@ -356,7 +357,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Command line entry point; returns the process exit code."""
     args = _parser().parse_args(argv)
     try:
-        config = SpawnConfig(
+        config = SpawnSettings(
             robot_parameters=oabug_parameter_overrides(args.param),
             site=args.site,
             site_seed=args.site_seed,
@@ -367,14 +368,10 @@ def main(argv: Sequence[str] | None = None) -> int:
             actions=args.actions,
             speed_mps=args.speed,
             record=args.record,
-            out_dir=None if args.no_figures else args.out_dir,
+            out_dir=None if args.no_plots else args.out,
         )
-    except ConfigurationError as err:
-        print(f'spawn: {err}', file=sys.stderr)
-        return 2
     except SwarmError as err:
-        print(f'spawn: {err}', file=sys.stderr)
-        return 1
+        return fail('spawn', err)
 
     def show(p: MissionProgress) -> None:
         print(
@@ -395,14 +392,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         result = run(config, progress=None if args.quiet else show)
     except SwarmError as err:
-        print(f'spawn: {err}', file=sys.stderr)
-        return 1
+        return fail('spawn', err)
     print(format_summary(result))
-    for path in result.figures:
+    for path in result.plots:
         print(f'wrote {path}')
     if result.mission.bag_path is not None:
         print(f'recorded {result.mission.bag_path}')
-    return 0
+    return EXIT_SUCCESS
 
 
 if __name__ == '__main__':

@@ -28,6 +28,7 @@ from typing import Any
 
 import numpy as np
 from sim_bridge.signal_extension import SignalExtension
+from swarm_common.cli import EXIT_SUCCESS, fail
 from swarm_common.errors import SwarmError
 from swarm_sim.engine import EngineConfig, SiteGeometry
 from swarm_sim.errors import ConfigurationError
@@ -453,8 +454,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         extra = node_parameter_overrides(args.param)
     except ConfigurationError as err:
-        print(f'error: {err}', file=sys.stderr)
-        return 2
+        return fail('spawn_bayes_swarm', err)
     settings = SpawnSettings(
         extra_parameters=extra,
         algorithm=args.algorithm,
@@ -478,8 +478,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         result = run(settings, progress=progress)
     except SwarmError as err:
-        print(f'error: {err}', file=sys.stderr)
-        return 2
+        return fail('spawn_bayes_swarm', err)
     times = result.finder_decision_times_s()
     print(f'case {result.case.name}, {result.settings.algorithm}, seed {settings.seed}')
     if result.found:
@@ -499,7 +498,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f'wrote {path}')
     if settings.record is not None:
         print(f'recorded {settings.record}')
-    return 0
+    return EXIT_SUCCESS
 
 
 if __name__ == '__main__':

@@ -29,6 +29,7 @@ from typing import Any
 
 import numpy as np
 from sim_bridge.rssi_extension import RssiExtension
+from swarm_common.cli import EXIT_SUCCESS, EXIT_UNFINISHED, fail
 from swarm_common.errors import SwarmError
 from swarm_sim.engine import EngineConfig, SiteGeometry
 from swarm_sim.errors import ConfigurationError
@@ -357,8 +358,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         extra = controller_parameter_overrides(args.param)
     except ConfigurationError as err:
-        print(f'spawn_msc_pf: {err}', file=sys.stderr)
-        return 2
+        return fail('spawn_msc_pf', err)
     settings = SpawnSettings(
         extra_parameters=extra,
         scheme=args.scheme,
@@ -380,8 +380,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         result = run(settings, progress=report)
     except SwarmError as err:
-        print(f'spawn_msc_pf: {err}', file=sys.stderr)
-        return 2
+        return fail('spawn_msc_pf', err)
     print(
         f'scheme {settings.scheme}, {settings.robots} robots, {targets} targets, seed {args.seed}'
     )
@@ -398,7 +397,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f'wrote {path}')
     if settings.record is not None:
         print(f'bag: {settings.record}')
-    return 0 if not math.isnan(result.cct_s) else 1
+    return EXIT_UNFINISHED if math.isnan(result.cct_s) else EXIT_SUCCESS
 
 
 if __name__ == '__main__':

@@ -80,10 +80,10 @@ def test_mission_spec_rejects_mismatched_robots_and_poses():
 @pytest.mark.slow
 def test_oabug_spawner_covers_the_small_site_deterministically(tmp_path):
     pytest.importorskip('oabug_robot.node')
-    from swarm_experiments.spawn import SpawnConfig, run
+    from swarm_experiments.spawn import SpawnSettings, run
 
     def once(out_dir):
-        config = SpawnConfig(
+        config = SpawnSettings(
             site=str(FIVE_ROOMS),
             departure='edge',
             robots=3,
@@ -100,11 +100,11 @@ def test_oabug_spawner_covers_the_small_site_deterministically(tmp_path):
     entries = [(e.room_index, e.robot_index, e.time_s) for e in first.mission.room_entries]
     assert entries == [(e.room_index, e.robot_index, e.time_s) for e in second.mission.room_entries]
     assert np.array_equal(first.mission.trajectories, second.mission.trajectories)
-    assert [p.name for p in first.figures] == [
+    assert [p.name for p in first.plots] == [
         'oabug_gas_sound_edge_five_rooms_seed1_paths.png',
         'oabug_gas_sound_edge_five_rooms_seed1_coverage.png',
     ]
-    assert all(p.stat().st_size > 1000 for p in first.figures)
+    assert all(p.stat().st_size > 1000 for p in first.plots)
 
 
 def test_spawner_help_reads_well(capsys):
@@ -127,11 +127,11 @@ def test_spawner_reports_bad_input_without_a_traceback(capsys):
 
 def test_spawner_parameters_reach_every_robot_node_typed():
     pytest.importorskip('oabug_robot.node')
-    from swarm_experiments.spawn import SpawnConfig, build_mission, oabug_parameter_overrides
+    from swarm_experiments.spawn import SpawnSettings, build_mission, oabug_parameter_overrides
 
     overrides = oabug_parameter_overrides(['gas_threshold=300', 'sound_turn_rule=toward'])
     spec, _ = build_mission(
-        SpawnConfig(site=str(FIVE_ROOMS), departure='edge', robots=3, robot_parameters=overrides)
+        SpawnSettings(site=str(FIVE_ROOMS), departure='edge', robots=3, robot_parameters=overrides)
     )
     for index, robot in enumerate(spec.robots):
         assert robot.parameters['gas_threshold'] == 300
@@ -142,10 +142,10 @@ def test_spawner_parameters_reach_every_robot_node_typed():
 def test_spawner_parameters_change_the_run():
     pytest.importorskip('oabug_robot.node')
     from swarm_experiments.oabug_batch import run_spawn_batch
-    from swarm_experiments.spawn import SpawnConfig
+    from swarm_experiments.spawn import SpawnSettings
 
     def trajectories(**parameters):
-        config = SpawnConfig(
+        config = SpawnSettings(
             site=str(FIVE_ROOMS),
             departure='edge',
             robots=2,
@@ -173,5 +173,5 @@ def test_spawner_rejects_bad_parameters_before_running(capsys, option, message):
     pytest.importorskip('oabug_robot.node')
     from swarm_experiments.spawn import main
 
-    assert main(['--param', option, '--no-figures']) == 2
+    assert main(['--param', option, '--no-plots']) == 2
     assert message in capsys.readouterr().err

@@ -15,7 +15,7 @@ from swarm_experiments.oabug_batch import (
     run_oabug_batch,
     run_spawn_batch,
 )
-from swarm_experiments.spawn import SpawnConfig, build_mission
+from swarm_experiments.spawn import SpawnSettings, build_mission
 from swarm_sim.errors import ConfigurationError
 from swarm_sim.sensors.bearings import BearingConfig, BearingModel
 from swarm_sim.sensors.lidar import LidarConfig
@@ -34,7 +34,7 @@ FIVE_ROOMS = Path(__file__).parent / 'data' / 'five_rooms.lay'
 def test_batch_and_ros_paths_give_the_same_poses_and_first_entries(
     site, robots, variant, departure, actions
 ):
-    config = SpawnConfig(
+    config = SpawnSettings(
         site=site, robots=robots, variant=variant, departure=departure, actions=actions
     )
     spec, _ = build_mission(config)
@@ -54,15 +54,15 @@ def test_batch_and_ros_paths_give_the_same_poses_and_first_entries(
 
 
 def test_batch_spawn_run_matches_its_config():
-    config = SpawnConfig(site=str(FIVE_ROOMS), robots=3, departure='edge', actions=60)
+    config = SpawnSettings(site=str(FIVE_ROOMS), robots=3, departure='edge', actions=60)
     result = run_spawn_batch(config)
     assert result.mission.sim_time_s == pytest.approx(config.budget_s, abs=0.11)
     assert result.mission.trajectories.shape[1:] == (3, 3)
-    assert result.figures == ()
+    assert result.plots == ()
 
 
 def test_batch_path_refuses_what_it_cannot_do(tmp_path):
-    spec, _ = build_mission(SpawnConfig(site=str(FIVE_ROOMS), robots=2, departure='edge'))
+    spec, _ = build_mission(SpawnSettings(site=str(FIVE_ROOMS), robots=2, departure='edge'))
     recorded = type(spec)(**{**spec.__dict__, 'recording': RecordingSpec(tmp_path / 'bag')})
     with pytest.raises(ConfigurationError, match='bag'):
         run_oabug_batch(recorded)
@@ -90,7 +90,7 @@ def test_without_the_cdr_round_trip_both_paths_still_agree(monkeypatch):
     # In-process messages then keep Python floats in their float32 fields; the batch path
     # follows the runtime's setting.
     monkeypatch.setenv('SWARM_RUNTIME_CDR_ROUNDTRIP', '0')
-    config = SpawnConfig(
+    config = SpawnSettings(
         site=str(FIVE_ROOMS), robots=4, variant='gas', departure='edge', actions=150
     )
     spec, _ = build_mission(config)

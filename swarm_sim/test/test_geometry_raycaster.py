@@ -173,10 +173,10 @@ def test_compiled_scan_is_bit_identical_to_the_numpy_reference(thickness, num_bi
 
 
 def test_compiled_scan_is_bit_identical_on_a_generated_site():
-    from swarm_experiments.spawn import SpawnConfig, build_mission
+    from swarm_experiments.spawn import SpawnSettings, build_mission
     from swarm_sim.site_geometry import geometry_from_site
 
-    spec, _ = build_mission(SpawnConfig(site='small', robots=10))
+    spec, _ = build_mission(SpawnSettings(site='small', robots=10))
     walls = geometry_from_site(spec.site).walls
     caster = RayCaster(walls, wall_thickness_m=0.025, robot_radius_m=0.1, num_bins=360)
     rng = np.random.default_rng(7)
