@@ -15,7 +15,7 @@ bootstrap:
 demo: bootstrap
 	rm -rf $(OUT)
 	$(VENV)/bin/spawn --site small --robots $(ROBOTS) --variant $(VARIANT) --seed $(SEED) \
-		--record $(OUT)/bag --out-dir $(OUT)
+		--record $(OUT)/bag --out $(OUT)
 
 test: bootstrap
 	$(PY) -m pytest -n 2 -q

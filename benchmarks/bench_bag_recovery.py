@@ -40,7 +40,7 @@ def record_mission(out: Path) -> Path:
     command = [
         sys.executable,
         '-m',
-        'sim_bridge.spawn',
+        'swarm_experiments.spawn',
         '--site',
         'small',
         '--robots',
@@ -49,9 +49,9 @@ def record_mission(out: Path) -> Path:
         '1',
         '--record',
         str(bag),
-        '--out-dir',
+        '--out',
         str(out),
-        '--no-figures',
+        '--no-plots',
         '--quiet',
     ]
     subprocess.run(command, check=True, stdout=subprocess.DEVNULL)

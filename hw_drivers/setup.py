@@ -25,7 +25,7 @@ setup(
         *share_files('config'),
         *share_files('bringup'),
     ],
-    install_requires=['numpy', 'pyserial', 'smbus2', 'gpiod', 'PyYAML', 'swarm_runtime'],
+    install_requires=['numpy', 'swarm_common', 'pyserial', 'smbus2', 'gpiod', 'PyYAML', 'swarm_runtime'],
     zip_safe=True,
     maintainer='Swarm search maintainers',
     maintainer_email='maintainers@swarm-search.org',

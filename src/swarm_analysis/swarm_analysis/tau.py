@@ -16,6 +16,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from swarm_common.segments import first_entry_fraction
 
 __all__ = [
     'TauError',
@@ -85,7 +86,7 @@ def first_detection(
             continue
         best: tuple[float, int] | None = None
         for i in range(pos.shape[1]):
-            s = _entry_fraction(pos[k - 1, i], pos[k, i], src, radius_m)
+            s = first_entry_fraction(pos[k - 1, i], pos[k, i], src, radius_m)
             if s is not None:
                 t = float(times_s[k - 1] + s * (times_s[k] - times_s[k - 1]))
                 if best is None or t < best[0]:
@@ -93,20 +94,6 @@ def first_detection(
         if best is not None:
             return best
     return None
-
-
-def _entry_fraction(p0: np.ndarray, p1: np.ndarray, c: np.ndarray, r: float) -> float | None:
-    d, f = p1 - p0, p0 - c
-    a, b, cc = float(d @ d), 2.0 * float(f @ d), float(f @ f) - r * r
-    if cc <= 0.0:
-        return 0.0
-    if a <= 0.0:
-        return None
-    disc = b * b - 4.0 * a * cc
-    if disc < 0.0:
-        return None
-    s = (-b - math.sqrt(disc)) / (2.0 * a)
-    return s if 0.0 <= s <= 1.0 else None
 
 
 def tau_from_tracks(
