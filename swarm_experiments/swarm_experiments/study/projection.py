@@ -60,11 +60,19 @@ class Projection:
 
     def summary(self) -> str:
         return (
-            f'{self.runs} runs on {self.cores} cores: {self.wall_s / 3600:.2f} h wall '
-            f'({self.cpu_s / 3600:.2f} CPU h of runs, {self.overhead_s / 3600:.3f} h of '
-            f'per-task overhead, lower bound {self.lower_bound_s / 3600:.2f} h, '
+            f'{self.runs} runs on {self.cores} cores: {_duration(self.wall_s)} wall '
+            f'({_duration(self.cpu_s)} CPU of runs, {_duration(self.overhead_s)} of '
+            f'per-task overhead, lower bound {_duration(self.lower_bound_s)}, '
             f'{100 * self.efficiency:.0f} % efficiency)'
         )
+
+
+def _duration(seconds: float) -> str:
+    if seconds < 120:
+        return f'{seconds:.1f} s'
+    if seconds < 7200:
+        return f'{seconds / 60:.1f} min'
+    return f'{seconds / 3600:.2f} h'
 
 
 def project_wall_time(

@@ -225,8 +225,12 @@ def read_rows(directory: str | os.PathLike[str], *, all_attempts: bool = False) 
             raise ResultsError(f'{part}: unreadable part file ({exc})') from exc
     if not tables:
         return pd.DataFrame(columns=['run_id', 'study', 'seed', 'status'])
-    table = pa.concat_tables(tables, promote_options='permissive')
-    frame = table.to_pandas()
+    try:
+        frame = pa.concat_tables(tables, promote_options='permissive').to_pandas()
+    except (pa.ArrowInvalid, pa.ArrowTypeError):
+        # Parts disagree on a column's type (a metric returned as text by some runs and as a
+        # number by others): such columns become object columns.
+        frame = pd.concat([table.to_pandas() for table in tables], ignore_index=True)
     if all_attempts:
         return frame.reset_index(drop=True)
     frame['_ok'] = frame['status'] == 'ok'

@@ -9,8 +9,8 @@ import time
 from pathlib import Path
 
 import pytest
-from helpers import comparable
 from study_fixtures import studies
+from study_helpers import comparable
 from swarm_experiments.study import StudyRegistry, read_rows
 from swarm_experiments.study.cli import main
 

@@ -18,8 +18,8 @@ import time
 from pathlib import Path
 
 import pytest
-from helpers import comparable
 from study_fixtures import studies
+from study_helpers import comparable
 from swarm_experiments.study import StudyRegistry, make_engine, make_specs, read_rows, run_study
 from swarm_experiments.study.cli import main
 from swarm_experiments.study.results import done_run_ids

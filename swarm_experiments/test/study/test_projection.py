@@ -18,6 +18,11 @@ def test_equal_runs_fill_the_cores_in_rounds() -> None:
     assert projection.cpu_s == pytest.approx(20.0)
     assert projection.overhead_s == pytest.approx(5.0)
     assert projection.efficiency == pytest.approx(20.0 / (4 * 7.5))
+    assert projection.summary() == (
+        '10 runs on 4 cores: 7.5 s wall (20.0 s CPU of runs, 5.0 s of per-task overhead, '
+        'lower bound 6.2 s, 67 % efficiency)'
+    )
+    assert project_wall_time([3600.0] * 3, 1).summary().startswith('3 runs on 1 cores: 3.00 h')
 
 
 def test_longest_first_beats_an_unlucky_order() -> None:

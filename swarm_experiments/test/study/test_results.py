@@ -140,3 +140,18 @@ def test_the_directory_lock_admits_one_writer(tmp_path: Path) -> None:
             pass
     with study_lock(tmp_path):
         pass
+
+
+def test_parts_that_disagree_on_a_type_still_read(tmp_path: Path) -> None:
+    writer = PartWriter(tmp_path, batch_rows=1)
+    base = {'study': 's', 'seed': 0, 'status': 'ok'}
+    writer.add({**base, 'run_id': 'a', 'param.f': [], 'metric.x': None})
+    writer.add({**base, 'run_id': 'b', 'param.f': [1, 2], 'metric.x': 2})
+    writer.add({**base, 'run_id': 'c', 'param.f': [1.5], 'metric.x': 3.5})
+    rows = read_rows(tmp_path).set_index('run_id')
+    assert rows['metric.x'].dtype == float
+    assert list(rows.loc['b', 'param.f']) == [1.0, 2.0]
+    writer.add({**base, 'run_id': 'd', 'metric.x': 'text'})
+    rows = read_rows(tmp_path).set_index('run_id')
+    assert rows.loc['d', 'metric.x'] == 'text'
+    assert rows.loc['c', 'metric.x'] == 3.5

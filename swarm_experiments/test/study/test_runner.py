@@ -5,8 +5,8 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from helpers import comparable
 from study_fixtures import dying_run, search_study
+from study_helpers import comparable
 from swarm_experiments.study import (
     EngineError,
     ResultsError,
@@ -156,3 +156,20 @@ def test_a_directory_of_another_study_is_refused(tmp_path: Path) -> None:
     (tmp_path / 'other').symlink_to(tmp_path / 'synthetic-search')
     with pytest.raises(ResultsError, match="holds study 'synthetic-search'"):
         _serial(make_specs(other, runs=1), tmp_path)
+
+
+def test_a_run_that_keeps_killing_dask_workers_gets_a_failed_row(tmp_path: Path) -> None:
+    import dask
+
+    study = search_study(run=dying_run)
+    plan = make_specs(study, runs=1, overrides=parse_overrides(['robots=2', 'variant=gas']))
+    with (
+        dask.config.set({'distributed.scheduler.allowed-failures': 1}),
+        make_engine('dask', workers=1) as engine,
+    ):
+        summary = run_study(plan, tmp_path, engine, code_version=VERSION)
+    assert (summary.ok, summary.failed) == (0, 1)
+    (row,) = read_rows(summary.directory).to_dict('records')
+    assert row['status'] == 'failed'
+    assert row['error'].startswith('KilledWorker: ')
+    assert row['run_id'] == plan.specs[0].run_id
