@@ -17,6 +17,12 @@ setup(
         'numpy',
         'matplotlib',
         'PyYAML',
+        # Studies: results as Parquet, the distributed engine, progress.
+        'pandas',
+        'pyarrow',
+        'dask',
+        'distributed',
+        'rich',
         'swarm_common',
         'swarm_runtime',
         'swarm_analysis',
@@ -32,7 +38,7 @@ setup(
     maintainer_email='maintainers@swarm-search.org',
     description=(
         'Experiment harness: the launch-free spawners, the mission loop, the batch runners of '
-        'the benchmarks and the node parameter overrides.'
+        'the benchmarks, the node parameter overrides and the studies (swarm_study).'
     ),
     license='Apache-2.0',
     entry_points={
@@ -40,6 +46,7 @@ setup(
             'spawn = swarm_experiments.spawn:main',
             'spawn_bayes_swarm = swarm_experiments.spawn_bayes_swarm:main',
             'spawn_msc_pf = swarm_experiments.spawn_msc_pf:main',
+            'swarm_study = swarm_experiments.study.cli:main',
         ],
     },
 )
