@@ -33,7 +33,7 @@ from swarm_runtime.ros import (
     qos_profile_sensor_data,
     rclpy,
 )
-from swarm_sim.departure import departure_poses
+from swarm_sim.departure import place_starts
 from swarm_sim.engine import EngineConfig, SimEngine, SiteGeometry, StepOutput
 from swarm_sim.errors import ConfigurationError, SimulationError
 from swarm_sim.peer_relay import RelayConfig, RelayModel, parse_message_type
@@ -179,6 +179,8 @@ class SimBridgeNode(Node):
 
             site = load_site(path, seed=self.config.seed)
             self._site_model = site
+        for warning in getattr(site, 'warnings', ()):
+            self.get_logger().warning(f'site: {warning}')
         return geometry_from_site(site)
 
     def _resolve_poses(self, initial_poses: np.ndarray | None) -> np.ndarray:
@@ -188,9 +190,14 @@ class SimBridgeNode(Node):
             raise ConfigurationError('initial_poses are required when the site is a geometry')
         count = int(self.get_parameter('robot_count').value)
         name = str(self.get_parameter('departure').value)
-        point = self._site_model.departure(name)
         bias = float(self.get_parameter('heading_bias_rad').value)
-        return departure_poses(point.xy, name, count, bias)
+        starts = place_starts(self._site_model, name, count, bias_rad=bias, body=self.config.body)
+        if starts.moved:
+            self.get_logger().info(
+                f'{len(starts.moved)} of {count} starts moved off the nominal fan into free '
+                f'space (at most {float(starts.moved_by_m.max()):.3f} m)'
+            )
+        return starts.poses
 
     def _publish_site(self) -> None:
         if self._site_model is None:

@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 from swarm_common.cli import EXIT_SUCCESS, fail
 from swarm_common.errors import SwarmError
-from swarm_sim.departure import departure_poses
+from swarm_sim.departure import place_starts
 from swarm_sim.engine import EngineConfig
 from swarm_sim.errors import ConfigurationError
 from swarm_sim.site_loading import load_site, site_budget_actions
@@ -158,14 +158,6 @@ class OABugRun:
         return self.mission.coverage
 
 
-def heading_bias_rad(departure: str, into_site_rad: float | None, seed: int) -> float:
-    """The fan's bias: random for a centre start; for an edge start, inward minus 90 deg."""
-    if departure == 'edge' and into_site_rad is not None:
-        return float(into_site_rad) - 0.5 * math.pi
-    rng = np.random.default_rng(np.random.SeedSequence([seed, 0xB1A5]))
-    return float(rng.uniform(-math.pi, math.pi))
-
-
 def oabug_parameter_overrides(items: Sequence[str]) -> dict[str, object]:
     """OA-Bug node parameters from ``NAME=VALUE`` items, typed and checked before a run.
 
@@ -200,13 +192,10 @@ def _oabug_factory() -> Callable[..., object]:
 def build_mission(config: SpawnSettings) -> tuple[MissionSpec, float]:
     """The mission spec of ``config`` and the heading bias it uses."""
     site = load_site(config.site, seed=config.site_seed)
-    try:
-        point = site.departure(config.departure)
-    except Exception as err:
-        raise ConfigurationError(str(err)) from err
-    fan = 'edge' if point.heading_rad is not None else 'center'
-    bias = heading_bias_rad(fan, point.heading_rad, config.seed)
-    poses = departure_poses(point.xy, fan, config.robots, bias)
+    starts = place_starts(
+        site, config.departure, config.robots, seed=config.seed, body=config.engine.body
+    )
+    fan, bias, poses = starts.fan, starts.bias_rad, starts.poses
     factory = _oabug_factory()
     robots = []
     for i in range(config.robots):
@@ -370,8 +359,11 @@ def main(argv: Sequence[str] | None = None) -> int:
             record=args.record,
             out_dir=None if args.no_plots else args.out,
         )
+        site_warnings = load_site(config.site, seed=config.site_seed).warnings
     except SwarmError as err:
         return fail('spawn', err)
+    for warning in site_warnings:
+        print(f'spawn: warning: {warning}', file=sys.stderr, flush=True)
 
     def show(p: MissionProgress) -> None:
         print(
