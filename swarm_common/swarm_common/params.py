@@ -717,7 +717,7 @@ class ParameterSpec:
             '|---|---|---|---|---|---|',
         ]
         for p in self.parameters:
-            constraints = p.constraints_text.replace('|', '\\|')
+            constraints = p.constraints_text.replace('range ', '').replace('|', '\\|')
             description = p.info.description.replace('|', '\\|')
             rows.append(
                 f'| `{p.name}` | `{render_value(values[p.name])}` | {p.info.unit} | '

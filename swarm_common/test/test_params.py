@@ -255,7 +255,7 @@ def test_the_markdown_table_has_a_row_per_parameter() -> None:
     assert rows[0].startswith('| parameter | default | unit |')
     assert len(rows) == 2 + len(SPEC.parameters)
     assert '| `mode` | `fast` |  | one of fast, slow | yes | how to drive |' in rows
-    assert '| `speed_mps` | `0.3` | m/s | range (0, 2] | no | cruise speed |' in rows
+    assert '| `speed_mps` | `0.3` | m/s | (0, 2] | no | cruise speed |' in rows
 
 
 def test_specs_refuse_fields_they_cannot_carry() -> None:
