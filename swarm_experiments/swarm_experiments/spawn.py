@@ -170,14 +170,11 @@ def oabug_parameter_overrides(items: Sequence[str]) -> dict[str, object]:
         ExperimentError: the OA-Bug package cannot be imported.
     """
     try:
-        from oabug_robot.node import PARAMETERS, config_from_parameters
+        from oabug_robot.node_settings import OABUG_PARAMETERS
     except ImportError as err:
         msg = f'the OA-Bug node (package oabug_robot) cannot be imported: {err}'
         raise ExperimentError(msg) from err
-    declared = {name: default for name, default, _ in PARAMETERS}
-    return parse_overrides(
-        items, declared, reserved=SPAWNER_PARAMETERS, check=config_from_parameters
-    )
+    return parse_overrides(items, OABUG_PARAMETERS, reserved=SPAWNER_PARAMETERS)
 
 
 def _oabug_factory() -> Callable[..., object]:

@@ -153,11 +153,9 @@ def controller_parameter_overrides(items: Sequence[str]) -> dict[str, Any]:
         ConfigurationError: a malformed item, an unknown or spawner-set name, a value of the
             wrong type, or one the controller rejects.
     """
-    from msc_pf.parameters import config_from_parameters, parameter_defaults
+    from msc_pf.parameters import MSC_PF_PARAMETERS
 
-    return parse_overrides(
-        items, parameter_defaults(), reserved=SPAWNER_PARAMETERS, check=config_from_parameters
-    )
+    return parse_overrides(items, MSC_PF_PARAMETERS, reserved=SPAWNER_PARAMETERS)
 
 
 def node_parameters(settings: SpawnSettings, index: int) -> dict[str, Any]:

@@ -142,7 +142,7 @@ def test_command_line_parameters_override_the_case_for_every_robot():
     [
         ('horizn_s=3', "unknown parameter 'horizn_s' (did you mean horizon_s?)"),
         ('n_robots=4', "'n_robots' is set by the spawner"),
-        ('horizon_s=-3', 'horizon_s must be > 0'),
+        ('horizon_s=-3', 'parameter horizon_s: must be > 0 s, got -3 s'),
     ],
 )
 def test_command_line_rejects_bad_parameters_with_exit_status_2(capsys, option, message):

@@ -110,7 +110,7 @@ def test_command_line_parameters_reach_every_robot_node_typed():
             "unknown parameter 'msc.leader_rul' (did you mean msc.leader_rule?)",
         ),
         ('swarm.comm_range_m=50', "'swarm.comm_range_m' is set by the spawner"),
-        ('msc.leader_rule=uphill', 'leader_rule not in'),
+        ('msc.leader_rule=uphill', "msc.leader_rule: 'uphill' is not one of gradient, pbest"),
         ('phases.unheard_updates=maybe', 'expected true or false'),
     ],
 )

@@ -48,6 +48,8 @@ from swarm_runtime.standalone import (
     runtime_missing_reason,
 )
 
+from hw_drivers.parameters import NODE_SPECS
+
 __all__ = [
     'DEVICE_PARAMETERS',
     'EXIT_CHILD_FAILED',
@@ -81,14 +83,16 @@ EXECUTABLES = {
 }
 DRIVERS = ('pump_node', 'rplidar_node', 'gas_adc_node', 'mpu6050_node', 'aoa_receiver_node')
 
-#: Driver parameters that name a device, with the drivers' defaults (a test keeps them equal
-#: to the nodes' parameter tables; the nodes themselves are not imported here, which would
-#: need ROS and the generated messages).
+#: Driver parameters that name a device, with the drivers' defaults (from their parameter
+#: specs, which are ROS-free: importing them needs neither ROS nor the generated messages).
 DEVICE_PARAMETERS: dict[str, dict[str, Any]] = {
-    'pump_node': {'chip': '/dev/gpiochip0'},
-    'rplidar_node': {'port': '/dev/rplidar'},
-    'gas_adc_node': {'backend': 'ads1115', 'i2c_bus': 1, 'serial_port': '/dev/gas_mcu'},
-    'mpu6050_node': {'i2c_bus': 1},
+    node: {name: NODE_SPECS[node][name].default for name in names}
+    for node, names in {
+        'pump_node': ('chip',),
+        'rplidar_node': ('port',),
+        'gas_adc_node': ('backend', 'i2c_bus', 'serial_port'),
+        'mpu6050_node': ('i2c_bus',),
+    }.items()
 }
 
 
