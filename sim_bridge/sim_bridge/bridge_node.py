@@ -42,6 +42,7 @@ from swarm_sim.site_geometry import geometry_from_site
 from sim_bridge import conversions
 from sim_bridge.bridge_parameters import ENGINE_PARAMETERS, config_from_values, values_from_config
 from sim_bridge.extensions import RobotStates, SimExtension
+from sim_bridge.visualization import BridgeVisualization
 
 __all__ = ['SimBridgeNode', 'main']
 
@@ -102,6 +103,8 @@ class SimBridgeNode(Node):
         declare('comm_range_m', math.inf, _descriptor('Peer relay range [m]; inf = unlimited.'))
         declare('peer_loss_probability', 0.0, _descriptor('Chance one relayed message is lost.'))
         declare('coverage_rate_hz', 1.0, _descriptor('Rate of periodic /sim/coverage [Hz].'))
+        declare('tf_rate_hz', 10.0, _descriptor('Most /tf messages per sim second [Hz].'))
+        declare('path_rate_hz', 0.5, _descriptor('Rate of /sim/markers/paths [Hz].'))
 
         values = {s.name: self.get_parameter(s.name).value for s in ENGINE_PARAMETERS}
         self.config = config_from_values(values, base)
@@ -145,6 +148,7 @@ class SimBridgeNode(Node):
             self.create_subscription(_std.Bool, f'/{name}/pump', self._make_pump_callback(i), 10)
         self._publish_site()
         self._relay = self._setup_relay()
+        self._visualization = self._setup_visualization()
 
         self.extensions = tuple(extensions)
         for ext in self.extensions:
@@ -203,6 +207,16 @@ class SimBridgeNode(Node):
         msg = site_to_ros(self._site_model)
         self._site_pub = self.create_publisher(type(msg), '/sim/site', _LATCHED)
         self._site_pub.publish(msg)
+
+    def _setup_visualization(self) -> BridgeVisualization:
+        rates = {
+            name: float(self.get_parameter(name).value) for name in ('tf_rate_hz', 'path_rate_hz')
+        }
+        for name, rate in rates.items():
+            if not (math.isfinite(rate) and rate > 0.0):
+                msg = f'{name} must be positive and finite, got {rate}'
+                raise ConfigurationError(msg)
+        return BridgeVisualization(self, self.engine, self.robot_names, self._site_model, **rates)
 
     def _setup_relay(self) -> RelayModel | None:
         config = RelayConfig(
@@ -303,6 +317,7 @@ class SimBridgeNode(Node):
                             poses[i], twists[i], t, f'{name}/odom', f'{name}/base_link'
                         )
                     )
+        self._visualization.on_step(out)
         if out.ground_truth_due:
             self._poses_pub.publish(conversions.true_poses_to_ros(names, out.poses, t))
         if out.new_room_entries or self.engine.step_index % self._coverage_every == 0:
