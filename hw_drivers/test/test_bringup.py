@@ -16,7 +16,14 @@ from hw_drivers.robot_bringup.cli import (
     driver_parameters,
 )
 
-from hw_drivers import aoa_receiver_node, gas_node, mpu6050_node, pump_node, rplidar_node
+from hw_drivers import (
+    aoa_receiver_node,
+    gas_node,
+    mpu6050_node,
+    pump_node,
+    rplidar_node,
+    static_frames_node,
+)
 
 
 def test_pump_starts_first_and_oabug_last_after_the_locator():
@@ -47,7 +54,7 @@ def test_fake_mode_switches_every_device_driver_to_its_simulated_device():
 def test_dry_run_prints_the_commands(capsys):
     assert cli.run(BringupOptions(launcher='python'), dry_run=True) == 0
     lines = capsys.readouterr().out.splitlines()
-    assert len(lines) == 6
+    assert len(lines) == 7
     assert lines[0].split()[1:3] == ['-m', 'hw_drivers.pump_node']
 
 
@@ -78,6 +85,7 @@ def test_example_parameter_file_names_real_parameters():
         'mpu6050_node': mpu6050_node.PARAMETERS,
         'aoa_receiver_node': aoa_receiver_node.PARAMETERS,
         'pump_node': pump_node.PARAMETERS,
+        'static_frames_node': static_frames_node.PARAMETERS,
     }
     path = Path(__file__).resolve().parents[1] / 'bringup' / 'r0.params.example.yaml'
     document = yaml.safe_load(path.read_text())

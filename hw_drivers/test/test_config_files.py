@@ -5,7 +5,14 @@ from pathlib import Path
 import pytest
 import yaml
 
-from hw_drivers import aoa_receiver_node, gas_node, mpu6050_node, pump_node, rplidar_node
+from hw_drivers import (
+    aoa_receiver_node,
+    gas_node,
+    mpu6050_node,
+    pump_node,
+    rplidar_node,
+    static_frames_node,
+)
 
 CONFIG = Path(__file__).resolve().parents[1] / 'config'
 NODES = {
@@ -14,6 +21,7 @@ NODES = {
     'mpu6050_node': mpu6050_node,
     'aoa_receiver_node': aoa_receiver_node,
     'pump_node': pump_node,
+    'static_frames_node': static_frames_node,
 }
 
 
