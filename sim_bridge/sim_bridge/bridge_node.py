@@ -6,6 +6,8 @@ Per robot ``<name>`` (r0, r1, ...) it publishes ``/<name>/scan``, ``gas``, ``bea
 swarm-wide it publishes ``/clock`` and the ground truth ``/sim/poses``, ``/sim/coverage``
 (and ``/sim/site`` when the site model can be converted). With ``peer_msg_type`` set it
 relays ``/<name>/peers/out`` to the other robots' ``peers/in`` within ``comm_range_m``.
+For viewers it publishes the REP 105 transform tree on ``/tf`` and ``/tf_static`` and the
+site, rooms, robots and paths as ``/sim/markers/...`` (:mod:`sim_bridge.visualization`).
 
 The node holds no simulation logic: :class:`swarm_sim.engine.SimEngine` does the work and
 :mod:`sim_bridge.conversions` builds the messages. It steps the engine on a wall timer of one
