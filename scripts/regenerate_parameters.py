@@ -86,6 +86,7 @@ NODES = (
             ('mpu6050_node', 'MPU6050_PARAMETERS'),
             ('aoa_receiver_node', 'AOA_RECEIVER_PARAMETERS'),
             ('pump_node', 'PUMP_PARAMETERS'),
+            ('static_frames_node', 'STATIC_FRAMES_PARAMETERS'),
         )
     ),
 )

@@ -94,7 +94,14 @@ def test_the_bayes_swarm_case_files_are_valid_parameter_files(case: str) -> None
 
 def _mains():
     from bayes_swarm import node as bayes_node
-    from hw_drivers import aoa_receiver_node, gas_node, mpu6050_node, pump_node, rplidar_node
+    from hw_drivers import (
+        aoa_receiver_node,
+        gas_node,
+        mpu6050_node,
+        pump_node,
+        rplidar_node,
+        static_frames_node,
+    )
     from msc_pf import node as msc_node
     from oabug_robot import node as oabug_node
     from sim_bridge import bridge_node
@@ -109,6 +116,7 @@ def _mains():
         'mpu6050_node': mpu6050_node.main,
         'aoa_receiver_node': aoa_receiver_node.main,
         'pump_node': pump_node.main,
+        'static_frames_node': static_frames_node.main,
     }
 
 
@@ -124,6 +132,12 @@ WRONG = {
     'msc_pf': 'odom_timeout_s',
     'sim_bridge': 'coverage_rate_hz',
     'pump_node': 'command_timeout_s',
+    'static_frames_node': 'laser_xyz_m',
+}
+# Nodes whose wrong parameter is an array: how each problem looks there.
+ARRAY_FILES = {
+    'wrong type': ('laser_xyz_m: fast', 'parameter laser_xyz_m: expected a list'),
+    'out of range': ('laser_xyz_m: [0.1, 0.2]', 'parameter laser_xyz_m: expected 3 values'),
 }
 
 
@@ -135,6 +149,8 @@ def test_a_malformed_params_file_stops_the_node_with_one_line(
     monkeypatch.setenv('SWARM_RUNTIME', 'builtin')  # drivers refuse to start alone otherwise
     body, expected = BAD_FILES[problem]
     name = WRONG.get(node, 'stale_timeout_s')
+    if name.endswith('_xyz_m'):
+        body, expected = ARRAY_FILES.get(problem, (body, expected))
     body = body.replace('stale_timeout_s', name).replace('stale_timeout', name[:-2])
     expected = expected.replace('stale_timeout_s', name).replace(
         "'stale_timeout'", f"'{name[:-2]}'"

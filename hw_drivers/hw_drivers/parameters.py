@@ -24,12 +24,14 @@ __all__ = [
     'NODE_SPECS',
     'PUMP_PARAMETERS',
     'RPLIDAR_PARAMETERS',
+    'STATIC_FRAMES_PARAMETERS',
     'AoaReceiverNodeConfig',
     'DriverParameterError',
     'GasNodeConfig',
     'Mpu6050NodeConfig',
     'PumpNodeConfig',
     'RPLidarNodeConfig',
+    'StaticFramesNodeConfig',
 ]
 
 #: Gas ADC backends.
@@ -227,6 +229,27 @@ class PumpNodeConfig:
 
 PUMP_PARAMETERS = ParameterSpec(PumpNodeConfig, error=DriverParameterError)
 
+
+@dataclass(frozen=True)
+class StaticFramesNodeConfig:
+    """The parameters of ``static_frames_node`` (mounting positions in base_link)."""
+
+    frame_prefix: str = parameter(
+        '', "prefix of every frame id, e.g. 'r0/' (robot_bringup sets it)"
+    )
+    laser_xyz_m: tuple[float, float, float] = parameter(
+        (0.0, 0.0, 0.0), 'lidar position in base_link: x forward, y left, z up', unit='m'
+    )
+    imu_xyz_m: tuple[float, float, float] = parameter(
+        (0.0, 0.0, 0.0), 'IMU position in base_link', unit='m'
+    )
+    gas_sensor_xyz_m: tuple[float, float, float] = parameter(
+        (0.08, 0.0, 0.0), 'gas sensor position in base_link', unit='m'
+    )
+
+
+STATIC_FRAMES_PARAMETERS = ParameterSpec(StaticFramesNodeConfig, error=DriverParameterError)
+
 #: Node name -> parameter spec, for the tools that handle every driver.
 NODE_SPECS: dict[str, ParameterSpec] = {
     'rplidar_node': RPLIDAR_PARAMETERS,
@@ -234,4 +257,5 @@ NODE_SPECS: dict[str, ParameterSpec] = {
     'mpu6050_node': MPU6050_PARAMETERS,
     'aoa_receiver_node': AOA_RECEIVER_PARAMETERS,
     'pump_node': PUMP_PARAMETERS,
+    'static_frames_node': STATIC_FRAMES_PARAMETERS,
 }

@@ -46,7 +46,7 @@ def test_fake_mode_switches_every_device_driver_to_its_simulated_device():
 def test_dry_run_prints_the_commands(capsys):
     assert cli.run(BringupOptions(launcher='python'), dry_run=True) == 0
     lines = capsys.readouterr().out.splitlines()
-    assert len(lines) == 6
+    assert len(lines) == 7
     assert lines[0].split()[1:3] == ['-m', 'hw_drivers.pump_node']
 
 

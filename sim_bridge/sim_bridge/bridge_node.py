@@ -6,6 +6,8 @@ Per robot ``<name>`` (r0, r1, ...) it publishes ``/<name>/scan``, ``gas``, ``bea
 swarm-wide it publishes ``/clock`` and the ground truth ``/sim/poses``, ``/sim/coverage``
 (and ``/sim/site`` when the site model can be converted). With ``peer_msg_type`` set it
 relays ``/<name>/peers/out`` to the other robots' ``peers/in`` within ``comm_range_m``.
+For viewers it publishes the REP 105 transform tree on ``/tf`` and ``/tf_static`` and the
+site, rooms, robots and paths as ``/sim/markers/...`` (:mod:`sim_bridge.visualization`).
 
 The node holds no simulation logic: :class:`swarm_sim.engine.SimEngine` does the work and
 :mod:`sim_bridge.conversions` builds the messages. It steps the engine on a wall timer of one
@@ -44,6 +46,7 @@ from swarm_sim.site_geometry import geometry_from_site
 from sim_bridge import conversions
 from sim_bridge.bridge_parameters import BRIDGE_PARAMETERS, NODE_NAME, BridgeNodeConfig
 from sim_bridge.extensions import RobotStates, SimExtension
+from sim_bridge.visualization import BridgeVisualization
 
 __all__ = ['SimBridgeNode', 'main']
 
@@ -125,6 +128,7 @@ class SimBridgeNode(Node):
             self.create_subscription(_std.Bool, f'/{name}/pump', self._make_pump_callback(i), 10)
         self._publish_site()
         self._relay = self._setup_relay()
+        self._visualization = self._setup_visualization()
 
         self.extensions = tuple(extensions)
         for ext in self.extensions:
@@ -191,6 +195,16 @@ class SimBridgeNode(Node):
         msg = site_to_ros(self._site_model)
         self._site_pub = self.create_publisher(type(msg), '/sim/site', _LATCHED)
         self._site_pub.publish(msg)
+
+    def _setup_visualization(self) -> BridgeVisualization:
+        return BridgeVisualization(
+            self,
+            self.engine,
+            self.robot_names,
+            self._site_model,
+            tf_rate_hz=self.settings.tf_rate_hz,
+            path_rate_hz=self.settings.path_rate_hz,
+        )
 
     def _setup_relay(self) -> RelayModel | None:
         config = RelayConfig(
@@ -291,6 +305,7 @@ class SimBridgeNode(Node):
                             poses[i], twists[i], t, f'{name}/odom', f'{name}/base_link'
                         )
                     )
+        self._visualization.on_step(out)
         if out.ground_truth_due:
             self._poses_pub.publish(conversions.true_poses_to_ros(names, out.poses, t))
         if out.new_room_entries or self.engine.step_index % self._coverage_every == 0:

@@ -61,6 +61,10 @@ class BridgeNodeConfig:
     coverage_rate_hz: float = parameter(
         1.0, 'rate of the periodic /sim/coverage message', unit='Hz', gt=0.0
     )
+    tf_rate_hz: float = parameter(10.0, 'most /tf messages per sim second', unit='Hz', gt=0.0)
+    path_rate_hz: float = parameter(
+        0.5, 'rate of the robot paths on /sim/markers/paths', unit='Hz', gt=0.0
+    )
 
 
 BRIDGE_PARAMETERS = ParameterSpec(BridgeNodeConfig, error=BridgeParameterError)

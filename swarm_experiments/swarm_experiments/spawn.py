@@ -33,6 +33,7 @@ from swarm_sim.site_loading import load_site, site_budget_actions
 
 from swarm_experiments.errors import ExperimentError
 from swarm_experiments.mission import (
+    VIEWER_TOPICS,
     MissionProgress,
     MissionResult,
     MissionSpec,
@@ -56,7 +57,7 @@ __all__ = [
 VARIANTS = ('random', 'minimum', 'sound', 'gas', 'gas_sound')
 ACTION_LENGTH_M = 0.1
 DEFAULT_ACTIONS = 1000
-DEFAULT_RECORD_TOPICS = ('/clock', '/sim/poses', '/sim/coverage', '/sim/site')
+DEFAULT_RECORD_TOPICS = ('/clock', '/sim/poses', '/sim/coverage', '/sim/site', *VIEWER_TOPICS)
 # OA-Bug node parameters the spawner sets from its own options (see build_mission).
 SPAWNER_PARAMETERS = (
     'variant',
@@ -88,6 +89,8 @@ class SpawnSettings:
         speed_mps: the robots' cruise speed [m/s].
         record: bag directory to write, or None.
         record_robot_topics: also record each robot's state, cmd_vel and pump topics.
+        record_scans: also record each robot's lidar scans (``/r<i>/scan``, about 8 kB/s
+            per robot; off by default, the viewers' scan displays show them when present).
         out_dir: directory for the PNGs, or None for no plots.
         robot_parameters: extra OA-Bug node parameters for every robot.
         engine: world configuration (its seed is replaced by ``seed``).
@@ -103,6 +106,7 @@ class SpawnSettings:
     speed_mps: float = 0.3
     record: Path | None = None
     record_robot_topics: bool = True
+    record_scans: bool = False
     out_dir: Path | None = None
     robot_parameters: dict[str, object] = field(default_factory=dict)
     engine: EngineConfig = field(default_factory=EngineConfig)
@@ -214,6 +218,8 @@ def build_mission(config: SpawnSettings) -> tuple[MissionSpec, float]:
         if config.record_robot_topics:
             for i in range(config.robots):
                 topics += [f'/r{i}/state', f'/r{i}/cmd_vel', f'/r{i}/pump']
+        if config.record_scans:
+            topics += [f'/r{i}/scan' for i in range(config.robots)]
         recording = RecordingSpec(Path(config.record), tuple(topics))
     engine = dataclasses.replace(config.engine, seed=int(config.seed))
     spec = MissionSpec(
@@ -324,6 +330,9 @@ def _parser() -> argparse.ArgumentParser:
     parser.add_argument('--speed', type=float, default=0.3, help='robot cruise speed [m/s]')
     parser.add_argument('--record', type=Path, default=None, help='write a rosbag2 bag here')
     parser.add_argument(
+        '--record-scans', action='store_true', help="also record the robots' lidar scans"
+    )
+    parser.add_argument(
         '--out', type=Path, default=Path('oabug_results'), help='directory for the PNGs'
     )
     parser.add_argument('--no-plots', action='store_true', help='do not write PNGs')
@@ -354,6 +363,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             actions=args.actions,
             speed_mps=args.speed,
             record=args.record,
+            record_scans=args.record_scans,
             out_dir=None if args.no_plots else args.out,
         )
         site_warnings = load_site(config.site, seed=config.site_seed).warnings

@@ -39,7 +39,13 @@ from swarm_experiments.bayes_batch import MissionSpec as BatchMissionSpec
 from swarm_experiments.bayes_batch import depot_fan
 from swarm_experiments.cli_args import points_argument
 from swarm_experiments.errors import ExperimentError
-from swarm_experiments.mission import MissionSpec, RecordingSpec, RobotNodeSpec, run_mission
+from swarm_experiments.mission import (
+    VIEWER_TOPICS,
+    MissionSpec,
+    RecordingSpec,
+    RobotNodeSpec,
+    run_mission,
+)
 from swarm_experiments.node_overrides import parse_overrides
 from swarm_experiments.open_field import point_robot_engine_config
 
@@ -71,6 +77,7 @@ DEFAULT_RECORD_TOPICS = (
     '/sim/source_search',
     '/r*/state',
     '/r*/peers/out',
+    *VIEWER_TOPICS,
 )
 GLOWWORM_RATE_HZ = 100.0
 

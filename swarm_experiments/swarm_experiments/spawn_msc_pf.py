@@ -38,6 +38,7 @@ from swarm_sim.rssi_targets import RssiTargetConfig, RssiTargetField, place_robo
 from swarm_experiments.cli_args import points_argument
 from swarm_experiments.errors import ExperimentError
 from swarm_experiments.mission import (
+    VIEWER_TOPICS,
     MissionProgress,
     MissionSpec,
     RecordingSpec,
@@ -54,7 +55,14 @@ SPAWNER_PARAMETERS = ('scheme', 'seed', 'robot_id', 'field_size_m', 'swarm.comm_
 
 SCHEMES = ('proposed', 'msc_pf', 'msc')
 PEER_TYPE = 'swarm_interfaces/msg/MscPeer'
-DEFAULT_RECORD_TOPICS = ('/clock', '/sim/poses', '/sim/targets', '/r*/state', '/r*/peers/out')
+DEFAULT_RECORD_TOPICS = (
+    '/clock',
+    '/sim/poses',
+    '/sim/targets',
+    '/r*/state',
+    '/r*/peers/out',
+    *VIEWER_TOPICS,
+)
 
 
 @dataclass(frozen=True)

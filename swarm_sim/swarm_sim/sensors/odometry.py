@@ -55,6 +55,11 @@ class WheelOdometry:
         self._pose = np.array(initial_poses, dtype=float)
         self._last_true = np.array(initial_poses, dtype=float)
 
+    @property
+    def poses(self) -> np.ndarray:
+        """(N, 3) odometry poses x [m], y [m], yaw [rad] now (a copy)."""
+        return self._pose.copy()
+
     def update(self, true_poses: np.ndarray, dt_s: float) -> tuple[np.ndarray, np.ndarray]:
         """Integrate the motion since the last update.
 
