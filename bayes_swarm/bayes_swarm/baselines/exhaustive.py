@@ -34,9 +34,9 @@ def partition_arena(arena: Arena, n_robots: int, partition: str = 'strips') -> l
     for quarter in (0, 2, 1, 3)[: n_robots % 4]:  # extra robots: 1st, 3rd, 2nd quarter
         counts[quarter] += 1
     parts: list[Arena] = []
-    for quarter, count in zip(quarters, counts, strict=True):
+    for area, count in zip(quarters, counts, strict=True):
         if count:
-            parts.extend(_strips(quarter, count))
+            parts.extend(_strips(area, count))
     return parts
 
 
