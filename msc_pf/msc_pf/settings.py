@@ -409,7 +409,7 @@ class PhaseConfig:
             'can directly approach the searching target once its location estimation is '
             'converged"). Off by default: MSC+PF filters often converge at the detection '
             'edge on a wrong point, and following such an estimate after the signal is gone '
-            'leads the swarm away from the target (docs/notes/msc_pf.md); off, the robot '
+            'leads the swarm away from the target (docs/msc_pf.md); off, the robot '
             'searches again once nothing is heard.'
         ),
     )
