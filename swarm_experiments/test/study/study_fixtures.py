@@ -9,7 +9,9 @@ robot count, a time series, and a few other metrics. Parameters used by the test
 
 With ``STUDY_TEST_MARKERS`` set to a directory, each execution leaves a marker file there
 named ``<run_id>.<node>.<pid>.<ns>`` (``STUDY_TEST_NODE`` names the node), so a test can
-see which runs started where and how often.
+see which runs started where and how often. With ``STUDY_TEST_HANG_NODE`` naming a node,
+every run after that node's first one hangs there, so a test that kills the node always
+cuts a run short.
 """
 
 from __future__ import annotations
@@ -30,10 +32,14 @@ def _marker(spec: RunSpec) -> Path | None:
     directory = os.environ.get('STUDY_TEST_MARKERS')
     if not directory:
         return None
-    node = os.environ.get('STUDY_TEST_NODE', 'main')
+    node = _node()
     path = Path(directory, f'{spec.run_id}.{node}.{os.getpid()}.{time.monotonic_ns()}')
     path.touch()
     return path
+
+
+def _node() -> str:
+    return os.environ.get('STUDY_TEST_NODE', 'main')
 
 
 def synthetic_run(spec: RunSpec) -> Mapping[str, Any]:
@@ -44,6 +50,10 @@ def synthetic_run(spec: RunSpec) -> Mapping[str, Any]:
         earlier = [p for p in marker.parent.glob(f'{spec.run_id}.*') if p != marker]
         if not earlier:
             os._exit(17)
+    if marker is not None and os.environ.get('STUDY_TEST_HANG_NODE') == _node():
+        earlier_here = [p for p in marker.parent.glob(f'*.{_node()}.*') if p != marker]
+        if earlier_here:
+            time.sleep(3600.0)  # until the test kills this node
     if config.get('sleep_s', 0.0):
         time.sleep(config['sleep_s'])
     if spec.seed in config.get('fail_seeds', []):

@@ -72,7 +72,12 @@ def test_the_study_finishes_with_identical_rows_after_a_node_dies(tmp_path: Path
     markers = tmp_path / 'markers'
     markers.mkdir()
     scheduler_file = tmp_path / 'scheduler.json'
-    env = {**os.environ, 'STUDY_TEST_MARKERS': str(markers), 'DASK_LOGGING__DISTRIBUTED': 'error'}
+    env = {
+        **os.environ,
+        'STUDY_TEST_MARKERS': str(markers),
+        'STUDY_TEST_HANG_NODE': 'node2',  # node2's second run hangs until the node is killed
+        'DASK_LOGGING__DISTRIBUTED': 'error',
+    }
     registry = StudyRegistry(studies())
     plan = make_specs(registry.get('synthetic-slow'))
     processes = []
