@@ -28,8 +28,10 @@ setup(
         'numpy',
         'scipy',
         'matplotlib',
-        'pybullet',
-        # The compiled ray casting, world and sensor kernels (simulation only, like pybullet).
+        # The optional pybullet physics backend (swarm_sim.pybullet_physics); wheels exist up
+        # to Python 3.11, and everything else imports and runs without it.
+        'pybullet; python_version < "3.12"',
+        # The compiled ray casting, world and sensor kernels (simulation only).
         'numba',
         'PyYAML',
         'swarm_common',

@@ -163,7 +163,8 @@ class SimBridgeNode(Node):
         self.get_logger().info(
             f'simulating {n} robots in {geometry.name!r} '
             f'({len(self.engine.world.walls)} walls, {self.engine.coverage.rooms_total} rooms), '
-            f'physics {self.config.physics_rate_hz:g} Hz, seed {self.config.seed}'
+            f'{self.config.physics} physics at {self.config.physics_rate_hz:g} Hz, '
+            f'seed {self.config.seed}'
         )
 
     # Set-up helpers -------------------------------------------------------------------
@@ -321,6 +322,13 @@ class SimBridgeNode(Node):
                 cov.rooms_total, cov.entries, self.robot_names, self.engine.time_s
             )
         )
+
+    def destroy_node(self) -> None:
+        """Release the engine's physics backend, then destroy the node."""
+        engine = getattr(self, 'engine', None)
+        if engine is not None:
+            engine.close()
+        super().destroy_node()
 
     def pause(self) -> None:
         """Stop stepping the world (the physics timer is cancelled); messages already

@@ -40,6 +40,7 @@ def _p(name: str, path: str, description: str) -> EngineParameter:
 
 ENGINE_PARAMETERS: tuple[EngineParameter, ...] = (
     _p('seed', 'seed', 'Seed of every random draw in the world; equal seeds give equal runs.'),
+    _p('physics', 'physics', 'Physics and ray-casting backend: numpy (fast) or pybullet.'),
     _p('physics_rate_hz', 'physics_rate_hz', 'Physics steps per second of sim time [Hz].'),
     _p('cmd_vel_timeout_s', 'cmd_vel_timeout_s', 'A robot stops when cmd_vel is older [s].'),
     _p('pump_timeout_s', 'pump_timeout_s', 'A pump stops when its last "on" is older [s].'),

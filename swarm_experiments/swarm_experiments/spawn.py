@@ -31,6 +31,7 @@ from swarm_sim.engine import EngineConfig
 from swarm_sim.errors import ConfigurationError
 from swarm_sim.site_loading import load_site, site_budget_actions
 
+from swarm_experiments.cli_args import add_physics_option, add_render_option, render_config
 from swarm_experiments.errors import ExperimentError
 from swarm_experiments.mission import (
     MissionProgress,
@@ -310,7 +311,7 @@ def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog='spawn',
         description=(
-            'Run an OA-Bug swarm search in the pybullet simulation until every room is covered '
+            'Run an OA-Bug swarm search in the simulation until every room is covered '
             'or the action budget ends; print the coverage summary and write the plots.'
         ),
         formatter_class=argparse.ArgumentDefaultsHelpFormatter,
@@ -350,6 +351,8 @@ def _parser() -> argparse.ArgumentParser:
         help='set an OA-Bug node parameter for every robot (repeatable), e.g. '
         'gas_threshold=300 or sound_turn_rule=toward; names and defaults: docs/oabug.md',
     )
+    add_physics_option(parser)
+    add_render_option(parser)
     return parser
 
 
@@ -369,6 +372,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             speed_mps=args.speed,
             record=args.record,
             out_dir=None if args.no_plots else args.out,
+            engine=EngineConfig(physics=args.physics, render=render_config(args.render)),
         )
     except SwarmError as err:
         return fail('spawn', err)
@@ -398,6 +402,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f'wrote {path}')
     if result.mission.bag_path is not None:
         print(f'recorded {result.mission.bag_path}')
+    frames = config.engine.render.frames_dir
+    if config.engine.render.mode == 'frames' and frames is not None:
+        print(f'wrote the frames to {frames} and {frames / "run.gif"}')
     return EXIT_SUCCESS
 
 

@@ -37,7 +37,7 @@ from swarm_sim.signal_mission import SignalMissionModel
 
 from swarm_experiments.bayes_batch import MissionSpec as BatchMissionSpec
 from swarm_experiments.bayes_batch import depot_fan
-from swarm_experiments.cli_args import points_argument
+from swarm_experiments.cli_args import add_physics_option, points_argument
 from swarm_experiments.errors import ExperimentError
 from swarm_experiments.mission import MissionSpec, RecordingSpec, RobotNodeSpec, run_mission
 from swarm_experiments.node_overrides import parse_overrides
@@ -94,6 +94,7 @@ class SpawnSettings:
         record: bag directory to write, or None.
         out_dir: where the PNGs go (None: no plots).
         extra_parameters: further node parameters (name -> value).
+        physics: the engine's physics backend ('numpy' or 'pybullet').
     """
 
     algorithm: str = 'bayes_swarm_p'
@@ -110,6 +111,7 @@ class SpawnSettings:
     record: Path | None = None
     out_dir: Path | None = None
     extra_parameters: dict[str, Any] = field(default_factory=dict)
+    physics: str = 'numpy'
 
 
 @dataclass
@@ -178,9 +180,12 @@ def _arena_site(case: SignalCase) -> SiteGeometry:
     )
 
 
-def _engine_config(case: SignalCase, seed: int) -> EngineConfig:
+def _engine_config(case: SignalCase, seed: int, physics: str = 'numpy') -> EngineConfig:
     return point_robot_engine_config(
-        physics_rate_hz=20.0, seed=seed, max_linear_speed_mps=1.05 * case.velocity_mps
+        physics_rate_hz=20.0,
+        seed=seed,
+        max_linear_speed_mps=1.05 * case.velocity_mps,
+        physics=physics,
     )
 
 
@@ -332,7 +337,7 @@ def run(settings: SpawnSettings, progress: Any = None) -> BayesSwarmRun:
         initial_poses=poses,
         robots=[RobotNodeSpec(factory, node_parameters(case, settings, n, i)) for i in range(n)],
         max_sim_time_s=case.max_mission_time_s + 2.0,
-        engine_config=_engine_config(case, settings.seed),
+        engine_config=_engine_config(case, settings.seed, settings.physics),
         bridge_parameters=bridge_parameters,
         extensions=[SignalExtension(model)],
         stop_when_all_rooms_covered=False,
@@ -445,6 +450,7 @@ def build_parser() -> argparse.ArgumentParser:
         help='set a bayes_swarm node parameter for every robot (repeatable), e.g. '
         'horizon_s=20; names and defaults: ros2 param describe, or bayes_swarm.node_settings',
     )
+    add_physics_option(parser)
     return parser
 
 
@@ -470,6 +476,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         outer_optimizer=args.outer_optimizer,
         record=args.record,
         out_dir=None if args.no_plots else args.out,
+        physics=args.physics,
     )
 
     def progress(report: Any) -> None:

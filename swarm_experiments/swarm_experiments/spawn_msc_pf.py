@@ -35,7 +35,7 @@ from swarm_sim.engine import EngineConfig, SiteGeometry
 from swarm_sim.errors import ConfigurationError
 from swarm_sim.rssi_targets import RssiTargetConfig, RssiTargetField, place_robots
 
-from swarm_experiments.cli_args import points_argument
+from swarm_experiments.cli_args import add_physics_option, points_argument
 from swarm_experiments.errors import ExperimentError
 from swarm_experiments.mission import (
     MissionProgress,
@@ -76,6 +76,7 @@ class SpawnSettings:
         record: bag directory to write, or None.
         out_dir: where the PNGs go (None: no plots).
         extra_parameters: further msc_pf node parameters (name -> value).
+        physics: the engine's physics backend ('numpy' or 'pybullet').
     """
 
     scheme: str = 'proposed'
@@ -92,6 +93,7 @@ class SpawnSettings:
     record: Path | None = None
     out_dir: Path | None = None
     extra_parameters: dict[str, Any] = field(default_factory=dict)
+    physics: str = 'numpy'
 
 
 @dataclass
@@ -138,7 +140,10 @@ def _check(settings: SpawnSettings) -> None:
 
 def _engine_config(settings: SpawnSettings) -> EngineConfig:
     return point_robot_engine_config(
-        physics_rate_hz=settings.physics_rate_hz, seed=settings.seed, max_linear_speed_mps=1.05
+        physics_rate_hz=settings.physics_rate_hz,
+        seed=settings.seed,
+        max_linear_speed_mps=1.05,
+        physics=settings.physics,
     )
 
 
@@ -348,6 +353,7 @@ def build_parser() -> argparse.ArgumentParser:
         help='set an msc_pf controller parameter for every robot (repeatable), e.g. '
         'msc.leader_rule=pbest; names and defaults: msc_pf/config/msc_pf.yaml',
     )
+    add_physics_option(parser)
     return parser
 
 
@@ -371,6 +377,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         target_positions_m=args.target_positions,
         record=args.record,
         out_dir=None if args.no_plots else args.out,
+        physics=args.physics,
     )
 
     def report(p: MissionProgress) -> None:
