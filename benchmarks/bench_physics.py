@@ -57,8 +57,9 @@ def run_missions(
     call, robot-seconds simulated, rooms covered per run)."""
     from swarm_experiments.oabug_batch import run_spawn_batch
     from swarm_experiments.spawn import SpawnSettings
-    from swarm_sim import physics as physics_module
     from swarm_sim.engine import EngineConfig
+
+    from swarm_sim import physics as physics_module
 
     spent: dict[str, float] = defaultdict(float)
     factory = physics_module.PHYSICS_BACKENDS[physics]

@@ -51,5 +51,5 @@ def test_the_bridge_runs_pybullet_physics_when_asked(ros):
 
 
 def test_an_unknown_physics_backend_is_refused_by_name(ros):
-    with pytest.raises(ConfigurationError, match="unknown physics backend 'ode'"):
+    with pytest.raises(ConfigurationError, match="physics: 'ode' is not one of numpy, pybullet"):
         bridge_with(physics='ode')
