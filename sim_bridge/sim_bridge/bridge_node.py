@@ -26,7 +26,7 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
-from swarm_common.cli import fail
+from swarm_common.cli import EXIT_SUCCESS, EXIT_USAGE, fail
 from swarm_runtime.parameters import ParameterFileError, check_parameter_arguments, declare_config
 from swarm_runtime.ros import (
     ExternalShutdownException,
@@ -356,6 +356,7 @@ def main(args: list[str] | None = None) -> None:
         raise SystemExit(fail(NODE_NAME, err)) from None
     rclpy.init(args=args)
     node = None
+    code = EXIT_SUCCESS
     try:
         node = SimBridgeNode()
         rclpy.spin(node)
@@ -363,13 +364,17 @@ def main(args: list[str] | None = None) -> None:
         pass
     except SimulationError as err:
         if node is None:
+            # The world could not be built (a bad parameter, pybullet missing): exit 2.
             rclpy.logging.get_logger('sim_bridge').error(str(err))
+            code = EXIT_USAGE
         else:
             node.get_logger().error(str(err))
     finally:
         if node is not None:
             node.destroy_node()
         rclpy.try_shutdown()
+    if code != EXIT_SUCCESS:
+        raise SystemExit(code)
 
 
 if __name__ == '__main__':

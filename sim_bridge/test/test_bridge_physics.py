@@ -1,5 +1,6 @@
 """The bridge's ``physics`` parameter picks the engine's physics backend by name."""
 
+import sys
 from pathlib import Path
 
 import pytest
@@ -53,3 +54,18 @@ def test_the_bridge_runs_pybullet_physics_when_asked(ros):
 def test_an_unknown_physics_backend_is_refused_by_name(ros):
     with pytest.raises(ConfigurationError, match="physics: 'ode' is not one of numpy, pybullet"):
         bridge_with(physics='ode')
+
+
+def test_the_bridge_exits_2_when_pybullet_physics_is_asked_without_pybullet(monkeypatch, caplog):
+    from sim_bridge.bridge_node import main
+
+    monkeypatch.setitem(sys.modules, 'pybullet', None)  # as on a machine without it
+    params = [f'site_file:={FIVE_ROOMS}', 'departure:=edge', 'physics:=pybullet']
+    args = ['sim_bridge', '--ros-args', *[a for p in params for a in ('-p', p)]]
+    with pytest.raises(SystemExit) as done:
+        main(args)
+    assert done.value.code == 2
+    errors = [r.getMessage() for r in caplog.records if r.levelname == 'ERROR']
+    assert len(errors) == 1
+    assert errors[0].startswith("pybullet is not installed: pip install 'swarm_sim[pybullet]'")
+    assert '\n' not in errors[0]

@@ -343,31 +343,30 @@ def run_oabug_batch(
     def snapshot() -> MissionProgress:
         return MissionProgress.of_engine(engine, wall_start)
 
-    try:
-        while True:
-            out = engine.step()
-            if out.time_s + 1e-9 >= next_sample_s:
-                times.append(out.time_s)
-                poses.append(out.poses)
-                next_sample_s += spec.trajectory_period_s
-            if spec.stop_when_all_rooms_covered and engine.coverage.complete:
-                reason = StopReason.ALL_ROOMS_COVERED
+    while True:
+        out = engine.step()
+        if out.time_s + 1e-9 >= next_sample_s:
+            times.append(out.time_s)
+            poses.append(out.poses)
+            next_sample_s += spec.trajectory_period_s
+        if spec.stop_when_all_rooms_covered and engine.coverage.complete:
+            reason = StopReason.ALL_ROOMS_COVERED
+            break
+        if engine.time_s + 1e-9 >= spec.max_sim_time_s:
+            reason = StopReason.BUDGET
+            break
+        if engine.time_s + 1e-9 >= next_report_s:
+            next_report_s += spec.progress_period_s
+            report = snapshot()
+            if progress is not None:
+                progress(report)
+            if stop is not None and stop(report):
+                reason = StopReason.PREDICATE
                 break
-            if engine.time_s + 1e-9 >= spec.max_sim_time_s:
-                reason = StopReason.BUDGET
-                break
-            if engine.time_s + 1e-9 >= next_report_s:
-                next_report_s += spec.progress_period_s
-                report = snapshot()
-                if progress is not None:
-                    progress(report)
-                if stop is not None and stop(report):
-                    reason = StopReason.PREDICATE
-                    break
-            _deliver(engine, out, robots, own_tags)
-    finally:
-        # Releases the physics backend (a pybullet client; a recorded run's animation).
-        engine.close()
+        _deliver(engine, out, robots, own_tags)
+
+    # Release the physics backend (a pybullet client; a recorded run's animation is written).
+    engine.close()
     final = snapshot()
     if progress is not None:
         progress(final)

@@ -29,6 +29,7 @@ from swarm_common.errors import SwarmError
 from swarm_sim.departure import place_starts
 from swarm_sim.engine import EngineConfig
 from swarm_sim.errors import ConfigurationError
+from swarm_sim.physics import require_backend
 from swarm_sim.site_loading import load_site, site_budget_actions
 
 from swarm_experiments.cli_args import add_physics_option, add_render_option, render_config
@@ -355,6 +356,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Command line entry point; returns the process exit code."""
     args = _parser().parse_args(argv)
     try:
+        require_backend(args.physics)
         config = SpawnSettings(
             robot_parameters=oabug_parameter_overrides(args.param),
             site=args.site,

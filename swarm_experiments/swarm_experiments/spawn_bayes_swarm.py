@@ -31,7 +31,7 @@ from sim_bridge.signal_extension import SignalExtension
 from swarm_common.cli import EXIT_SUCCESS, fail
 from swarm_common.errors import SwarmError
 from swarm_sim.engine import EngineConfig, SiteGeometry
-from swarm_sim.errors import ConfigurationError
+from swarm_sim.physics import require_backend
 from swarm_sim.signal_fields import CASE_NAMES, SignalCase, UnknownCaseError, get_case
 from swarm_sim.signal_mission import SignalMissionModel
 
@@ -464,8 +464,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``spawn_bayes_swarm``; returns the exit status."""
     args = build_parser().parse_args(argv)
     try:
+        require_backend(args.physics)
         extra = node_parameter_overrides(args.param)
-    except ConfigurationError as err:
+    except SwarmError as err:
         return fail('spawn_bayes_swarm', err)
     settings = SpawnSettings(
         extra_parameters=extra,

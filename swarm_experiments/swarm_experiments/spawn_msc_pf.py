@@ -32,7 +32,7 @@ from sim_bridge.rssi_extension import RssiExtension
 from swarm_common.cli import EXIT_SUCCESS, EXIT_UNFINISHED, fail
 from swarm_common.errors import SwarmError
 from swarm_sim.engine import EngineConfig, SiteGeometry
-from swarm_sim.errors import ConfigurationError
+from swarm_sim.physics import require_backend
 from swarm_sim.rssi_targets import RssiTargetConfig, RssiTargetField, place_robots
 
 from swarm_experiments.cli_args import add_physics_option, points_argument
@@ -368,8 +368,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     targets = args.targets if args.target_positions is None else len(args.target_positions)
     try:
+        require_backend(args.physics)
         extra = controller_parameter_overrides(args.param)
-    except ConfigurationError as err:
+    except SwarmError as err:
         return fail('spawn_msc_pf', err)
     settings = SpawnSettings(
         extra_parameters=extra,

@@ -42,6 +42,7 @@ __all__ = [
     'RenderConfig',
     'WallCrossingCounter',
     'make_physics',
+    'require_backend',
 ]
 
 # (K, 2) path starts [m], (K, 2) path ends [m] -> (K,) number of walls each path crosses.
@@ -282,10 +283,34 @@ def _pybullet_physics(setup: PhysicsSetup) -> PhysicsBackend:
     return PybulletPhysics(setup)
 
 
+def _require_pybullet() -> None:
+    from swarm_sim.pybullet_scene import import_pybullet
+
+    import_pybullet()
+
+
 PHYSICS_BACKENDS: dict[str, Callable[[PhysicsSetup], PhysicsBackend]] = {
     'numpy': NumpyPhysics,
     'pybullet': _pybullet_physics,
 }
+# Per backend, a check that raises SimulationError when its library is missing.
+_REQUIREMENTS: dict[str, Callable[[], None]] = {'pybullet': _require_pybullet}
+
+
+def require_backend(name: str) -> None:
+    """Check that backend ``name`` exists and its library is installed, without building it
+    (so that a command-line tool refuses a run before it starts anything).
+
+    Raises:
+        ConfigurationError: no backend of that name.
+        SimulationError: the backend's library is missing (pybullet not installed).
+    """
+    if name not in PHYSICS_BACKENDS:
+        msg = f'unknown physics backend {name!r}; choose from {", ".join(PHYSICS_BACKENDS)}'
+        raise ConfigurationError(msg)
+    check = _REQUIREMENTS.get(name)
+    if check is not None:
+        check()
 
 
 def make_physics(name: str, setup: PhysicsSetup) -> PhysicsBackend:

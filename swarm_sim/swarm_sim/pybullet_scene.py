@@ -50,8 +50,8 @@ def import_pybullet() -> Any:
         import pybullet
     except ImportError as err:
         msg = (
-            'pybullet is not installed (it belongs to the simulation install only, wheels '
-            'exist up to Python 3.11): use the numpy physics backend'
+            "pybullet is not installed: pip install 'swarm_sim[pybullet]' (wheels exist only "
+            'up to Python 3.11 on x86-64), or use the numpy physics backend'
         )
         raise SimulationError(msg) from err
     return pybullet
