@@ -1,11 +1,15 @@
 """CPU time per simulated robot-second of each physics backend, on whole OA-Bug missions.
 
-Runs the same OA-Bug missions (batch path, generated Small sites) on every backend named, and
-prints, per backend and robot count, the CPU seconds of the whole run and of the backend's own
-calls (the physics step, the lidar scan, the wall counts of bearings and scent) divided by
-robots x simulated seconds. The backend's calls are timed by wrapping the backend the
-registry builds (``swarm_sim.physics.PHYSICS_BACKENDS``); one short warm-up mission per
-backend first loads the compiled kernels. CPU time is ``time.process_time``, one process::
+Runs the same OA-Bug missions (batch path, gas_sound, generated Small sites) on every backend
+named, interleaved site by site, and prints, per backend and robot count, the CPU seconds of
+the whole run and of the backend's own calls (the physics step, the lidar scan, the wall
+counts of bearings and scent) divided by robots x simulated seconds, then the ratio of each
+backend's whole-run figure to the first backend's, measured in the same run. The backend's
+calls are timed by wrapping the backend the registry builds
+(``swarm_sim.physics.PHYSICS_BACKENDS``); the numpy backend hands the wall counts to the
+sensor models' own compiled kernels, so its wall-count column is 0 and that time is in the
+whole run only. One short warm-up mission per backend first loads the compiled kernels. CPU
+time is ``time.process_time``, one process::
 
     nice -n 10 python benchmarks/bench_physics.py --robots 4 10 --sites 2 --seconds 60
 """
@@ -16,6 +20,7 @@ import argparse
 import time
 from collections import defaultdict
 from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -50,70 +55,112 @@ class TimedBackend:
         return getattr(self._backend, name)
 
 
-def run_missions(
-    physics: str, robots: int, site_seeds: Sequence[int], seconds: float
-) -> tuple[float, dict[str, float], float, list[int]]:
-    """Run one gas_sound mission per site seed; return (CPU s of the runs, CPU s per backend
-    call, robot-seconds simulated, rooms covered per run)."""
+def run_mission(
+    physics: str, robots: int, site_seed: int, seconds: float, spent: dict[str, float]
+) -> tuple[float, float, int]:
+    """Run one gas_sound mission; return (CPU s of the run, robot-seconds simulated, rooms
+    covered), adding the CPU s of the backend's calls to ``spent``."""
     from swarm_experiments.oabug_batch import run_spawn_batch
     from swarm_experiments.spawn import SpawnSettings
     from swarm_sim.engine import EngineConfig
 
     from swarm_sim import physics as physics_module
 
-    spent: dict[str, float] = defaultdict(float)
     factory = physics_module.PHYSICS_BACKENDS[physics]
     physics_module.PHYSICS_BACKENDS[physics] = lambda setup: TimedBackend(factory(setup), spent)
     try:
-        cpu = 0.0
-        robot_s = 0.0
-        covered = []
-        for seed in site_seeds:
-            settings = SpawnSettings(
-                site='small',
-                site_seed=seed,
-                seed=seed,
-                variant='gas_sound',
-                robots=robots,
-                actions=max(1, round(seconds * 0.3 / 0.1)),
-                engine=EngineConfig(physics=physics),
-            )
-            start = time.process_time()
-            result = run_spawn_batch(settings)
-            cpu += time.process_time() - start
-            robot_s += robots * result.mission.sim_time_s
-            covered.append(result.mission.rooms_covered)
+        settings = SpawnSettings(
+            site='small',
+            site_seed=site_seed,
+            seed=site_seed,
+            variant='gas_sound',
+            robots=robots,
+            actions=max(1, round(seconds * 0.3 / 0.1)),
+            engine=EngineConfig(physics=physics),
+        )
+        start = time.process_time()
+        result = run_spawn_batch(settings)
+        cpu = time.process_time() - start
     finally:
         physics_module.PHYSICS_BACKENDS[physics] = factory
-    return cpu, dict(spent), robot_s, covered
+    return cpu, robots * result.mission.sim_time_s, result.mission.rooms_covered
+
+
+@dataclass
+class Tally:
+    """What the missions of one backend and robot count added up to."""
+
+    cpu_s: float = 0.0
+    robot_s: float = 0.0
+    spent: dict[str, float] = field(default_factory=lambda: defaultdict(float))
+    covered: list[int] = field(default_factory=list)
+
+    def per_robot_s_ms(self, seconds: float) -> float:
+        """``seconds`` of CPU in milliseconds per simulated robot-second."""
+        return 1e3 * seconds / self.robot_s
+
+
+def measure(
+    backends: Sequence[str], robots: int, site_seeds: Sequence[int], seconds: float
+) -> dict[str, Tally]:
+    """The same missions on every backend, interleaved (site by site, the order of the
+    backends alternating) so that a change of the machine's load hits all of them alike."""
+    tallies = {name: Tally() for name in backends}
+    for k, seed in enumerate(site_seeds):
+        order = list(backends) if k % 2 == 0 else list(reversed(backends))
+        for name in order:
+            tally = tallies[name]
+            cpu, robot_s, covered = run_mission(name, robots, seed, seconds, tally.spent)
+            tally.cpu_s += cpu
+            tally.robot_s += robot_s
+            tally.covered.append(covered)
+    return tallies
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Command line entry point."""
+    from swarm_common.cli import fail
+    from swarm_common.errors import SwarmError
+    from swarm_sim.physics import require_backend
+
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     parser.add_argument('--physics', nargs='+', default=['numpy', 'pybullet'])
     parser.add_argument('--robots', nargs='+', type=int, default=[4, 10])
     parser.add_argument('--sites', type=int, default=2, help='generated Small sites 0..n-1')
     parser.add_argument('--seconds', type=float, default=60.0, help='sim time per mission [s]')
     args = parser.parse_args(argv)
+    try:
+        for name in args.physics:
+            require_backend(name)
+    except SwarmError as err:
+        return fail('bench_physics', err)
+    for name in args.physics:
+        run_mission(name, 2, 0, 5.0, defaultdict(float))  # warm-up: imports, compiled kernels
     print(
         '| physics | robots | missions | rooms covered | CPU ms per robot-s (whole run) '
         '| backend ms per robot-s | of which step / scan / wall counts |'
     )
     print('|---|---|---|---|---|---|---|')
-    for physics in args.physics:
-        run_missions(physics, 2, [0], 5.0)  # warm-up: imports, compiled kernels
-        for robots in args.robots:
-            cpu, spent, robot_s, covered = run_missions(
-                physics, robots, range(args.sites), args.seconds
-            )
-            per = 1e3 / robot_s
-            parts = ' / '.join(f'{spent.get(name, 0.0) * per:.2f}' for name in CALLS)
+    ratios = []
+    for robots in args.robots:
+        tallies = measure(args.physics, robots, range(args.sites), args.seconds)
+        for name, tally in tallies.items():
+            parts = ' / '.join(f'{tally.per_robot_s_ms(tally.spent[c]):.2f}' for c in CALLS)
             print(
-                f'| {physics} | {robots} | {len(covered)} | {np.mean(covered):.1f} '
-                f'| {cpu * per:.2f} | {sum(spent.values()) * per:.2f} | {parts} |',
+                f'| {name} | {robots} | {len(tally.covered)} | {np.mean(tally.covered):.1f} '
+                f'| {tally.per_robot_s_ms(tally.cpu_s):.2f} '
+                f'| {tally.per_robot_s_ms(sum(tally.spent.values())):.2f} | {parts} |',
                 flush=True,
             )
+        base_name = args.physics[0]
+        base = tallies[base_name]
+        for name in args.physics[1:]:
+            ratio = tallies[name].per_robot_s_ms(tallies[name].cpu_s) / base.per_robot_s_ms(
+                base.cpu_s
+            )
+            ratios.append(f'{name} / {base_name} at {robots} robots: {ratio:.1f} x')
+    if ratios:
+        print('\nCPU time per robot-second, whole runs, measured in this run: ' + '; '.join(ratios))
     return 0
 
 
