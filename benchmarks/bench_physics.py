@@ -2,14 +2,11 @@
 
 Runs the same OA-Bug missions (batch path, gas_sound, generated Small sites) on every backend
 named, interleaved site by site, and prints, per backend and robot count, the CPU seconds of
-the whole run and of the backend's own calls (the physics step, the lidar scan, the wall
-counts of bearings and scent) divided by robots x simulated seconds, then the ratio of each
-backend's whole-run figure to the first backend's, measured in the same run. The backend's
-calls are timed by wrapping the backend the registry builds
-(``swarm_sim.physics.PHYSICS_BACKENDS``); the numpy backend hands the wall counts to the
-sensor models' own compiled kernels, so its wall-count column is 0 and that time is in the
-whole run only. One short warm-up mission per backend first loads the compiled kernels. CPU
-time is ``time.process_time``, one process::
+the whole run and of the backend's own calls (the physics step, the lidar scan) divided by
+robots x simulated seconds, then the ratio of each backend's whole-run figure to the first
+backend's, measured in the same run. The backend's calls are timed by wrapping the backend
+the registry builds (``swarm_sim.physics.PHYSICS_BACKENDS``). One short warm-up mission per
+backend first loads the compiled kernels. CPU time is ``time.process_time``, one process::
 
     nice -n 10 python benchmarks/bench_physics.py --robots 4 10 --sites 2 --seconds 60
 """
@@ -25,19 +22,17 @@ from typing import Any
 
 import numpy as np
 
-CALLS = ('step', 'scan', 'wall_crossings')
+CALLS = ('step', 'scan')
 
 
 class TimedBackend:
-    """A physics backend whose step, scan and wall counts add their CPU time to ``spent``."""
+    """A physics backend whose step and scan add their CPU time to ``spent``."""
 
     def __init__(self, backend: Any, spent: dict[str, float]) -> None:
         self._backend = backend
         self._spent = spent
         self.walls = backend.walls
         self.num_bins = backend.num_bins
-        counter = backend.wall_crossings
-        self.wall_crossings = None if counter is None else self._timed('wall_crossings', counter)
         self.step = self._timed('step', backend.step)
         self.scan = self._timed('scan', backend.scan)
 
@@ -138,7 +133,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         run_mission(name, 2, 0, 5.0, defaultdict(float))  # warm-up: imports, compiled kernels
     print(
         '| physics | robots | missions | rooms covered | CPU ms per robot-s (whole run) '
-        '| backend ms per robot-s | of which step / scan / wall counts |'
+        '| backend ms per robot-s | of which step / scan |'
     )
     print('|---|---|---|---|---|---|---|')
     ratios = []

@@ -262,15 +262,14 @@ class SimEngine:
         self.bearing_model: BearingModel | None = None
         self.imu: GyroYawModel | None = None
         self.odometry: WheelOdometry | None = None
-        crossings = self.world.wall_crossings
         if 'scan' in self.sensors:
             self.lidar = LidarModel(self.world, cfg.lidar, rngs[0])
         if 'gas' in self.sensors:
-            self.scent = ScentField(cfg.scent, self.world.walls, crossings)
+            self.scent = ScentField(cfg.scent, self.world.walls)
             self._depositor = PumpDepositor(self.scent, n)
             self.gas = Mp503Model(n, cfg.gas, rngs[1])
         if 'bearings' in self.sensors:
-            self.bearing_model = BearingModel(n, cfg.bearings, rngs[2], self.world.walls, crossings)
+            self.bearing_model = BearingModel(n, cfg.bearings, rngs[2], self.world.walls)
         if 'imu' in self.sensors:
             self.imu = GyroYawModel(poses[:, 2], cfg.imu, rngs[3])
         if 'odometry' in self.sensors:

@@ -1,10 +1,11 @@
 """Physics and ray-casting backends of the engine, chosen by name.
 
-The engine needs four things of its physics: the robot bodies and their motion under velocity
-commands (with collisions against the walls and each other), the lidar's ranges, the number
-of walls on straight paths (the bearing model's wall attenuation and the scent field's
-line of sight), and a way to release what the backend holds. :class:`PhysicsBackend` is that
-contract; :data:`PHYSICS_BACKENDS` maps each backend's name to its factory:
+The engine needs three things of its physics: the robot bodies and their motion under
+velocity commands (with collisions against the walls and each other), the lidar's ranges,
+and a way to release what the backend holds. :class:`PhysicsBackend` is that contract;
+:data:`PHYSICS_BACKENDS` maps each backend's name to its factory. (The wall counts on straight
+paths, the bearing model's wall attenuation and the scent field's line of sight, are the
+sensor models' own: they count crossings of the same wall centre lines on every backend.)
 
 * ``numpy`` (:class:`NumpyPhysics`, the default): the kinematic disc world of
   :mod:`swarm_sim.world` (a move into contact is cancelled) and the exact 2D caster of
@@ -40,13 +41,9 @@ __all__ = [
     'PhysicsSetup',
     'PybulletConfig',
     'RenderConfig',
-    'WallCrossingCounter',
     'make_physics',
     'require_backend',
 ]
-
-# (K, 2) path starts [m], (K, 2) path ends [m] -> (K,) number of walls each path crosses.
-WallCrossingCounter = Callable[[np.ndarray, np.ndarray], np.ndarray]
 
 RENDER_MODES = ('none', 'gui', 'frames')
 
@@ -103,7 +100,7 @@ class PybulletConfig:
         robot_mass_kg: mass of every robot (it matters only when robots push each other).
         robot_height_m: height of the robot cylinders [m].
         wall_height_m: height of the wall boxes [m].
-        sensor_height_m: height of every ray (lidar, sight lines, vapour paths) [m]; below
+        sensor_height_m: height of the lidar's rays [m]; below
             the robots' top so that robots see each other.
         contact_friction: friction coefficient of robot-wall and robot-robot contacts (0:
             a robot pressed against a wall slides along it and is not turned by it).
@@ -173,14 +170,10 @@ class PhysicsBackend(Protocol):
     Attributes:
         walls: (M, 2, 2) wall centre lines [m].
         num_bins: lidar bins per revolution of :meth:`scan` (0 without a lidar).
-        wall_crossings: the counter of walls on straight paths that the bearing model and
-            the scent field must use, or None where those models' own compiled segment
-            tests are this backend's answer (the walls are exactly the 2D centre lines).
     """
 
     walls: np.ndarray
     num_bins: int
-    wall_crossings: WallCrossingCounter | None
 
     @property
     def num_robots(self) -> int:
@@ -221,8 +214,6 @@ class PhysicsBackend(Protocol):
 class NumpyPhysics:
     """The kinematic disc world and the exact 2D caster (see :mod:`swarm_sim.world` and
     :class:`swarm_sim.geometry.RayCaster`), on the compiled kernels."""
-
-    wall_crossings: WallCrossingCounter | None = None
 
     def __init__(self, setup: PhysicsSetup) -> None:
         self._world = World(setup.walls, setup.initial_poses, setup.body)

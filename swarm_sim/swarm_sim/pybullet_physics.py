@@ -16,10 +16,11 @@ contacts, whose normals stay horizontal, and are put back should they move by mo
 0.1 mm. A kinematic body (pose set each step, contacts only detected) was not chosen: it
 would leave the contact resolution to this code, which is what the numpy backend already is.
 
-Rays (lidar, sight lines between robots, vapour paths) go through ``rayTestBatch`` of the
-same client (:class:`swarm_sim.pybullet_scene.PybulletScene`). The run is deterministic: the
-client is private to the backend, and pybullet in DIRECT mode gives equal results for equal
-calls.
+The lidar's rays go through ``rayTestBatch`` of the same client
+(:class:`swarm_sim.pybullet_scene.PybulletScene`); the bearing model and the scent field
+count the walls on their paths on the wall centre lines themselves, as with the numpy
+backend. The run is deterministic: the client is private to the backend, and pybullet in
+DIRECT mode gives equal results for equal calls.
 """
 
 from __future__ import annotations
@@ -33,7 +34,7 @@ from swarm_common.angles import wrap_angle
 
 from swarm_sim.errors import ConfigurationError
 from swarm_sim.geometry import as_segments
-from swarm_sim.physics import PhysicsSetup, WallCrossingCounter
+from swarm_sim.physics import PhysicsSetup
 from swarm_sim.pybullet_render import FrameRecorder, place_gui_camera, robot_colours
 from swarm_sim.pybullet_scene import PybulletScene, yaw_quaternion
 from swarm_sim.world import checked_poses
@@ -93,7 +94,6 @@ class PybulletPhysics:
         self._bin_angles = -math.pi + 2.0 * math.pi / max(self.num_bins, 1) * np.arange(
             self.num_bins
         )
-        self.wall_crossings: WallCrossingCounter | None = self._scene.count_wall_hits
         self._render = render
         # The animation written by close() when frames are recorded.
         self.gif_path: Path | None = None

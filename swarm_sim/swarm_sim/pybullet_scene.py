@@ -9,8 +9,8 @@ window), passes its id to every pybullet call and disconnects it on :meth:`close
 the end of a ``with`` block). :mod:`swarm_sim.pybullet_physics` drives the robots; the cross-
 check test of the caster uses :meth:`cast_scan` on walls alone.
 
-Walls and robots are in separate collision groups, so that rays can be cast against the
-walls alone (the bearing model's wall counts, the scent field's line of sight).
+Walls and robots are in separate collision groups, so that robots can be let pass through
+each other while they still hit the walls (and every ray still hits both).
 """
 
 from __future__ import annotations
@@ -304,32 +304,6 @@ class PybulletScene:
         """Ranges [m] along the robot-frame angles from one ``pose`` (x, y, yaw); inf if no
         hit: :meth:`scan` of one robot."""
         return self.scan(np.asarray(pose, dtype=float)[None, :], bin_angles_rad, max_range_m)[0]
-
-    def count_wall_hits(self, starts: np.ndarray, ends: np.ndarray) -> np.ndarray:
-        """(K,) number of walls each straight path from (K, 2) ``starts`` to ``ends`` [m]
-        passes through (robots are not counted). Cast at sensor height; a path from inside
-        a wall does not count that wall."""
-        starts = np.asarray(starts, dtype=float).reshape(-1, 2)
-        ends = np.asarray(ends, dtype=float).reshape(-1, 2)
-        counts = np.zeros(len(starts), dtype=np.int64)
-        if not self.wall_bodies or len(starts) == 0:
-            return counts
-        # Bullet reports the k-th of all hits of a ray for reportHitNumber=k (one per body).
-        active = np.flatnonzero(np.any(starts != ends, axis=1))
-        lifted_starts, lifted_ends = self._lift(starts), self._lift(ends)
-        for k in range(len(self.wall_bodies)):
-            if len(active) == 0:
-                break
-            hits = self._ray_batches(
-                lifted_starts[active],
-                lifted_ends[active],
-                reportHitNumber=k,
-                collisionFilterMask=WALL_GROUP,
-            )
-            hit = np.array([h[0] >= 0 for h in hits], dtype=bool)
-            active = active[hit]
-            counts[active] += 1
-        return counts
 
     def close(self) -> None:
         """Disconnect the pybullet client (idempotent)."""

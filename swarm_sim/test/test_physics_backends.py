@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from swarm_sim.engine import EngineConfig, SimEngine, SiteGeometry
 from swarm_sim.errors import ConfigurationError, SimulationError
-from swarm_sim.geometry import count_crossings, point_segment_distance
+from swarm_sim.geometry import point_segment_distance
 from swarm_sim.physics import (
     PHYSICS_BACKENDS,
     NumpyPhysics,
@@ -86,7 +86,6 @@ def test_default_engine_runs_the_numpy_backend():
     site = SiteGeometry(walls=WALLS, room_rects=np.array([[4.03, 0.03, 5.97, 2.97]]))
     engine = SimEngine(site, np.array([[1.0, 1.5, 0.0]]), EngineConfig())
     assert isinstance(engine.world, NumpyPhysics)
-    assert engine.world.wall_crossings is None  # the sensors' compiled segment kernels
 
 
 def test_the_simulator_imports_and_runs_without_pybullet():
@@ -269,57 +268,6 @@ def test_lidar_ranges_agree_with_the_numpy_caster_on_a_static_scene():
     assert grazing.sum() < 0.01 * grazing.size  # few rays are left out
 
 
-def test_wall_counts_agree_with_the_centre_lines_away_from_wall_ends():
-    needs_pybullet()
-    walls = geometry_from_site(load_site('small', seed=1)).walls
-    rng = np.random.default_rng(5)
-    points = _clear_points(walls, 1000, rng)
-    starts, ends = points[:500], points[500:]
-    backend = make_physics('pybullet', setup_of([[1.0, 1.0, 0.0]], walls))
-    try:
-        got = backend.wall_crossings(starts, ends)
-    finally:
-        backend.close()
-    expected = count_crossings(starts, ends, walls)
-    assert got.sum() > 1000  # paths across the building
-    # The boxes differ from the centre lines only within half a thickness of a wall's end
-    # (door jambs, corners): a path passing there may count one wall more or less.
-    differ = np.flatnonzero(got != expected)
-    paths = np.stack([starts[differ], ends[differ]], axis=1)
-    wall_ends = walls.reshape(-1, 2)
-    assert np.all(point_segment_distance(wall_ends, paths).min(axis=0) < HALF_T * math.sqrt(2))
-    assert len(differ) < 0.2 * len(starts)
-
-
-def test_wall_counts_see_walls_but_not_robots():
-    needs_pybullet()
-    backend = make_physics('pybullet', setup_of([[2.0, 1.5, 0.0]]))
-    try:
-        counts = backend.wall_crossings(
-            np.array([[1.0, 1.5], [1.0, 0.5], [3.0, 0.5], [5.0, 0.5]]),
-            np.array([[3.0, 1.5], [5.0, 0.5], [3.0, 0.5], [5.0, 3.5]]),
-        )
-    finally:
-        backend.close()
-    # Through the robot only; through the room's wall; a zero-length path; out of the hall.
-    assert counts.tolist() == [0, 1, 0, 1]
-
-
-def test_engine_hands_the_backends_wall_counter_to_bearings_and_scent():
-    needs_pybullet()
-    site = SiteGeometry(walls=WALLS, room_rects=np.array([[4.03, 0.03, 5.97, 2.97]]))
-    poses = np.array([[1.0, 1.5, 0.0], [5.0, 0.5, 0.0]])
-    with SimEngine(site, poses, EngineConfig(physics='pybullet', seed=2)) as engine:
-        counter = engine.world.wall_crossings
-        assert counter is not None
-        assert engine.bearing_model._crossings == counter
-        assert engine.scent._crossings == counter
-        engine.set_velocity_command(0, 0.3, 0.0)
-        outs = [engine.step() for _ in range(5)]
-        assert any(out.scans is not None for out in outs)
-        assert any(out.bearings is not None for out in outs)
-
-
 # pybullet: rendering ------------------------------------------------------------------
 
 
@@ -355,26 +303,16 @@ def test_the_window_without_a_display_is_refused_in_one_line(monkeypatch):
     assert '\n' not in str(err.value)
 
 
-# The sensor models with a backend's wall counter ---------------------------------------
-
-
-def test_scent_and_bearings_use_a_given_wall_counter():
-    from swarm_sim.sensors.bearings import BearingConfig, BearingModel
-    from swarm_sim.sensors.scent import ScentConfig, ScentField
-
-    def blocked(starts, ends):
-        return np.full(len(starts), 9, dtype=np.int64)
-
-    open_field = ScentField(ScentConfig(), WALLS)
-    walled = ScentField(ScentConfig(), WALLS, crossings=blocked)
-    for field in (open_field, walled):
-        field.deposit(np.array([[1.0, 1.0]]), 0.0, np.array([5.0]))
-    assert open_field.concentration(np.array([[1.05, 1.0]]), 1.0)[0] > 0.0
-    assert walled.concentration(np.array([[1.05, 1.0]]), 1.0)[0] == 0.0
-
-    config = BearingConfig(dropout_probability=0.0, range_m=10.0, wall_range_factor=0.5)
-    poses = np.array([[1.0, 1.5, 0.0], [3.0, 1.5, 0.0]])
-    heard = BearingModel(2, config, np.random.default_rng(0), WALLS).measure_cycle(poses)
-    muffled = BearingModel(2, config, np.random.default_rng(0), WALLS, blocked).measure_cycle(poses)
-    assert len(heard.tags) == 2  # 2 m apart, no wall between
-    assert len(muffled.tags) == 0  # 9 walls: 10 m x 0.5**9 < 2 m
+def test_a_pybullet_engine_runs_every_sensor():
+    needs_pybullet()
+    site = SiteGeometry(walls=WALLS, room_rects=np.array([[4.03, 0.03, 5.97, 2.97]]))
+    poses = np.array([[1.0, 1.5, 0.0], [5.0, 0.5, 0.0]])
+    with SimEngine(site, poses, EngineConfig(physics='pybullet', seed=2)) as engine:
+        client = engine.world.client
+        engine.set_velocity_command(0, 0.3, 0.0)
+        outs = [engine.step() for _ in range(5)]
+        assert any(out.scans is not None for out in outs)
+        assert any(out.bearings is not None for out in outs)
+        assert engine.world.poses[0, 0] == pytest.approx(1.15, abs=1e-3)
+    assert client >= 0
+    assert engine.world.client == -1  # released by the with block

@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import itertools
 import math
-from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -139,23 +138,10 @@ class BearingModel:
         config: BearingConfig,
         rng: np.random.Generator,
         walls: np.ndarray | None = None,
-        crossings: Callable[[np.ndarray, np.ndarray], np.ndarray] | None = None,
     ) -> None:
-        """Build the model.
-
-        Args:
-            num_robots: N.
-            config: the model's parameters.
-            rng: its random stream.
-            walls: (M, 2, 2) wall centre lines [m].
-            crossings: counts the walls on (K, 2) start -> (K, 2) end paths, for a physics
-                backend whose walls are not these segments (pybullet's boxes); None counts
-                segment crossings with the compiled kernel.
-        """
         self.config = config
         self._rng = rng
         self._walls = as_segments(walls if walls is not None else np.zeros((0, 2, 2)))
-        self._crossings = crossings
         self._sequence = np.zeros((num_robots, num_robots), dtype=np.int64)
         q, s = padded_walls(self._walls)
         self._padded_walls = (q, s, np.arange(len(self._walls), dtype=np.int64))
@@ -177,8 +163,6 @@ class BearingModel:
 
     def measure_cycle(self, poses: np.ndarray) -> BearingCycle:
         """:meth:`measure` with the reports in flat arrays (the same values and draws)."""
-        if self._crossings is not None:
-            return self._cycle(poses, *self._sight_lines(poses, self._crossings))
         rx, tx, delta, dist, walls = sight_lines_kernel(
             np.ascontiguousarray(poses, dtype=float), self.config.range_m, *self._padded_walls
         )
@@ -188,14 +172,6 @@ class BearingModel:
         """:meth:`measure` with the sight lines in numpy, the reference of the compiled
         :func:`~swarm_sim.raycast_kernel.sight_lines_kernel` (the same reports from the
         same random state)."""
-        lines = self._sight_lines(poses, lambda a, b: count_crossings(a, b, self._walls))
-        return self._cycle(poses, *lines).reports()
-
-    def _sight_lines(
-        self, poses: np.ndarray, crossings: Callable[[np.ndarray, np.ndarray], np.ndarray]
-    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """Receivers, transmitters, offsets [m], distances [m] and walls crossed (counted
-        by ``crossings`` for the pairs within line-of-sight range) of every ordered pair."""
         n = len(poses)
         rx, tx = np.nonzero(~np.eye(n, dtype=bool))
         delta = poses[tx, :2] - poses[rx, :2]
@@ -204,8 +180,8 @@ class BearingModel:
         walls = np.zeros(len(rx), dtype=int)
         if len(self._walls) and in_los_range.any():
             idx = np.flatnonzero(in_los_range)
-            walls[idx] = crossings(poses[rx[idx], :2], poses[tx[idx], :2])
-        return rx, tx, delta, dist, walls
+            walls[idx] = count_crossings(poses[rx[idx], :2], poses[tx[idx], :2], self._walls)
+        return self._cycle(poses, rx, tx, delta, dist, walls).reports()
 
     def _cycle(
         self,

@@ -17,7 +17,6 @@ still found at the end, while the spread makes a chain of puffs read as one trai
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -82,24 +81,9 @@ class ScentConfig:
 class ScentField:
     """All puffs deposited so far, and the concentration they produce."""
 
-    def __init__(
-        self,
-        config: ScentConfig,
-        walls: np.ndarray | None = None,
-        crossings: Callable[[np.ndarray, np.ndarray], np.ndarray] | None = None,
-    ) -> None:
-        """Start with no puffs.
-
-        Args:
-            config: the field's parameters.
-            walls: (M, 2, 2) wall centre lines [m].
-            crossings: counts the walls on (K, 2) start -> (K, 2) end paths, for a physics
-                backend whose walls are not these segments (pybullet's boxes); None tests
-                the segments with the compiled pair search.
-        """
+    def __init__(self, config: ScentConfig, walls: np.ndarray | None = None) -> None:
         self.config = config
         self._walls = as_segments(walls if walls is not None else np.zeros((0, 2, 2)))
-        self._crossings = crossings
         reach = config.cutoff_sigmas * config.final_spread_m
         self._cutoff2 = reach**2
         self._grid = WallGrid(self._walls, cell_m=0.5, reach_m=reach) if len(self._walls) else None
@@ -160,8 +144,6 @@ class ScentField:
         n = self._count
         if n == 0:
             return np.zeros(len(points))
-        if self._crossings is not None:
-            return self._concentration_numpy(points, time_s, self._crossings)
         q_idx, p_idx, d2 = open_puff_pairs(
             np.ascontiguousarray(points),
             self._xy[:n],
@@ -192,19 +174,9 @@ class ScentField:
     def concentration_reference(self, points: np.ndarray, time_s: float) -> np.ndarray:
         """:meth:`concentration` in numpy, the reference of the compiled pair search."""
         points = np.atleast_2d(np.asarray(points, dtype=float))
-        if self._count == 0:
-            return np.zeros(len(points))
-        return self._concentration_numpy(points, time_s, None)
-
-    def _concentration_numpy(
-        self,
-        points: np.ndarray,
-        time_s: float,
-        crossings: Callable[[np.ndarray, np.ndarray], np.ndarray] | None,
-    ) -> np.ndarray:
-        """The concentration at (K, 2) points of at least one puff, in numpy; the vapour
-        paths' walls are counted by ``crossings``, or on the wall grid when None."""
         n = self._count
+        if n == 0:
+            return np.zeros(len(points))
         cfg = self.config
         xy = self._xy[:n]
         dx = points[:, 0, None] - xy[:, 0]
@@ -219,11 +191,8 @@ class ScentField:
         if len(q_idx) == 0:
             return np.zeros(len(points))
         if cfg.walls_block and self._grid is not None:
-            if crossings is None:
-                near_walls = self._grid.candidates(points)[q_idx]
-                crossed = self._grid.count_crossings(points[q_idx], xy[p_idx], near_walls)
-            else:
-                crossed = crossings(points[q_idx], xy[p_idx])
+            near_walls = self._grid.candidates(points)[q_idx]
+            crossed = self._grid.count_crossings(points[q_idx], xy[p_idx], near_walls)
             open_path = crossed == 0
             q_idx, p_idx = q_idx[open_path], p_idx[open_path]
         value = self._puff_values(p_idx, d2[q_idx, p_idx], time_s)
