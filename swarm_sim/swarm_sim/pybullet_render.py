@@ -29,7 +29,11 @@ def robot_colours(count: int) -> list[tuple[float, float, float, float]]:
     from matplotlib import colormaps
 
     cmap = colormaps['tab10']
-    return [tuple(float(v) for v in cmap(i % 10)) for i in range(count)]
+    colours = []
+    for i in range(count):
+        red, green, blue, alpha = (float(v) for v in cmap(i % 10))
+        colours.append((red, green, blue, alpha))
+    return colours
 
 
 def site_view(walls: np.ndarray, aspect: float) -> tuple[list[float], float]:
