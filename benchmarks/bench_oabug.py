@@ -136,6 +136,7 @@ class Job:
     speed_mps: float
     path: str = 'batch'
     parameters: tuple[tuple[str, object], ...] = ()
+    physics: str = 'numpy'
 
 
 @dataclass(frozen=True)
@@ -167,6 +168,7 @@ def run_job(job: Job) -> Outcome:
     """Run one job headless (called in a worker process)."""
     from swarm_experiments.oabug_batch import run_spawn_batch
     from swarm_experiments.spawn import SpawnSettings, run
+    from swarm_sim.engine import EngineConfig
 
     config = SpawnSettings(
         site=job.config,
@@ -178,6 +180,7 @@ def run_job(job: Job) -> Outcome:
         actions=job.actions,
         speed_mps=job.speed_mps,
         robot_parameters=dict(job.parameters),
+        engine=EngineConfig(physics=job.physics),
     )
     start = time.perf_counter()
     start_cpu = time.process_time()
@@ -296,7 +299,8 @@ def format_footer(outcomes: Sequence[Outcome], total_s: float, args: argparse.Na
     if args.set:
         settings = f' OA-Bug parameters other than the defaults: {" ".join(args.set)}.'
     return (
-        f'{n} runs ({args.config}, {args.robots} robots, {args.sites} sites, {args.path} path) '
+        f'{n} runs ({args.config}, {args.robots} robots, {args.sites} sites, {args.path} path, '
+        f'{args.physics} physics) '
         f'in {total_s:.0f} s wall with {workers} workers: {cpu:.2f} CPU s per run, '
         f'{total_s / n:.2f} wall s per run overall, {metres / total_s:.0f} robot-m and '
         f'{sim_s / total_s:.1f} sim s per wall s. A {SWEEP_RUNS}-run sweep: '
@@ -319,6 +323,7 @@ def run(
     workers: int = 2,
     path: str = 'batch',
     parameters: dict[str, object] | None = None,
+    physics: str = 'numpy',
 ) -> tuple[list[Outcome], float]:
     """Run the sweep; return the outcomes and the total wall time [s].
 
@@ -326,7 +331,7 @@ def run(
     """
     settings = tuple(sorted((parameters or {}).items()))
     jobs = [
-        Job(config, seed, variant, departure, robots, actions, speed_mps, path, settings)
+        Job(config, seed, variant, departure, robots, actions, speed_mps, path, settings, physics)
         for seed in range(first_site_seed, first_site_seed + sites)
         for departure in departures
         for variant in variants
@@ -390,6 +395,12 @@ def main(argv: Sequence[str] | None = None) -> int:
         metavar='NAME=VALUE',
         help='OA-Bug node parameters other than the defaults (e.g. gas_threshold=300)',
     )
+    parser.add_argument(
+        '--physics',
+        choices=('numpy', 'pybullet'),
+        default='numpy',
+        help='physics and ray-casting backend of every mission (docs/simulation.md)',
+    )
     args = parser.parse_args(argv)
     from swarm_experiments.spawn import oabug_parameter_overrides
     from swarm_sim.errors import ConfigurationError
@@ -410,6 +421,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         workers=args.workers,
         path=args.path,
         parameters=parameters,
+        physics=args.physics,
     )
     table = format_table(outcomes, reference_for(args.config, args.robots, args.actions))
     footer = '\n' + format_footer(outcomes, total_s, args)

@@ -11,6 +11,9 @@ cd "$(dirname "$0")/.."
 PYTHON=${PYTHON:-python3}
 VENV=${VENV:-.venv}
 PACKAGES=(swarm_common src/swarm_runtime src/swarm_analysis oabug_robot bayes_swarm msc_pf hw_drivers swarm_sim sim_bridge swarm_experiments)
+# Optional extras of the development install: the simulator's pybullet physics backend (its
+# marker skips pybullet on Python >= 3.12, where it has no wheels; robot installs never get it).
+declare -A EXTRAS=([swarm_sim]=pybullet)
 # Debian packages: the real ROS message parser and package.xml tools used by the tests.
 APT_PACKAGES=(python3-rosidl python3-catkin-pkg python3-ament-xmllint)
 
@@ -44,7 +47,7 @@ install_python_packages() {
   log "installing Python packages (versions from constraints.txt)"
   "$VENV/bin/python" -m pip install -q --upgrade pip
   local editable=()
-  for pkg in "${PACKAGES[@]}"; do editable+=(-e "$pkg"); done
+  for pkg in "${PACKAGES[@]}"; do editable+=(-e "$pkg${EXTRAS[$pkg]:+[${EXTRAS[$pkg]}]}"); done
   "$VENV/bin/python" -m pip install -q -c constraints.txt -r requirements-dev.txt "${editable[@]}"
   echo "$digest" > "$stamp"
 }

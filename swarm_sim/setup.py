@@ -28,12 +28,18 @@ setup(
         'numpy',
         'scipy',
         'matplotlib',
-        'pybullet',
-        # The compiled ray casting, world and sensor kernels (simulation only, like pybullet).
+        # The compiled ray casting, world and sensor kernels (simulation only).
         'numba',
         'PyYAML',
         'swarm_common',
     ],
+    extras_require={
+        # The optional pybullet physics backend (swarm_sim.pybullet_physics), for simulation
+        # installs only: `pip install -e 'swarm_sim[pybullet]'`. pybullet has wheels only up to
+        # Python 3.11 (x86-64), so the marker skips it on newer interpreters; everything else
+        # imports and runs without it.
+        'pybullet': ['pybullet; python_version < "3.12"'],
+    },
     zip_safe=True,
     maintainer='Swarm search maintainers',
     maintainer_email='maintainers@swarm-search.org',

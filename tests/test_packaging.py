@@ -9,6 +9,7 @@ from __future__ import annotations
 import ast
 import configparser
 import importlib
+import re
 import xml.etree.ElementTree as ET
 from importlib.metadata import distribution
 from pathlib import Path
@@ -104,7 +105,33 @@ def test_third_party_versions_are_pinned_in_one_place() -> None:
     first_party = {path.name for path in AMENT_PYTHON_PACKAGES}
     for package_dir in AMENT_PYTHON_PACKAGES:
         call = _setup_call(package_dir)
-        requires = next(k.value for k in call.keywords if k.arg == 'install_requires')
-        names = {element.value.lower() for element in requires.elts}
+        names = {_requirement_name(value) for value in _requirements(call)}
         unpinned = names - pinned - first_party
         assert not unpinned, f'{package_dir.name} requires {unpinned} without a pin'
+
+
+def _requirements(call: ast.Call) -> list[str]:
+    """The requirement strings of install_requires and of every extra."""
+    keywords = {k.arg: k.value for k in call.keywords}
+    values = [element.value for element in keywords['install_requires'].elts]
+    extras = keywords.get('extras_require')
+    if extras is not None:
+        for group in extras.values:
+            values.extend(element.value for element in group.elts)
+    return values
+
+
+def _requirement_name(requirement: str) -> str:
+    """The project name of a requirement string ('pybullet; python_version < "3.12"')."""
+    return re.split(r'[\s;<>=!~\[]', requirement, maxsplit=1)[0].lower()
+
+
+def test_pybullet_is_an_extra_of_the_simulator_only() -> None:
+    for package_dir in AMENT_PYTHON_PACKAGES:
+        call = _setup_call(package_dir)
+        keywords = {k.arg: k.value for k in call.keywords}
+        required = {_requirement_name(e.value) for e in keywords['install_requires'].elts}
+        assert 'pybullet' not in required, package_dir.name
+    extras = {k.arg: k.value for k in _setup_call(REPO / 'swarm_sim').keywords}['extras_require']
+    groups = dict(zip((key.value for key in extras.keys), extras.values, strict=True))
+    assert [e.value for e in groups['pybullet'].elts] == ['pybullet; python_version < "3.12"']

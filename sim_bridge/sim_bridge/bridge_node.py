@@ -26,7 +26,7 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
-from swarm_common.cli import fail
+from swarm_common.cli import EXIT_SUCCESS, EXIT_USAGE, fail
 from swarm_runtime.parameters import ParameterFileError, check_parameter_arguments, declare_config
 from swarm_runtime.ros import (
     ExternalShutdownException,
@@ -142,7 +142,8 @@ class SimBridgeNode(Node):
         self.get_logger().info(
             f'simulating {n} robots in {geometry.name!r} '
             f'({len(self.engine.world.walls)} walls, {self.engine.coverage.rooms_total} rooms), '
-            f'physics {self.config.physics_rate_hz:g} Hz, seed {self.config.seed}'
+            f'{self.config.physics} physics at {self.config.physics_rate_hz:g} Hz, '
+            f'seed {self.config.seed}'
         )
 
     def _retime(self, settings: BridgeNodeConfig) -> None:
@@ -325,6 +326,13 @@ class SimBridgeNode(Node):
             )
         )
 
+    def destroy_node(self) -> None:
+        """Release the engine's physics backend, then destroy the node."""
+        engine = getattr(self, 'engine', None)
+        if engine is not None:
+            engine.close()
+        super().destroy_node()
+
     def pause(self) -> None:
         """Stop stepping the world (the physics timer is cancelled); messages already
         published are still delivered."""
@@ -348,6 +356,7 @@ def main(args: list[str] | None = None) -> None:
         raise SystemExit(fail(NODE_NAME, err)) from None
     rclpy.init(args=args)
     node = None
+    code = EXIT_SUCCESS
     try:
         node = SimBridgeNode()
         rclpy.spin(node)
@@ -355,13 +364,17 @@ def main(args: list[str] | None = None) -> None:
         pass
     except SimulationError as err:
         if node is None:
+            # The world could not be built (a bad parameter, pybullet missing): exit 2.
             rclpy.logging.get_logger('sim_bridge').error(str(err))
+            code = EXIT_USAGE
         else:
             node.get_logger().error(str(err))
     finally:
         if node is not None:
             node.destroy_node()
         rclpy.try_shutdown()
+    if code != EXIT_SUCCESS:
+        raise SystemExit(code)
 
 
 if __name__ == '__main__':

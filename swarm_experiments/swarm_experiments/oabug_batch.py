@@ -365,6 +365,8 @@ def run_oabug_batch(
                 break
         _deliver(engine, out, robots, own_tags)
 
+    # Release the physics backend (a pybullet client; a recorded run's animation is written).
+    engine.close()
     final = snapshot()
     if progress is not None:
         progress(final)

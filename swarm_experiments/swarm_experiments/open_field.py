@@ -9,6 +9,7 @@ The mission's own sensing comes from its extension (signal, RSSI).
 from __future__ import annotations
 
 from swarm_sim.engine import EngineConfig
+from swarm_sim.physics import PybulletConfig
 from swarm_sim.sensors.odometry import OdometryConfig
 from swarm_sim.world import BodyConfig
 
@@ -23,14 +24,19 @@ def point_robot_engine_config(
     seed: int,
     max_linear_speed_mps: float,
     max_angular_speed_radps: float = 2.0,
+    physics: str = 'numpy',
 ) -> EngineConfig:
     """Engine configuration of point robots that sense only their odometry.
+
+    With the pybullet physics the robots do not collide with each other either (their
+    cylinders pass through each other).
 
     Args:
         physics_rate_hz: physics and odometry rate [Hz].
         seed: seed of the world.
         max_linear_speed_mps: forward speed limit [m/s].
         max_angular_speed_radps: yaw rate limit [rad/s].
+        physics: the physics backend (:data:`swarm_sim.physics.PHYSICS_BACKENDS`).
     """
     return EngineConfig(
         physics_rate_hz=physics_rate_hz,
@@ -42,4 +48,6 @@ def point_robot_engine_config(
             max_angular_speed_radps=max_angular_speed_radps,
         ),
         odometry=OdometryConfig(rate_hz=physics_rate_hz),
+        physics=physics,
+        pybullet=PybulletConfig(robot_contacts=False),
     )

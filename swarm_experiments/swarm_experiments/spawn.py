@@ -29,8 +29,10 @@ from swarm_common.errors import SwarmError
 from swarm_sim.departure import place_starts
 from swarm_sim.engine import EngineConfig
 from swarm_sim.errors import ConfigurationError
+from swarm_sim.physics import require_backend
 from swarm_sim.site_loading import load_site, site_budget_actions
 
+from swarm_experiments.cli_args import add_physics_option, add_render_option, render_config
 from swarm_experiments.errors import ExperimentError
 from swarm_experiments.mission import (
     VIEWER_TOPICS,
@@ -345,6 +347,8 @@ def _parser() -> argparse.ArgumentParser:
         help='set an OA-Bug node parameter for every robot (repeatable), e.g. '
         'gas_threshold=300 or sound_turn_rule=toward; names and defaults: docs/oabug.md',
     )
+    add_physics_option(parser)
+    add_render_option(parser)
     return parser
 
 
@@ -352,6 +356,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Command line entry point; returns the process exit code."""
     args = _parser().parse_args(argv)
     try:
+        require_backend(args.physics)
         config = SpawnSettings(
             robot_parameters=oabug_parameter_overrides(args.param),
             site=args.site,
@@ -365,6 +370,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             record=args.record,
             record_scans=args.record_scans,
             out_dir=None if args.no_plots else args.out,
+            engine=EngineConfig(physics=args.physics, render=render_config(args.render)),
         )
         site_warnings = load_site(config.site, seed=config.site_seed).warnings
     except SwarmError as err:
@@ -397,6 +403,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f'wrote {path}')
     if result.mission.bag_path is not None:
         print(f'recorded {result.mission.bag_path}')
+    frames = config.engine.render.frames_dir
+    if config.engine.render.mode == 'frames' and frames is not None:
+        print(f'wrote the frames to {frames} and {frames / "run.gif"}')
     return EXIT_SUCCESS
 
 

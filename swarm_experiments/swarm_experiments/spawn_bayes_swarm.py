@@ -31,13 +31,13 @@ from sim_bridge.signal_extension import SignalExtension
 from swarm_common.cli import EXIT_SUCCESS, fail
 from swarm_common.errors import SwarmError
 from swarm_sim.engine import EngineConfig, SiteGeometry
-from swarm_sim.errors import ConfigurationError
+from swarm_sim.physics import require_backend
 from swarm_sim.signal_fields import CASE_NAMES, SignalCase, UnknownCaseError, get_case
 from swarm_sim.signal_mission import SignalMissionModel
 
 from swarm_experiments.bayes_batch import MissionSpec as BatchMissionSpec
 from swarm_experiments.bayes_batch import depot_fan
-from swarm_experiments.cli_args import points_argument
+from swarm_experiments.cli_args import add_physics_option, points_argument
 from swarm_experiments.errors import ExperimentError
 from swarm_experiments.mission import (
     VIEWER_TOPICS,
@@ -101,6 +101,7 @@ class SpawnSettings:
         record: bag directory to write, or None.
         out_dir: where the PNGs go (None: no plots).
         extra_parameters: further node parameters (name -> value).
+        physics: the engine's physics backend ('numpy' or 'pybullet').
     """
 
     algorithm: str = 'bayes_swarm_p'
@@ -117,6 +118,7 @@ class SpawnSettings:
     record: Path | None = None
     out_dir: Path | None = None
     extra_parameters: dict[str, Any] = field(default_factory=dict)
+    physics: str = 'numpy'
 
 
 @dataclass
@@ -185,9 +187,12 @@ def _arena_site(case: SignalCase) -> SiteGeometry:
     )
 
 
-def _engine_config(case: SignalCase, seed: int) -> EngineConfig:
+def _engine_config(case: SignalCase, seed: int, physics: str = 'numpy') -> EngineConfig:
     return point_robot_engine_config(
-        physics_rate_hz=20.0, seed=seed, max_linear_speed_mps=1.05 * case.velocity_mps
+        physics_rate_hz=20.0,
+        seed=seed,
+        max_linear_speed_mps=1.05 * case.velocity_mps,
+        physics=physics,
     )
 
 
@@ -338,7 +343,7 @@ def run(settings: SpawnSettings, progress: Any = None) -> BayesSwarmRun:
         initial_poses=poses,
         robots=[RobotNodeSpec(factory, node_parameters(case, settings, n, i)) for i in range(n)],
         max_sim_time_s=case.max_mission_time_s + 2.0,
-        engine_config=_engine_config(case, settings.seed),
+        engine_config=_engine_config(case, settings.seed, settings.physics),
         bridge_parameters=bridge_parameters,
         extensions=[SignalExtension(model)],
         stop_when_all_rooms_covered=False,
@@ -451,6 +456,7 @@ def build_parser() -> argparse.ArgumentParser:
         help='set a bayes_swarm node parameter for every robot (repeatable), e.g. '
         'horizon_s=20; names and defaults: ros2 param describe, or bayes_swarm.node_settings',
     )
+    add_physics_option(parser)
     return parser
 
 
@@ -458,8 +464,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``spawn_bayes_swarm``; returns the exit status."""
     args = build_parser().parse_args(argv)
     try:
+        require_backend(args.physics)
         extra = node_parameter_overrides(args.param)
-    except ConfigurationError as err:
+    except SwarmError as err:
         return fail('spawn_bayes_swarm', err)
     settings = SpawnSettings(
         extra_parameters=extra,
@@ -476,6 +483,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         outer_optimizer=args.outer_optimizer,
         record=args.record,
         out_dir=None if args.no_plots else args.out,
+        physics=args.physics,
     )
 
     def progress(report: Any) -> None:

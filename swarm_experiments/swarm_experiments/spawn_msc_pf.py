@@ -32,10 +32,10 @@ from sim_bridge.rssi_extension import RssiExtension
 from swarm_common.cli import EXIT_SUCCESS, EXIT_UNFINISHED, fail
 from swarm_common.errors import SwarmError
 from swarm_sim.engine import EngineConfig, SiteGeometry
-from swarm_sim.errors import ConfigurationError
+from swarm_sim.physics import require_backend
 from swarm_sim.rssi_targets import RssiTargetConfig, RssiTargetField, place_robots
 
-from swarm_experiments.cli_args import points_argument
+from swarm_experiments.cli_args import add_physics_option, points_argument
 from swarm_experiments.errors import ExperimentError
 from swarm_experiments.mission import (
     VIEWER_TOPICS,
@@ -84,6 +84,7 @@ class SpawnSettings:
         record: bag directory to write, or None.
         out_dir: where the PNGs go (None: no plots).
         extra_parameters: further msc_pf node parameters (name -> value).
+        physics: the engine's physics backend ('numpy' or 'pybullet').
     """
 
     scheme: str = 'proposed'
@@ -100,6 +101,7 @@ class SpawnSettings:
     record: Path | None = None
     out_dir: Path | None = None
     extra_parameters: dict[str, Any] = field(default_factory=dict)
+    physics: str = 'numpy'
 
 
 @dataclass
@@ -146,7 +148,10 @@ def _check(settings: SpawnSettings) -> None:
 
 def _engine_config(settings: SpawnSettings) -> EngineConfig:
     return point_robot_engine_config(
-        physics_rate_hz=settings.physics_rate_hz, seed=settings.seed, max_linear_speed_mps=1.05
+        physics_rate_hz=settings.physics_rate_hz,
+        seed=settings.seed,
+        max_linear_speed_mps=1.05,
+        physics=settings.physics,
     )
 
 
@@ -354,6 +359,7 @@ def build_parser() -> argparse.ArgumentParser:
         help='set an msc_pf controller parameter for every robot (repeatable), e.g. '
         'msc.leader_rule=pbest; names and defaults: msc_pf/config/msc_pf.yaml',
     )
+    add_physics_option(parser)
     return parser
 
 
@@ -362,8 +368,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     targets = args.targets if args.target_positions is None else len(args.target_positions)
     try:
+        require_backend(args.physics)
         extra = controller_parameter_overrides(args.param)
-    except ConfigurationError as err:
+    except SwarmError as err:
         return fail('spawn_msc_pf', err)
     settings = SpawnSettings(
         extra_parameters=extra,
@@ -377,6 +384,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         target_positions_m=args.target_positions,
         record=args.record,
         out_dir=None if args.no_plots else args.out,
+        physics=args.physics,
     )
 
     def report(p: MissionProgress) -> None:

@@ -23,15 +23,22 @@ from swarm_common.angles import wrap_angle
 from swarm_common.params import parameter, section
 
 from swarm_sim.errors import ConfigurationError, WorldGeometryError
-from swarm_sim.geometry import RayCaster
 from swarm_sim.ground_truth import CoverageTracker, RoomEntry
+from swarm_sim.physics import (
+    PHYSICS_BACKENDS,
+    PhysicsBackend,
+    PhysicsSetup,
+    PybulletConfig,
+    RenderConfig,
+    make_physics,
+)
 from swarm_sim.sensors.bearings import BearingConfig, BearingCycle, BearingModel, PeerBearings
 from swarm_sim.sensors.gas_sensor import GasSensorConfig, Mp503Model
 from swarm_sim.sensors.imu import GyroYawModel, ImuConfig
 from swarm_sim.sensors.lidar import LidarConfig, LidarModel
 from swarm_sim.sensors.odometry import OdometryConfig, WheelOdometry
 from swarm_sim.sensors.scent import PumpDepositor, ScentConfig, ScentField
-from swarm_sim.world import BodyConfig, World
+from swarm_sim.world import BodyConfig
 
 __all__ = ['SENSORS', 'EngineConfig', 'SimEngine', 'SiteGeometry', 'StepOutput']
 
@@ -74,6 +81,11 @@ class EngineConfig:
             Each model draws from its own random stream, so leaving one out changes none of
             the others; a sensor left out is not built and costs nothing. Without ``gas``
             there is no scent field either (pumps then lay nothing).
+        physics: the physics and ray-casting backend, a name of
+            :data:`swarm_sim.physics.PHYSICS_BACKENDS`: 'numpy' (kinematic discs, exact 2D
+            rays; fast) or 'pybullet' (rigid bodies with pybullet's contacts and ray tests).
+        pybullet: settings of the pybullet backend (ignored by 'numpy').
+        render: showing the run (pybullet only: a window or camera frames).
     """
 
     physics_rate_hz: float = parameter(
@@ -92,6 +104,12 @@ class EngineConfig:
     seed: int = parameter(
         0, 'Seed of every random draw in the world; equal seeds give equal runs.', ge=0
     )
+    physics: str = parameter(
+        'numpy',
+        'Physics and ray-casting backend: numpy (kinematic discs, exact 2D rays; fast) or '
+        'pybullet (rigid bodies, pybullet contacts and rayTestBatch; needs pybullet).',
+        choices=tuple(PHYSICS_BACKENDS),
+    )
     sensors: frozenset[str] = SENSORS
     body: BodyConfig = section(BodyConfig, prefix='')
     lidar: LidarConfig = section(LidarConfig, prefix='scan_')
@@ -100,6 +118,8 @@ class EngineConfig:
     bearings: BearingConfig = section(BearingConfig, prefix='bearing_')
     imu: ImuConfig = section(ImuConfig, prefix='imu_')
     odometry: OdometryConfig = section(OdometryConfig, prefix='odom_')
+    pybullet: PybulletConfig = field(default_factory=PybulletConfig)
+    render: RenderConfig = field(default_factory=RenderConfig)
 
     def __post_init__(self) -> None:
         for name in ('physics_rate_hz', 'cmd_vel_timeout_s', 'pump_timeout_s'):
@@ -117,6 +137,15 @@ class EngineConfig:
             msg = f'unknown sensors {sorted(unknown)}; choose from {sorted(SENSORS)}'
             raise ConfigurationError(msg)
         object.__setattr__(self, 'sensors', frozenset(self.sensors))
+        if self.physics not in PHYSICS_BACKENDS:
+            msg = (
+                f'unknown physics backend {self.physics!r}; choose from '
+                f'{", ".join(PHYSICS_BACKENDS)}'
+            )
+            raise ConfigurationError(msg)
+        if self.render.mode != 'none' and self.physics != 'pybullet':
+            msg = f'rendering ({self.render.mode}) needs the pybullet physics, not {self.physics!r}'
+            raise ConfigurationError(msg)
 
     @property
     def physics_period_s(self) -> float:
@@ -179,7 +208,12 @@ class _Schedule:
 
 
 class SimEngine:
-    """N robots in a site, with every shared sensor and actuator."""
+    """N robots in a site, with every shared sensor and actuator.
+
+    ``world`` is the physics backend the configuration names (:mod:`swarm_sim.physics`):
+    it moves the robots and casts the rays. :meth:`close` releases it (a pybullet client,
+    and writes the animation of a recorded run); the engine is also a context manager.
+    """
 
     def __init__(
         self,
@@ -203,7 +237,18 @@ class SimEngine:
         self.config = config or EngineConfig()
         cfg = self.config
         self.site = site
-        self.world = World(site.walls, initial_poses, cfg.body)
+        self.world: PhysicsBackend = make_physics(
+            cfg.physics,
+            PhysicsSetup(
+                walls=site.walls,
+                initial_poses=initial_poses,
+                body=cfg.body,
+                physics_period_s=cfg.physics_period_s,
+                scan_bins=cfg.lidar.num_bins if 'scan' in cfg.sensors else None,
+                pybullet=cfg.pybullet,
+                render=cfg.render,
+            ),
+        )
         n = self.world.num_robots
         streams = np.random.SeedSequence(cfg.seed).spawn(5)
         rngs = [np.random.default_rng(s) for s in streams]
@@ -218,13 +263,7 @@ class SimEngine:
         self.imu: GyroYawModel | None = None
         self.odometry: WheelOdometry | None = None
         if 'scan' in self.sensors:
-            caster = RayCaster(
-                self.world.walls,
-                wall_thickness_m=cfg.body.wall_thickness_m,
-                robot_radius_m=cfg.body.robot_radius_m,
-                num_bins=cfg.lidar.num_bins,
-            )
-            self.lidar = LidarModel(caster, cfg.lidar, rngs[0])
+            self.lidar = LidarModel(self.world, cfg.lidar, rngs[0])
         if 'gas' in self.sensors:
             self.scent = ScentField(cfg.scent, self.world.walls)
             self._depositor = PumpDepositor(self.scent, n)
@@ -260,6 +299,16 @@ class SimEngine:
     def num_robots(self) -> int:
         """Number of robots N."""
         return self.world.num_robots
+
+    def close(self) -> None:
+        """Release the physics backend (idempotent)."""
+        self.world.close()
+
+    def __enter__(self) -> SimEngine:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
 
     @property
     def step_index(self) -> int:

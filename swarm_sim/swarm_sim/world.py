@@ -6,9 +6,10 @@ way a real base pressing against an obstacle behaves: a robot whose move would b
 into a wall or another robot keeps its rotation but does not translate. Robots are updated in
 bridge order (r0 first), so later robots see the already-moved earlier ones.
 
-Geometry queries (lidar rays, wall crossings) go through :mod:`swarm_sim.geometry`; a pybullet
-scene of the same walls and bodies is available for cross-checks and as an alternative ray
-backend (:mod:`swarm_sim.pybullet_scene`).
+This is the physics of the engine's default ``numpy`` backend (:mod:`swarm_sim.physics`);
+its geometry queries (lidar rays, wall crossings) go through :mod:`swarm_sim.geometry`. The
+``pybullet`` backend (:mod:`swarm_sim.pybullet_physics`) replaces both with pybullet's rigid
+bodies, contacts and ray tests.
 """
 
 from __future__ import annotations
@@ -24,7 +25,7 @@ from swarm_sim.errors import ConfigurationError, WorldGeometryError
 from swarm_sim.geometry import WallGrid, as_segments
 from swarm_sim.world_kernel import world_step_kernel
 
-__all__ = ['BodyConfig', 'World']
+__all__ = ['BodyConfig', 'World', 'checked_poses']
 
 
 @dataclass(frozen=True)
@@ -54,6 +55,22 @@ class BodyConfig:
             raise ConfigurationError(msg)
 
 
+def checked_poses(initial_poses: object) -> np.ndarray:
+    """(N, 3) float copy of start poses x [m], y [m], yaw [rad], yaw wrapped to (-pi, pi].
+
+    Raises:
+        WorldGeometryError: not of shape (N, 3) with N >= 1, or NaN / inf values.
+    """
+    poses = np.array(initial_poses, dtype=float)
+    if poses.ndim != 2 or poses.shape[1] != 3 or len(poses) == 0:
+        msg = f'initial_poses must have shape (N, 3) with N >= 1, got {poses.shape}'
+        raise WorldGeometryError(msg)
+    if not np.all(np.isfinite(poses)):
+        raise WorldGeometryError('initial_poses contain NaN or inf')
+    poses[:, 2] = wrap_angle(poses[:, 2])
+    return poses
+
+
 class World:
     """Walls plus N disc robots; owns the true state of every robot."""
 
@@ -69,13 +86,7 @@ class World:
         """
         self.body = body or BodyConfig()
         self.walls = as_segments(walls)
-        poses = np.array(initial_poses, dtype=float)
-        if poses.ndim != 2 or poses.shape[1] != 3 or len(poses) == 0:
-            msg = f'initial_poses must have shape (N, 3) with N >= 1, got {poses.shape}'
-            raise WorldGeometryError(msg)
-        if not np.all(np.isfinite(poses)):
-            raise WorldGeometryError('initial_poses contain NaN or inf')
-        poses[:, 2] = wrap_angle(poses[:, 2])
+        poses = checked_poses(initial_poses)
         self._poses = poses
         self._velocities = np.zeros((len(poses), 2))
         self._wall_clearance_m = self.body.robot_radius_m + 0.5 * self.body.wall_thickness_m

@@ -11,15 +11,26 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Protocol
 
 import numpy as np
 from swarm_common.params import parameter
 
 from swarm_sim.errors import ConfigurationError
-from swarm_sim.geometry import RayCaster
 from swarm_sim.raycast_kernel import lidar_noise_kernel
 
-__all__ = ['LidarConfig', 'LidarModel']
+__all__ = ['LidarConfig', 'LidarModel', 'RangeCaster']
+
+
+class RangeCaster(Protocol):
+    """Exact ranges of every bin from every robot: :class:`swarm_sim.geometry.RayCaster`,
+    or a physics backend (:class:`swarm_sim.physics.PhysicsBackend`)."""
+
+    num_bins: int
+
+    def scan(self, poses: np.ndarray, max_range_m: float) -> np.ndarray:
+        """(N, num_bins) ranges [m] from (N, 3) poses; ``inf`` beyond ``max_range_m``."""
+        ...
 
 
 @dataclass(frozen=True)
@@ -75,7 +86,7 @@ class LidarConfig:
 class LidarModel:
     """Noisy 360-degree scans of every robot from exact ray-cast ranges."""
 
-    def __init__(self, caster: RayCaster, config: LidarConfig, rng: np.random.Generator) -> None:
+    def __init__(self, caster: RangeCaster, config: LidarConfig, rng: np.random.Generator) -> None:
         if caster.num_bins != config.num_bins:
             msg = f'caster has {caster.num_bins} bins, config {config.num_bins}'
             raise ConfigurationError(msg)
