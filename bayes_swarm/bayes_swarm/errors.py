@@ -5,6 +5,8 @@ Library code raises these; nodes and scripts catch them and log or print the mes
 
 from __future__ import annotations
 
+from swarm_common.errors import SwarmError
+
 __all__ = [
     'BayesSwarmError',
     'ConfigError',
@@ -14,7 +16,7 @@ __all__ = [
 ]
 
 
-class BayesSwarmError(Exception):
+class BayesSwarmError(SwarmError):
     """Base class of every error raised by this package."""
 
 

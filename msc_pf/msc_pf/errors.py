@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+from swarm_common.errors import SwarmError
+
 __all__ = ['ConfigError', 'MscPfError', 'ObservationError']
 
 
-class MscPfError(Exception):
+class MscPfError(SwarmError):
     """Base class of every error the msc_pf package raises."""
 
 

@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+from swarm_common.errors import SwarmError
+
 __all__ = ['ConfigError', 'OABugError', 'ScanError']
 
 
-class OABugError(Exception):
+class OABugError(SwarmError):
     """Base class of every error the oabug_robot package raises."""
 
 

@@ -2,14 +2,19 @@
 
 Plain script, no launch file (``ros2 run swarm_experiments spawn`` or ``python -m
 swarm_experiments.spawn``). It builds the site, starts the sim bridge and one OA-Bug node
-per robot on sim time, shows progress, prints the summary (coverage, rooms covered/total,
-time, rooms first visited per robot) and writes two PNGs: the paper's Fig. 6 view (paths per
-robot, rooms coloured by first visitor) and coverage over time. With ``--record`` it also
-writes a rosbag2 (MCAP) bag from which ``python -m swarm_analysis.oabug_report`` reproduces
-the same summary and figures.
+per robot on sim time, shows a progress bar (on a terminal), prints the summary (coverage,
+rooms covered/total, time, rooms first visited per robot) and writes two PNGs: the paper's
+Fig. 6 view (paths per robot, rooms coloured by first visitor) and coverage over time. With
+``--record`` it also writes a rosbag2 (MCAP) bag from which ``swarm_report`` reproduces the
+same summary and figures.
 
 The budget follows the paper: max actions per robot (Table II: Small 1000, Medium 2000, Big
 4000), one action being a 0.1 m step, so mission time = actions x 0.1 m / robot speed.
+
+Everything is checked before the mission starts: the options, the site, that the robots fit
+around the departure point, that ``--record`` is a new bag and ``--out`` can be written.
+Exit codes: 0 every room covered, 1 the budget ended first, 2 bad options or input, 130
+Ctrl-C (the summary so far is printed and the bag closed).
 """
 
 # ruff: noqa: T201  (main() is a command-line entry point that prints its report)
@@ -22,15 +27,23 @@ import sys
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
-from swarm_common.cli import EXIT_SUCCESS, fail
-from swarm_common.errors import SwarmError
-from swarm_sim.departure import departure_poses
+from swarm_common.cli import (
+    EXIT_INTERRUPTED,
+    EXIT_SUCCESS,
+    EXIT_UNFINISHED,
+    ToolParser,
+    fail,
+    run_tool,
+)
+from swarm_sim.departure import departure_poses, fan_fits, max_fan_robots
 from swarm_sim.engine import EngineConfig
 from swarm_sim.errors import ConfigurationError
 from swarm_sim.site_loading import load_site, site_budget_actions
 
+from swarm_experiments.cli_args import SPAWNER_EXIT_CODES, add_run_options, check_run_outputs
 from swarm_experiments.errors import ExperimentError
 from swarm_experiments.mission import (
     MissionProgress,
@@ -38,9 +51,11 @@ from swarm_experiments.mission import (
     MissionSpec,
     RecordingSpec,
     RobotNodeSpec,
+    StopReason,
     run_mission,
 )
 from swarm_experiments.node_overrides import parse_overrides
+from swarm_experiments.progress import MissionProgressBar, progress_wanted
 
 __all__ = [
     'ACTION_LENGTH_M',
@@ -121,7 +136,8 @@ class SpawnSettings:
             msg = f'speed_mps must be positive, got {self.speed_mps}'
             raise ConfigurationError(msg)
         if self.seed < 0 or self.site_seed < 0:
-            raise ConfigurationError('seeds must be >= 0')
+            msg = f'seeds must be >= 0, got seed {self.seed}, site seed {self.site_seed}'
+            raise ConfigurationError(msg)
 
     @property
     def budget_actions(self) -> int:
@@ -197,8 +213,37 @@ def _oabug_factory() -> Callable[..., object]:
     return OABugNode
 
 
+def _check_robots_fit(
+    config: SpawnSettings, site: Any, point: Any, fan: str, bias: float, poses: np.ndarray
+) -> None:
+    """Raise ConfigurationError unless the fan of ``config.robots`` fits (see
+    :func:`swarm_sim.departure.fan_fits`), naming the most that do."""
+    body = config.engine.body
+    clearance = body.robot_radius_m + 0.5 * body.wall_thickness_m
+    walls = np.asarray(site.sealed_walls)
+    bounds = (site.width_m, site.height_m)
+    kwargs = {'robot_radius_m': body.robot_radius_m, 'wall_clearance_m': clearance}
+    if fan_fits(poses, walls, bounds, **kwargs):
+        return
+    most = max_fan_robots(point.xy, fan, bias, walls, bounds, **kwargs)
+    msg = (
+        f'{config.robots} robots do not fit around departure point {config.departure!r} of '
+        f'site {site.name!r}: at most {most} do (they start on a '
+        f'{"half " if fan == "edge" else ""}circle of radius '
+        f'{math.dist(point.xy, poses[0, :2]):.2f} m around it, each {clearance:.3f} m clear of '
+        f'the walls, no centre inside another robot)'
+    )
+    raise ConfigurationError(msg)
+
+
 def build_mission(config: SpawnSettings) -> tuple[MissionSpec, float]:
-    """The mission spec of ``config`` and the heading bias it uses."""
+    """The mission spec of ``config`` and the heading bias it uses.
+
+    Raises:
+        ConfigurationError: an unknown site or departure point, or more robots than fit
+            around the departure point (the message gives the most that fit).
+        swarm_sim.sites.SiteError: the site file or layout is invalid.
+    """
     site = load_site(config.site, seed=config.site_seed)
     try:
         point = site.departure(config.departure)
@@ -207,6 +252,7 @@ def build_mission(config: SpawnSettings) -> tuple[MissionSpec, float]:
     fan = 'edge' if point.heading_rad is not None else 'center'
     bias = heading_bias_rad(fan, point.heading_rad, config.seed)
     poses = departure_poses(point.xy, fan, config.robots, bias)
+    _check_robots_fit(config, site, point, fan, bias, poses)
     factory = _oabug_factory()
     robots = []
     for i in range(config.robots):
@@ -237,6 +283,7 @@ def build_mission(config: SpawnSettings) -> tuple[MissionSpec, float]:
         max_sim_time_s=config.budget_s,
         engine_config=engine,
         recording=recording,
+        progress_period_s=min(10.0, max(1.0, config.budget_s / 100.0)),
     )
     return spec, bias
 
@@ -252,6 +299,9 @@ def write_plots(result: MissionResult, out_dir: Path, stem: str) -> tuple[Path, 
         f'{stem}: {100.0 * result.coverage:.1f} % '
         f'({result.rooms_covered}/{result.rooms_total} rooms) in {result.sim_time_s:.0f} s'
     )
+    if result.stop_reason == StopReason.INTERRUPTED:
+        title += ' (interrupted)'
+
     paths = plot_site_paths(
         out_dir / f'{stem}_paths.png',
         walls=np.asarray(site.sealed_walls),
@@ -299,20 +349,28 @@ def run(
     """
     spec, bias = build_mission(config)
     mission = runner(spec, progress=progress)
-    plots: tuple[Path, ...] = ()
+    result = OABugRun(settings=config, mission=mission, heading_bias_rad=bias)
     if config.out_dir is not None:
-        stem = f'oabug_{config.variant}_{config.departure}_{mission.site.name}_seed{config.seed}'
-        plots = write_plots(mission, Path(config.out_dir), stem)
-    return OABugRun(settings=config, mission=mission, heading_bias_rad=bias, plots=plots)
+        result = dataclasses.replace(result, plots=write_run_plots(result, Path(config.out_dir)))
+    return result
+
+
+def write_run_plots(result: OABugRun, out_dir: Path) -> tuple[Path, ...]:
+    """Write the PNGs of a run into ``out_dir`` (see :func:`write_plots`)."""
+    config = result.settings
+    mission = result.mission
+    stem = f'oabug_{config.variant}_{config.departure}_{mission.site.name}_seed{config.seed}'
+    return write_plots(mission, out_dir, stem)
 
 
 def _parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = ToolParser(
         prog='spawn',
         description=(
-            'Run an OA-Bug swarm search in the pybullet simulation until every room is covered '
+            'Run an OA-Bug swarm search in the simulation until every room is covered '
             'or the action budget ends; print the coverage summary and write the plots.'
         ),
+        epilog=SPAWNER_EXIT_CODES,
         formatter_class=argparse.ArgumentDefaultsHelpFormatter,
     )
     parser.add_argument(
@@ -336,12 +394,7 @@ def _parser() -> argparse.ArgumentParser:
         help='max actions (0.1 m steps) per robot; default: the preset budget (Small 1000)',
     )
     parser.add_argument('--speed', type=float, default=0.3, help='robot cruise speed [m/s]')
-    parser.add_argument('--record', type=Path, default=None, help='write a rosbag2 bag here')
-    parser.add_argument(
-        '--out', type=Path, default=Path('oabug_results'), help='directory for the PNGs'
-    )
-    parser.add_argument('--no-plots', action='store_true', help='do not write PNGs')
-    parser.add_argument('--quiet', action='store_true', help='no progress lines')
+    add_run_options(parser, out_default=Path('oabug_results'), plots='the PNGs')
     parser.add_argument(
         '--param',
         action='append',
@@ -354,34 +407,29 @@ def _parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Command line entry point; returns the process exit code."""
+    """Command line entry point; returns the process exit code (module docstring)."""
+    return run_tool('spawn', _main, argv)
+
+
+def _main(argv: list[str]) -> int:
     args = _parser().parse_args(argv)
-    try:
-        config = SpawnSettings(
-            robot_parameters=oabug_parameter_overrides(args.param),
-            site=args.site,
-            site_seed=args.site_seed,
-            variant=args.variant,
-            robots=args.robots,
-            departure=args.departure,
-            seed=args.seed,
-            actions=args.actions,
-            speed_mps=args.speed,
-            record=args.record,
-            out_dir=None if args.no_plots else args.out,
-        )
-    except SwarmError as err:
-        return fail('spawn', err)
-
-    def show(p: MissionProgress) -> None:
-        print(
-            f'  t = {p.sim_time_s:6.1f} s  coverage {100.0 * p.coverage:5.1f} % '
-            f'({p.rooms_covered}/{p.rooms_total})  wall {p.wall_time_s:5.1f} s',
-            flush=True,
-        )
-
+    config = SpawnSettings(
+        robot_parameters=oabug_parameter_overrides(args.param),
+        site=args.site,
+        site_seed=args.site_seed,
+        variant=args.variant,
+        robots=args.robots,
+        departure=args.departure,
+        seed=args.seed,
+        actions=args.actions,
+        speed_mps=args.speed,
+        record=args.record,
+        out_dir=None if args.no_plots else args.out,
+    )
+    check_run_outputs(config.record, config.out_dir)
+    spec, bias = build_mission(config)
     print(
-        f'OA-Bug {config.variant}: {config.robots} robots, site {config.site}, '
+        f'OA-Bug {config.variant}: {config.robots} robots, site {spec.site.name}, '
         f'{config.departure} departure, budget {config.budget_actions} actions '
         f'= {config.budget_s:.0f} s at {config.speed_mps} m/s',
         flush=True,
@@ -389,16 +437,26 @@ def main(argv: Sequence[str] | None = None) -> int:
     if config.robot_parameters:
         settings = ', '.join(f'{k}={v}' for k, v in sorted(config.robot_parameters.items()))
         print(f'OA-Bug parameters other than the defaults: {settings}', flush=True)
-    try:
-        result = run(config, progress=None if args.quiet else show)
-    except SwarmError as err:
-        return fail('spawn', err)
-    print(format_summary(result))
-    for path in result.plots:
-        print(f'wrote {path}')
-    if result.mission.bag_path is not None:
-        print(f'recorded {result.mission.bag_path}')
-    return EXIT_SUCCESS
+    bar = MissionProgressBar(
+        f'OA-Bug {config.variant}', spec.max_sim_time_s, enabled=progress_wanted(args.quiet)
+    )
+    with bar:
+        mission = run_mission(spec, progress=bar)
+    result = OABugRun(settings=config, mission=mission, heading_bias_rad=bias)
+    print(format_summary(result), flush=True)
+    if mission.bag_path is not None:
+        print(f'recorded {mission.bag_path}', flush=True)
+    if config.out_dir is not None:
+        for path in write_run_plots(result, Path(config.out_dir)):
+            print(f'wrote {path}')
+    if mission.stop_reason == StopReason.INTERRUPTED:
+        fail(
+            'spawn',
+            f'interrupted at sim time {mission.sim_time_s:.1f} s; the summary covers '
+            'the run so far',
+        )
+        return EXIT_INTERRUPTED
+    return EXIT_SUCCESS if mission.coverage >= 1.0 else EXIT_UNFINISHED
 
 
 if __name__ == '__main__':

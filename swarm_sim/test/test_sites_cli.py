@@ -110,7 +110,7 @@ def test_validate_accepts_the_example_files_and_rejects_a_broken_one(
     lines = (CONFIG_DIR / 'office_plan.lay').read_text().splitlines()
     lines[5] = ' ' + lines[5][1:]
     broken.write_text('\n'.join(lines) + '\n')
-    assert main(['validate', str(broken)]) == 1
+    assert main(['validate', str(broken)]) == 2
     assert 'broken.lay:6:1: the enclosure is open' in capsys.readouterr().err
 
 
@@ -123,12 +123,17 @@ def test_render_draws_a_png(tmp_path: Path) -> None:
 def test_unknown_file_types_and_missing_files_fail_cleanly(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    assert main(['validate', str(tmp_path / 'site.txt')]) == 1
+    assert main(['validate', str(tmp_path / 'site.txt')]) == 2
     assert "unknown site file type '.txt'" in capsys.readouterr().err
-    assert main(['validate', str(tmp_path / 'missing.yaml')]) == 1
+    assert main(['validate', str(tmp_path / 'missing.yaml')]) == 2
     assert 'missing.yaml' in capsys.readouterr().err
 
 
-def test_a_bad_departure_argument_is_an_argparse_error(tmp_path: Path) -> None:
-    with pytest.raises(SystemExit):
-        main(['import-lay', 'x.lay', '-o', str(tmp_path / 'x.yaml'), '--departure', 'center'])
+def test_a_bad_departure_argument_is_a_one_line_usage_error(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    argv = ['import-lay', 'x.lay', '-o', str(tmp_path / 'x.yaml'), '--departure', 'center']
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.count('\n') == 1
+    assert 'expected NAME=LINE,COLUMN' in err

@@ -130,3 +130,9 @@ def test_an_entrance_that_is_not_a_gap_in_the_enclosure_is_rejected() -> None:
         SiteValidationError, match=r'the entrance at \(2\.000, 0\.000\) m is not a gap'
     ):
         validate_site(box_site(walls=walls))
+
+
+def test_a_site_without_rooms_is_rejected() -> None:
+    with pytest.raises(SiteValidationError, match='has no rooms') as info:
+        validate_site(box_site(rooms=(), doors=()))
+    assert info.value.key_path == ('rooms',)

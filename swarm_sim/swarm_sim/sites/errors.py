@@ -8,6 +8,8 @@ catch that one.
 
 from __future__ import annotations
 
+from swarm_sim.errors import SimulationError
+
 __all__ = [
     'GeneratorError',
     'LayoutError',
@@ -18,8 +20,8 @@ __all__ = [
 ]
 
 
-class SiteError(Exception):
-    """Base class of every error raised by :mod:`swarm_sim.sites`."""
+class SiteError(SimulationError):
+    """Base class of every error raised by :mod:`swarm_sim.sites` (a bad site: exit code 2)."""
 
 
 class SiteValidationError(SiteError):

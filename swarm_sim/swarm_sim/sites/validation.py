@@ -1,6 +1,8 @@
 """Invariants every site must hold, checked the same way for generated, imported and loaded
 sites.
 
+0. The site has at least one room (a search covers rooms; with none there is nothing to
+   search and coverage would be 0 of 0).
 1. Walls and rooms lie within the bounds; rooms do not overlap; doors name existing rooms
    and are at least as wide as a robot.
 2. Every departure point has a robot's clearance from every wall (it is not inside a wall)
@@ -120,6 +122,9 @@ def validate_site(site: Site, *, robot_radius_m: float = DEFAULT_ROBOT_RADIUS_M)
         SiteValidationError: the first violated invariant, with the place (metres) and the
             site-file key path of the offending item.
     """
+    if not site.rooms:
+        msg = f'site {site.name!r} has no rooms; a search site needs at least one room'
+        raise SiteValidationError(msg, key_path=('rooms',))
     _check_within_bounds(site)
     if not site.departure_points:
         raise SiteValidationError(
