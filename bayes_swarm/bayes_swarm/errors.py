@@ -7,11 +7,14 @@ from __future__ import annotations
 
 from swarm_common.errors import SwarmError
 
+from swarm_common import params
+
 __all__ = [
     'BayesSwarmError',
     'ConfigError',
     'GpFitError',
     'ObservationError',
+    'ParameterError',
     'PlanningError',
 ]
 
@@ -22,6 +25,10 @@ class BayesSwarmError(SwarmError):
 
 class ConfigError(BayesSwarmError, ValueError):
     """A configuration value is invalid (negative range, N_max < 1, unknown case, ...)."""
+
+
+class ParameterError(ConfigError, params.ParameterError):
+    """A node parameter is unknown, of the wrong type, out of range or not one of its choices."""
 
 
 class ObservationError(BayesSwarmError, ValueError):

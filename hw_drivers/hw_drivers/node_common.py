@@ -1,8 +1,8 @@
 """Pieces every driver node shares: parameter tables, device polling, diagnostics, main().
 
-* :func:`declare_parameter_table` declares each ``(name, default, description)`` once with a
-  read-only ParameterDescriptor and returns the values (the same tables are mirrored in
-  ``config/*.yaml`` and checked by a test).
+* The parameters of each driver are a spec in :mod:`hw_drivers.parameters`, declared with
+  :func:`swarm_runtime.parameters.declare_config`; ``--help`` lists them and
+  :func:`start_driver_process` checks the parameter files of the command line.
 * :class:`DevicePoller` runs a :class:`~hw_drivers.worker.DeviceWorker` in its own thread
   (robots) or from a node timer (deterministic tests on the built-in runtime).
 * :class:`DeviceMonitor` turns the worker's status plus data freshness into one
@@ -11,7 +11,7 @@
 * :class:`TimerGate` pauses a node's fast publishing timer while its device is missing, so
   an unplugged driver idles.
 * :func:`run_driver_node` is the body of every driver's ``main()``: ``--help``, the runtime
-  check, line-buffered output, init, spin, clean shutdown.
+  check, the parameter-file check, line-buffered output, init, spin, clean shutdown.
 """
 
 from __future__ import annotations
@@ -24,7 +24,10 @@ from collections.abc import Callable, Mapping, Sequence
 from types import FrameType
 from typing import Any
 
-from swarm_runtime.ros import ExternalShutdownException, message_module, rclpy, using_real_rclpy
+from swarm_common.cli import fail
+from swarm_common.params import ParameterSpec, render_value
+from swarm_runtime.parameters import ParameterFileError, check_parameter_arguments
+from swarm_runtime.ros import ExternalShutdownException, rclpy, using_real_rclpy
 from swarm_runtime.standalone import standalone_runtime_problem
 
 from hw_drivers.conversions import DiagnosticEntry, diagnostics_to_ros
@@ -36,10 +39,8 @@ __all__ = [
     'REMINDER_PERIOD_S',
     'DeviceMonitor',
     'DevicePoller',
-    'ParamSpec',
     'StatusLog',
     'TimerGate',
-    'declare_parameter_table',
     'driver_help',
     'no_sleep',
     'publish_diagnostics',
@@ -49,20 +50,9 @@ __all__ = [
     'start_driver_process',
 ]
 
-ParamSpec = tuple[str, Any, str]
 DIAGNOSTICS_TOPIC = '/diagnostics'
 #: While a status stays WARN or worse, it is logged again this often [s].
 REMINDER_PERIOD_S = 30.0
-
-
-def declare_parameter_table(node: Any, table: Sequence[ParamSpec]) -> dict[str, Any]:
-    """Declare every parameter of ``table`` (read-only, described); return name -> value."""
-    descriptor_class = message_module('rcl_interfaces').ParameterDescriptor
-    values: dict[str, Any] = {}
-    for name, default, description in table:
-        descriptor = descriptor_class(description=description, read_only=True)
-        values[name] = node.declare_parameter(name, default, descriptor).value
-    return values
 
 
 class DevicePoller:
@@ -254,7 +244,7 @@ def seconds_clock(node: Any) -> Callable[[], float]:
     return lambda: node.get_clock().now().nanoseconds * 1e-9
 
 
-def driver_help(name: str, summary: str, parameters: Sequence[ParamSpec]) -> str:
+def driver_help(name: str, summary: str, parameters: ParameterSpec) -> str:
     """The ``--help`` text of a driver: usage, what it does, its parameters.
 
     ``summary`` is the module docstring; its first paragraph is used.
@@ -266,9 +256,10 @@ def driver_help(name: str, summary: str, parameters: Sequence[ParamSpec]) -> str
         '',
         'parameters (-p name:=value, or --params-file):',
     ]
-    width = max((len(pname) for pname, _, _ in parameters), default=0)
-    for pname, default, description in parameters:
-        lines.append(f'  {pname:<{width}}  {description} [default: {default!r}]')
+    width = max((len(p.name) for p in parameters.parameters), default=0)
+    for p in parameters.parameters:
+        default = render_value(p.default)
+        lines.append(f'  {p.name:<{width}}  {p.description_text} [default: {default}]')
     lines += [
         '',
         'Without its device the driver reports an error on /diagnostics and retries with',
@@ -326,13 +317,14 @@ def spin_node(node: Any, *, tick_s: float = 0.05) -> None:
 
 
 def start_driver_process(
-    name: str, args: Sequence[str] | None, *, summary: str, parameters: Sequence[ParamSpec]
+    name: str, args: Sequence[str] | None, *, summary: str, parameters: ParameterSpec
 ) -> None:
     """What every driver's ``main()`` does before ``rclpy.init``.
 
     ``--help`` prints the help and exits 0 without touching ROS; on the built-in runtime
     without an explicit ``SWARM_RUNTIME=builtin`` the process exits 2 with a one-line
-    reason; otherwise output becomes line-buffered and SIGTERM stops the node cleanly.
+    reason, and so does a bad parameter file or ``-p`` value (naming the file and the
+    parameter); otherwise output becomes line-buffered and SIGTERM stops the node cleanly.
     """
     own = _own_arguments(args)
     if '-h' in own or '--help' in own:
@@ -342,6 +334,10 @@ def start_driver_process(
     if problem is not None:
         sys.stderr.write(f'{name}: {problem}\n')
         raise SystemExit(2)
+    try:
+        check_parameter_arguments(parameters, name, args)
+    except ParameterFileError as err:
+        raise SystemExit(fail(name, err)) from None
     _line_buffered_output()
     _sigterm_as_interrupt()
 
@@ -352,7 +348,7 @@ def run_driver_node(
     args: list[str] | None,
     *,
     summary: str = '',
-    parameters: Sequence[ParamSpec] = (),
+    parameters: ParameterSpec,
 ) -> None:
     """The body of a sensor driver's ``main()``: checks, init, spin until shutdown, clean up.
 

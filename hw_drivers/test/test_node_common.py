@@ -6,8 +6,9 @@ from hw_drivers.errors import DeviceUnavailableError
 from hw_drivers.fakes.clock import FakeClock
 from hw_drivers.fakes.locator import FakeLocatorClient, ndjson_payload
 from hw_drivers.node_common import DeviceMonitor, StatusLog, TimerGate, driver_help
-from hw_drivers.rplidar_node import PARAMETERS as LIDAR_PARAMETERS
+from hw_drivers.parameters import RPLIDAR_PARAMETERS
 from hw_drivers.worker import DeviceWorker, DiagnosticLevel
+from swarm_common.params import render_value
 from swarm_runtime.ros import Node, Parameter, SingleThreadedExecutor, message_module, rclpy
 from swarm_runtime.simulation import spin_until
 
@@ -114,11 +115,12 @@ def test_the_timer_gate_stops_and_restarts_a_timer():
 
 
 def test_help_lists_every_parameter_with_its_default():
-    text = driver_help('rplidar_node', 'RPLidar A1 driver node.', LIDAR_PARAMETERS)
+    text = driver_help('rplidar_node', 'RPLidar A1 driver node.', RPLIDAR_PARAMETERS)
     assert text.startswith('usage: rplidar_node [--help] [--ros-args')
-    for name, default, _ in LIDAR_PARAMETERS:
-        assert f'  {name} ' in text
-        assert repr(default) in text
+    for p in RPLIDAR_PARAMETERS.parameters:
+        line = next(line for line in text.splitlines() if line.startswith(f'  {p.name} '))
+        assert p.description_text in line
+        assert line.endswith(f'[default: {render_value(p.default)}]')
 
 
 @pytest.fixture

@@ -125,7 +125,7 @@ def test_gas_node_runs_every_backend(ros, backend):
 
 def test_gas_node_refuses_an_unknown_backend(ros):
     _, _, _add = ros
-    with pytest.raises(ConfigurationError, match='backend must be one of'):
+    with pytest.raises(ConfigurationError, match="backend: 'pcf8591' is not one of ads1115"):
         GasNode(parameter_overrides=[Parameter('backend', value='pcf8591')])
 
 

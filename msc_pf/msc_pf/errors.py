@@ -4,7 +4,9 @@ from __future__ import annotations
 
 from swarm_common.errors import SwarmError
 
-__all__ = ['ConfigError', 'MscPfError', 'ObservationError']
+from swarm_common import params
+
+__all__ = ['ConfigError', 'MscPfError', 'ObservationError', 'ParameterError']
 
 
 class MscPfError(SwarmError):
@@ -13,6 +15,10 @@ class MscPfError(SwarmError):
 
 class ConfigError(MscPfError, ValueError):
     """A configuration value is out of range or inconsistent with another one."""
+
+
+class ParameterError(ConfigError, params.ParameterError):
+    """A node parameter is unknown, of the wrong type, out of range or not one of its choices."""
 
 
 class ObservationError(MscPfError, ValueError):

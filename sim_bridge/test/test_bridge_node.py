@@ -5,9 +5,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-import yaml
 from sim_bridge.bridge_node import SimBridgeNode
-from sim_bridge.bridge_parameters import values_from_config
 from swarm_runtime.ros import (
     Node,
     Parameter,
@@ -17,7 +15,6 @@ from swarm_runtime.ros import (
     rclpy,
 )
 from swarm_runtime.simulation import spin_until
-from swarm_sim.engine import EngineConfig
 from swarm_sim.errors import ConfigurationError
 from swarm_sim.site_loading import load_site
 
@@ -126,12 +123,6 @@ def test_bridge_moves_a_robot_by_cmd_vel_and_stops_it_when_commands_stop(ros):
 def test_bridge_without_a_site_explains_what_is_missing(ros):
     with pytest.raises(ConfigurationError, match='site_file'):
         SimBridgeNode()
-
-
-def test_config_file_mirrors_the_engine_defaults():
-    params = yaml.safe_load(CONFIG.read_text())['/sim_bridge']['ros__parameters']
-    for name, value in values_from_config(EngineConfig()).items():
-        assert params[name] == pytest.approx(value), name
 
 
 class PeerProbe(Node):

@@ -91,12 +91,14 @@ class ToolParser(argparse.ArgumentParser):
     A malformed command line raises :class:`swarm_common.errors.UsageError` with argparse's
     one-line message (``argument --robots: invalid int value: 'x'``) instead of printing the
     usage and exiting, so :func:`run_tool` reports it like any other bad input. The epilog
-    lists the exit codes unless one is given. Sub-command parsers are ToolParsers too and
+    lists the exit codes unless one is given. Options are never abbreviated, so a misspelt
+    option is an error rather than another option. Sub-command parsers are ToolParsers too and
     accept ``--debug`` after the sub-command.
     """
 
     def __init__(self, *args: object, debug_option: bool = True, **kwargs: object) -> None:
         kwargs.setdefault('epilog', EXIT_CODES_HELP)
+        kwargs.setdefault('allow_abbrev', False)  # '--robot 3' is an error, not --robots
         super().__init__(*args, **kwargs)  # type: ignore[arg-type]
         if debug_option:
             self.add_argument('--debug', action='store_true', help='show the traceback of an error')

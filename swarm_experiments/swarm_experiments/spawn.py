@@ -27,7 +27,6 @@ import sys
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 from swarm_common.cli import (
@@ -38,14 +37,16 @@ from swarm_common.cli import (
     fail,
     run_tool,
 )
-from swarm_sim.departure import departure_poses, fan_fits, max_fan_robots
+from swarm_sim.departure import free_space_capacity, place_starts
 from swarm_sim.engine import EngineConfig
 from swarm_sim.errors import ConfigurationError
 from swarm_sim.site_loading import load_site, site_budget_actions
+from swarm_sim.sites import PRESETS, Site, require_rooms
 
 from swarm_experiments.cli_args import SPAWNER_EXIT_CODES, add_run_options, check_run_outputs
 from swarm_experiments.errors import ExperimentError
 from swarm_experiments.mission import (
+    VIEWER_TOPICS,
     MissionProgress,
     MissionResult,
     MissionSpec,
@@ -60,9 +61,12 @@ from swarm_experiments.progress import MissionProgressBar, progress_wanted
 __all__ = [
     'ACTION_LENGTH_M',
     'DEFAULT_RECORD_TOPICS',
+    'MAX_ROBOTS',
     'VARIANTS',
     'OABugRun',
     'SpawnSettings',
+    'build_mission',
+    'check_site_limits',
     'main',
     'oabug_parameter_overrides',
     'run',
@@ -71,7 +75,10 @@ __all__ = [
 VARIANTS = ('random', 'minimum', 'sound', 'gas', 'gas_sound')
 ACTION_LENGTH_M = 0.1
 DEFAULT_ACTIONS = 1000
-DEFAULT_RECORD_TOPICS = ('/clock', '/sim/poses', '/sim/coverage', '/sim/site')
+#: Largest swarm the command runs: every robot is a node in this one process (the paper
+#: reports 2 to 10 robots; oabug_batch runs larger swarms without nodes).
+MAX_ROBOTS = 100
+DEFAULT_RECORD_TOPICS = ('/clock', '/sim/poses', '/sim/coverage', '/sim/site', *VIEWER_TOPICS)
 # OA-Bug node parameters the spawner sets from its own options (see build_mission).
 SPAWNER_PARAMETERS = (
     'variant',
@@ -103,6 +110,8 @@ class SpawnSettings:
         speed_mps: the robots' cruise speed [m/s].
         record: bag directory to write, or None.
         record_robot_topics: also record each robot's state, cmd_vel and pump topics.
+        record_scans: also record each robot's lidar scans (``/r<i>/scan``, about 8 kB/s
+            per robot; off by default, the viewers' scan displays show them when present).
         out_dir: directory for the PNGs, or None for no plots.
         robot_parameters: extra OA-Bug node parameters for every robot.
         engine: world configuration (its seed is replaced by ``seed``).
@@ -118,6 +127,7 @@ class SpawnSettings:
     speed_mps: float = 0.3
     record: Path | None = None
     record_robot_topics: bool = True
+    record_scans: bool = False
     out_dir: Path | None = None
     robot_parameters: dict[str, object] = field(default_factory=dict)
     engine: EngineConfig = field(default_factory=EngineConfig)
@@ -174,14 +184,6 @@ class OABugRun:
         return self.mission.coverage
 
 
-def heading_bias_rad(departure: str, into_site_rad: float | None, seed: int) -> float:
-    """The fan's bias: random for a centre start; for an edge start, inward minus 90 deg."""
-    if departure == 'edge' and into_site_rad is not None:
-        return float(into_site_rad) - 0.5 * math.pi
-    rng = np.random.default_rng(np.random.SeedSequence([seed, 0xB1A5]))
-    return float(rng.uniform(-math.pi, math.pi))
-
-
 def oabug_parameter_overrides(items: Sequence[str]) -> dict[str, object]:
     """OA-Bug node parameters from ``NAME=VALUE`` items, typed and checked before a run.
 
@@ -194,14 +196,11 @@ def oabug_parameter_overrides(items: Sequence[str]) -> dict[str, object]:
         ExperimentError: the OA-Bug package cannot be imported.
     """
     try:
-        from oabug_robot.node import PARAMETERS, config_from_parameters
+        from oabug_robot.node_settings import OABUG_PARAMETERS
     except ImportError as err:
         msg = f'the OA-Bug node (package oabug_robot) cannot be imported: {err}'
         raise ExperimentError(msg) from err
-    declared = {name: default for name, default, _ in PARAMETERS}
-    return parse_overrides(
-        items, declared, reserved=SPAWNER_PARAMETERS, check=config_from_parameters
-    )
+    return parse_overrides(items, OABUG_PARAMETERS, reserved=SPAWNER_PARAMETERS)
 
 
 def _oabug_factory() -> Callable[..., object]:
@@ -213,46 +212,48 @@ def _oabug_factory() -> Callable[..., object]:
     return OABugNode
 
 
-def _check_robots_fit(
-    config: SpawnSettings, site: Any, point: Any, fan: str, bias: float, poses: np.ndarray
-) -> None:
-    """Raise ConfigurationError unless the fan of ``config.robots`` fits (see
-    :func:`swarm_sim.departure.fan_fits`), naming the most that do."""
-    body = config.engine.body
-    clearance = body.robot_radius_m + 0.5 * body.wall_thickness_m
-    walls = np.asarray(site.sealed_walls)
-    bounds = (site.width_m, site.height_m)
-    kwargs = {'robot_radius_m': body.robot_radius_m, 'wall_clearance_m': clearance}
-    if fan_fits(poses, walls, bounds, **kwargs):
-        return
-    most = max_fan_robots(point.xy, fan, bias, walls, bounds, **kwargs)
-    msg = (
-        f'{config.robots} robots do not fit around departure point {config.departure!r} of '
-        f'site {site.name!r}: at most {most} do (they start on a '
-        f'{"half " if fan == "edge" else ""}circle of radius '
-        f'{math.dist(point.xy, poses[0, :2]):.2f} m around it, each {clearance:.3f} m clear of '
-        f'the walls, no centre inside another robot)'
-    )
-    raise ConfigurationError(msg)
+def check_site_limits(config: SpawnSettings, site: Site, *, max_robots: int | None = None) -> None:
+    """Check the run against its site before anything is placed or started.
+
+    Raises:
+        swarm_sim.sites.SiteValidationError: the site has no rooms (nothing to search).
+        ConfigurationError: no such departure point, more robots than its free space could
+            hold (:func:`swarm_sim.departure.free_space_capacity`, quick for any count), or
+            more than ``max_robots``.
+    """
+    require_rooms(site, None if config.site.lower() in PRESETS else config.site)
+    capacity = free_space_capacity(site, config.departure, body=config.engine.body)
+    if config.robots > capacity.max_robots:
+        msg = (
+            f'{config.robots} robots do not fit around departure point {capacity.departure!r} '
+            f'of site {site.name!r}: its {capacity.area_m2:.0f} m^2 of free space hold at most '
+            f'{capacity.max_robots} robots of radius {config.engine.body.robot_radius_m} m'
+        )
+        raise ConfigurationError(msg)
+    if max_robots is not None and config.robots > max_robots:
+        msg = (
+            f'--robots must be in 1..{max_robots} (one node per robot in this process; '
+            f'oabug_batch runs larger swarms), got {config.robots}'
+        )
+        raise ConfigurationError(msg)
 
 
-def build_mission(config: SpawnSettings) -> tuple[MissionSpec, float]:
+def build_mission(
+    config: SpawnSettings, *, max_robots: int | None = None
+) -> tuple[MissionSpec, float]:
     """The mission spec of ``config`` and the heading bias it uses.
 
     Raises:
         ConfigurationError: an unknown site or departure point, or more robots than fit
-            around the departure point (the message gives the most that fit).
-        swarm_sim.sites.SiteError: the site file or layout is invalid.
+            around the departure point (:func:`check_site_limits`) or than ``max_robots``.
+        swarm_sim.sites.SiteError: the site file or layout is invalid or has no rooms.
     """
     site = load_site(config.site, seed=config.site_seed)
-    try:
-        point = site.departure(config.departure)
-    except Exception as err:
-        raise ConfigurationError(str(err)) from err
-    fan = 'edge' if point.heading_rad is not None else 'center'
-    bias = heading_bias_rad(fan, point.heading_rad, config.seed)
-    poses = departure_poses(point.xy, fan, config.robots, bias)
-    _check_robots_fit(config, site, point, fan, bias, poses)
+    check_site_limits(config, site, max_robots=max_robots)
+    starts = place_starts(
+        site, config.departure, config.robots, seed=config.seed, body=config.engine.body
+    )
+    fan, bias, poses = starts.fan, starts.bias_rad, starts.poses
     factory = _oabug_factory()
     robots = []
     for i in range(config.robots):
@@ -274,6 +275,8 @@ def build_mission(config: SpawnSettings) -> tuple[MissionSpec, float]:
         if config.record_robot_topics:
             for i in range(config.robots):
                 topics += [f'/r{i}/state', f'/r{i}/cmd_vel', f'/r{i}/pump']
+        if config.record_scans:
+            topics += [f'/r{i}/scan' for i in range(config.robots)]
         recording = RecordingSpec(Path(config.record), tuple(topics))
     engine = dataclasses.replace(config.engine, seed=int(config.seed))
     spec = MissionSpec(
@@ -396,6 +399,9 @@ def _parser() -> argparse.ArgumentParser:
     parser.add_argument('--speed', type=float, default=0.3, help='robot cruise speed [m/s]')
     add_run_options(parser, out_default=Path('oabug_results'), plots='the PNGs')
     parser.add_argument(
+        '--record-scans', action='store_true', help="also record the robots' lidar scans"
+    )
+    parser.add_argument(
         '--param',
         action='append',
         default=[],
@@ -424,10 +430,13 @@ def _main(argv: list[str]) -> int:
         actions=args.actions,
         speed_mps=args.speed,
         record=args.record,
+        record_scans=args.record_scans,
         out_dir=None if args.no_plots else args.out,
     )
     check_run_outputs(config.record, config.out_dir)
-    spec, bias = build_mission(config)
+    spec, bias = build_mission(config, max_robots=MAX_ROBOTS)
+    for warning in spec.site.warnings:
+        print(f'spawn: warning: {warning}', file=sys.stderr, flush=True)
     print(
         f'OA-Bug {config.variant}: {config.robots} robots, site {spec.site.name}, '
         f'{config.departure} departure, budget {config.budget_actions} actions '

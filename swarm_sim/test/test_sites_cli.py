@@ -137,3 +137,31 @@ def test_a_bad_departure_argument_is_a_one_line_usage_error(
     err = capsys.readouterr().err
     assert err.count('\n') == 1
     assert 'expected NAME=LINE,COLUMN' in err
+
+
+def test_import_and_validate_log_the_sites_warnings_on_stderr(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    plan = tmp_path / 'boxes.lay'
+    plan.write_text(
+        '%%%%%%%%%%%%\n%    %     %\n%    %%%%%%%\n%  D       %\n%          %\n%%%%%%%%%%%%\n'
+    )
+    out = tmp_path / 'boxes.yaml'
+    assert main(['import-lay', str(plan), '-o', str(out)]) == 0
+    captured = capsys.readouterr()
+    assert 'found 0 rooms and 0 doors, 1 sealed voids read as solid' in captured.out
+    assert f'warning: {plan}:2:7: an enclosed area with no door' in captured.err
+    assert 'warning: the site has no rooms' in captured.err
+    # Validation prints the warnings, then refuses the site: it has nothing to search.
+    assert main(['validate', str(plan)]) == 2
+    err = capsys.readouterr().err
+    assert f'warning: {plan}:2:7:' in err
+    assert err.endswith(
+        f'site_tool: {plan}: the site has no rooms; a search needs at least one'
+        ' (coverage would be 0/0)\n'
+    )
+    # The site file holds the void as solid already: nothing left to warn about.
+    assert main(['validate', str(out)]) == 2
+    err = capsys.readouterr().err
+    assert 'warning' not in err
+    assert err.count('\n') == 1

@@ -162,9 +162,7 @@ def test_an_unreachable_cluster_is_a_one_line_error(
     )
     assert code == 1
     err = capsys.readouterr().err
-    assert err.startswith(
-        'swarm_study: cannot reach the Dask scheduler at tcp://127.0.0.1:9'
-    )
+    assert err.startswith('swarm_study: cannot reach the Dask scheduler at tcp://127.0.0.1:9')
     assert err.count('\n') == 1
 
 

@@ -14,6 +14,7 @@ from swarm_sim.sites.errors import (
     SiteError,
     SiteFileError,
     SiteValidationError,
+    SiteWarning,
 )
 from swarm_sim.sites.generator import (
     BIG,
@@ -29,7 +30,7 @@ from swarm_sim.sites.layout import Layout, LayoutImport, LayoutMode, import_layo
 from swarm_sim.sites.model import CELL_M, NO_ROOM, DeparturePoint, Door, Room, Site
 from swarm_sim.sites.room_lookup import RoomLookup
 from swarm_sim.sites.site_file import load_site, save_site
-from swarm_sim.sites.validation import validate_site
+from swarm_sim.sites.validation import require_rooms, validate_site
 
 __all__ = [
     'BIG',
@@ -53,11 +54,13 @@ __all__ = [
     'SiteError',
     'SiteFileError',
     'SiteValidationError',
+    'SiteWarning',
     'generate_layout',
     'generate_site',
     'import_layout',
     'layout_to_site',
     'load_site',
+    'require_rooms',
     'save_site',
     'validate_site',
 ]

@@ -8,10 +8,13 @@ Examples::
     site_tool validate plan.yaml
     site_tool render small7.yaml -o small7.png
 
-Every command exits with 0 on success and 2 on an invalid site or bad input, printing the
+Every command exits with 0 on success and 2 on an invalid site or bad input (``validate``
+also refuses a site without rooms, which ``import-lay`` writes with a warning), printing the
 error as one line (file, line and column or key) on stderr; ``--debug`` adds the traceback.
 Outputs are checked before anything is built and written under a temporary name first, so
 a failed command leaves no partial file.
+The site's warnings (a sealed void read as solid, a departure point inside a room, ...) go
+to stderr as ``warning: ...`` lines.
 """
 
 from __future__ import annotations
@@ -30,7 +33,7 @@ from swarm_sim.sites.generator import PRESETS, generate_layout, resolve_config, 
 from swarm_sim.sites.layout import LayoutMode, import_layout, layout_to_site, write_layout
 from swarm_sim.sites.model import CELL_M, Site
 from swarm_sim.sites.site_file import load_site, save_site
-from swarm_sim.sites.validation import DEFAULT_ROBOT_RADIUS_M, validate_site
+from swarm_sim.sites.validation import DEFAULT_ROBOT_RADIUS_M, require_rooms, validate_site
 
 __all__ = ['build_parser', 'load_any', 'main']
 
@@ -59,6 +62,11 @@ def _summary(site: Site) -> str:
         f'{len(site.doors)} doors, {len(site.walls)} walls, '
         f'{"one entrance" if site.entrance else "no entrance"}; departure points: {points}'
     )
+
+
+def _log_warnings(site: Site) -> None:
+    for warning in site.warnings:
+        print(f'warning: {warning}', file=sys.stderr)
 
 
 def _render(site: Site, path: str) -> None:
@@ -96,6 +104,7 @@ def _generate(args: argparse.Namespace) -> int:
     site = layout_to_site(
         layout, mode=LayoutMode.LABELLED, cell_m=config.cell_m, name=name, seed=args.seed
     ).site
+    _log_warnings(site)
     save_site(site, args.output)
     print(f'wrote {args.output}: {_summary(site)}')
     if args.lay:
@@ -127,10 +136,17 @@ def _import_lay(args: argparse.Namespace) -> int:
         departures=dict(args.departure) if args.departure else None,
         max_door_cells=args.max_door_cells,
     )
+    voids = f', {result.voids_found} sealed voids read as solid' if result.voids_found else ''
     print(
         f'{args.layout}: {result.mode.value} layout, found {result.rooms_found} rooms and '
-        f'{result.doors_found} doors'
+        f'{result.doors_found} doors{voids}'
     )
+    _log_warnings(result.site)
+    if not result.site.rooms:
+        print(
+            'warning: the site has no rooms; the spawners and site_tool validate refuse it',
+            file=sys.stderr,
+        )
     save_site(result.site, args.output)
     print(f'wrote {args.output}: {_summary(result.site)}')
     if args.png:
@@ -143,6 +159,8 @@ def _validate(args: argparse.Namespace) -> int:
         raise SiteError(f'--robot-radius-m must be > 0, got {args.robot_radius_m}')
     site = load_any(args.site)
     validate_site(site, robot_radius_m=args.robot_radius_m)
+    _log_warnings(site)
+    require_rooms(site, str(args.site))
     print(f'{args.site}: valid. {_summary(site)}')
     return 0
 
@@ -150,6 +168,7 @@ def _validate(args: argparse.Namespace) -> int:
 def _render_command(args: argparse.Namespace) -> int:
     _check_outputs(args, '--output')
     site = load_any(args.site)
+    _log_warnings(site)
     _render(site, args.output)
     return 0
 
@@ -181,7 +200,7 @@ def build_parser() -> argparse.ArgumentParser:
     imports.add_argument('--cell-m', type=float, default=CELL_M, help='grid spacing [m]')
     imports.add_argument('--name', help='site name (default: the file name)')
     imports.add_argument(
-        '--departure-name', default='edge', help="name of the 'D' point of an unlabelled plan"
+        '--departure-name', default='edge', help="name of the departure point marked 'D'"
     )
     imports.add_argument(
         '--departure',

@@ -1,8 +1,6 @@
 """Invariants every site must hold, checked the same way for generated, imported and loaded
 sites.
 
-0. The site has at least one room (a search covers rooms; with none there is nothing to
-   search and coverage would be 0 of 0).
 1. Walls and rooms lie within the bounds; rooms do not overlap; doors name existing rooms
    and are at least as wide as a robot.
 2. Every departure point has a robot's clearance from every wall (it is not inside a wall)
@@ -12,6 +10,13 @@ sites.
    in the enclosure).
 4. Every room is reachable from every departure point through its doors; a room that cannot
    be reached and is named by no door is reported as a room with no door.
+
+A site without rooms holds these invariants (an imported plan whose only enclosures are
+sealed voids, say), but there is nothing to search in it: :func:`require_rooms` is the extra
+check of the tools that run or validate a search (coverage would be 0 of 0).
+
+A departure point inside a room is not an error (robots can leave through its door) but a
+warning, which says whether the room is *nested* (its doors open only into other rooms).
 
 Reachability is decided on a raster of the free space in which the walls are drawn as
 8-connected lines and flooded 4-connected, so no path slips between two wall cells. Sites on
@@ -27,14 +32,16 @@ from typing import Final
 import numpy as np
 from scipy import ndimage
 
-from swarm_sim.sites.errors import SiteValidationError
-from swarm_sim.sites.model import NO_ROOM, Door, Site
+from swarm_sim.sites.errors import SiteValidationError, SiteWarning
+from swarm_sim.sites.model import NO_ROOM, Door, Room, Site
 
 __all__ = [
     'DEFAULT_ROBOT_RADIUS_M',
     'FreeSpaceRaster',
+    'departure_room_warnings',
     'free_space_raster',
     'point_segment_distances',
+    'require_rooms',
     'validate_site',
 ]
 
@@ -115,16 +122,32 @@ def free_space_raster(site: Site, *, sealed: bool = True) -> FreeSpaceRaster:
     return FreeSpaceRaster(walls, site.width_m, site.height_m, resolution)
 
 
-def validate_site(site: Site, *, robot_radius_m: float = DEFAULT_ROBOT_RADIUS_M) -> None:
+def require_rooms(site: Site, source: str | None = None) -> None:
+    """Raise :class:`SiteValidationError` when the site has no room to search.
+
+    Args:
+        site: the site.
+        source: the file it came from, named in the message instead of the site's name.
+    """
+    if site.rooms:
+        return
+    where = source if source is not None else f'site {site.name!r}'
+    msg = f'{where}: the site has no rooms; a search needs at least one (coverage would be 0/0)'
+    raise SiteValidationError(msg, key_path=('rooms',))
+
+
+def validate_site(
+    site: Site, *, robot_radius_m: float = DEFAULT_ROBOT_RADIUS_M
+) -> tuple[SiteWarning, ...]:
     """Check the invariants listed in the module docstring.
+
+    Returns:
+        the warnings: departure points that lie inside a room.
 
     Raises:
         SiteValidationError: the first violated invariant, with the place (metres) and the
             site-file key path of the offending item.
     """
-    if not site.rooms:
-        msg = f'site {site.name!r} has no rooms; a search site needs at least one room'
-        raise SiteValidationError(msg, key_path=('rooms',))
     _check_within_bounds(site)
     if not site.departure_points:
         raise SiteValidationError(
@@ -193,6 +216,40 @@ def validate_site(site: Site, *, robot_radius_m: float = DEFAULT_ROBOT_RADIUS_M)
             raise SiteValidationError(msg, position_m=(lx, ly), key_path=('rooms', index))
     if site.entrance is not None:
         _check_entrance_opens(site, site.entrance)
+    return tuple(departure_room_warnings(site))
+
+
+def departure_room_warnings(site: Site) -> list[SiteWarning]:
+    """A warning for every departure point that lies inside a room (robots would start in
+    that room, not in a corridor), saying whether the room is nested in other rooms."""
+    points = list(site.departure_points.values())
+    if not points or not site.rooms:
+        return []
+    room_ids = site.room_ids_at(np.array([p.xy for p in points], dtype=np.float64))
+    warnings = []
+    for point, room_id in zip(points, room_ids.tolist(), strict=True):
+        if room_id == NO_ROOM:
+            continue
+        room = site.room(room_id)
+        doors = [door for door in site.doors if room_id in door.room_ids]
+        outer = sorted({i for door in doors for i in door.room_ids} - {room_id})
+        nested = bool(doors) and all(len(door.room_ids) == 2 for door in doors)
+        x, y = point.xy
+        where = f'departure point {point.name!r} at ({x:.3f}, {y:.3f}) m lies inside '
+        if nested:
+            into = ', '.join(_room_name(site.room(i)) for i in outer)
+            what = f'{_room_name(room)}, a room nested in {into} (its doors open only into rooms)'
+        else:
+            what = _room_name(room)
+        msg = f'{where}{what}: robots start in that room, not in a corridor'
+        warnings.append(
+            SiteWarning(msg, position_m=point.xy, key_path=('departure_points', point.name))
+        )
+    return warnings
+
+
+def _room_name(room: Room) -> str:
+    return f'room {room.room_id}' + (f' ({room.label!r})' if room.label else '')
 
 
 def _check_door_widths(site: Site, robot_radius_m: float) -> None:
