@@ -62,7 +62,9 @@ def add_run_options(parser: argparse.ArgumentParser, *, out_default: Path, plots
     parser.add_argument('--out', type=Path, default=out_default, help=f'directory for {plots}')
     parser.add_argument('--no-plots', action='store_true', help='do not write plots')
     parser.add_argument(
-        '--quiet', action='store_true', help='no progress bar (there is none when not a terminal)'
+        '--quiet',
+        action='store_true',
+        help='no progress on stderr (a bar on a terminal, else a line per tenth of the budget)',
     )
 
 

@@ -1,8 +1,10 @@
-"""Progress of a mission on the terminal: one rich bar over the sim-time budget.
+"""Progress of a mission: one rich bar over the sim-time budget, or plain lines in a log.
 
-The spawners pass :class:`MissionProgressBar` as the mission's ``progress`` callback. It draws
-on stderr only when stderr is a terminal and ``--quiet`` was not given, so logs, pipes and
-tests get the report alone; the bar disappears when the mission ends.
+The spawners pass :class:`MissionProgressBar` as the mission's ``progress`` callback. On a
+terminal (and without ``--quiet``) it draws a bar on stderr that disappears when the mission
+ends; written to a pipe or a log, it prints a plain line on stderr at every tenth of the
+budget instead (``lines=True``), so a long run is never silent and stdout holds the report
+alone.
 """
 
 from __future__ import annotations
@@ -32,6 +34,9 @@ class MissionProgressBar:
         budget_s: the mission's sim-time budget [s].
         enabled: draw at all (see :func:`progress_wanted`); when False every call is a no-op.
         detail: text right of the bar for a report (default: rooms covered).
+        lines: when the bar is not drawn, print ``<description>: sim <t>/<budget> s (<p> %),
+            <detail>, wall <s> s`` on ``stream`` at every tenth of the budget.
+        stream: where the lines go (default: sys.stderr).
     """
 
     def __init__(
@@ -41,11 +46,16 @@ class MissionProgressBar:
         *,
         enabled: bool,
         detail: Callable[[MissionProgress], str] | None = None,
+        lines: bool = False,
+        stream: TextIO | None = None,
     ) -> None:
         self.description = description
         self.budget_s = float(budget_s)
         self.enabled = enabled
         self.detail = detail or _rooms
+        self.lines = lines and not enabled
+        self.stream = stream
+        self._next_line_s = 0.1 * self.budget_s
         self._progress: Any = None
         self._task: Any = None
 
@@ -76,6 +86,18 @@ class MissionProgressBar:
         return self
 
     def __call__(self, report: MissionProgress) -> None:
+        if self.lines and report.sim_time_s + 1e-9 >= self._next_line_s:
+            while self._next_line_s <= report.sim_time_s + 1e-9:
+                self._next_line_s += 0.1 * self.budget_s
+            share = 100.0 * report.sim_time_s / self.budget_s if self.budget_s > 0 else 100.0
+            detail = self.detail(report)
+            print(
+                f'{self.description}: sim {report.sim_time_s:.0f}/{self.budget_s:.0f} s '
+                f'({share:.0f} %), {detail + ", " if detail else ""}'
+                f'wall {report.wall_time_s:.1f} s',
+                file=self.stream if self.stream is not None else sys.stderr,
+                flush=True,
+            )
         if self._progress is None:
             return
         self._progress.update(

@@ -447,7 +447,10 @@ def _main(argv: list[str]) -> int:
         settings = ', '.join(f'{k}={v}' for k, v in sorted(config.robot_parameters.items()))
         print(f'OA-Bug parameters other than the defaults: {settings}', flush=True)
     bar = MissionProgressBar(
-        f'OA-Bug {config.variant}', spec.max_sim_time_s, enabled=progress_wanted(args.quiet)
+        f'OA-Bug {config.variant}',
+        spec.max_sim_time_s,
+        enabled=progress_wanted(args.quiet),
+        lines=not args.quiet,
     )
     with bar:
         mission = run_mission(spec, progress=bar)

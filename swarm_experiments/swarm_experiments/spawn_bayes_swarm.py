@@ -527,6 +527,7 @@ def _main(argv: list[str]) -> int:
         f'{settings.algorithm} {case.name}',
         case.max_mission_time_s,
         enabled=progress_wanted(args.quiet),
+        lines=not args.quiet,
         detail=lambda report: '',
     )
     with bar:

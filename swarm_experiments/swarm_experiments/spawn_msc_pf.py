@@ -442,6 +442,7 @@ def _main(argv: list[str]) -> int:
         f'{settings.scheme}, {settings.robots} robots',
         settings.max_time_s,
         enabled=progress_wanted(args.quiet),
+        lines=not args.quiet,
         detail=lambda report: '',
     )
     with bar:

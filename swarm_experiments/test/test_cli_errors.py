@@ -80,11 +80,15 @@ ROWS = [
     _row('site is a directory', 'spawn', '--site {inputs}', 'is a directory'),
     _row('unknown site type', 'spawn', '--site {inputs}/plain_file', 'unknown site file type'),
     _row('no such departure', 'spawn', '--departure roof', "'roof'", 'center, edge'),
+    _row('site is a list', 'spawn', '--site {inputs}/list.yaml', 'list.yaml:1', 'mapping'),
+    _row('missing key', 'spawn', '--site {inputs}/no_bounds.yaml', 'no_bounds.yaml:1', "'bounds'"),
+    _row('site is a device', 'spawn', '--site /dev/null', "'/dev/null'", 'existing file'),
     # Outputs, checked before the run.
     _row('record into a bag', 'spawn', '--record {inputs}/old_bag', '--record', 'exists already'),
     _row('record under a file', 'spawn', '--record {inputs}/plain_file/bag', 'not a directory'),
     _row('out is a file', 'spawn', '--out {inputs}/plain_file', '--out', 'is a file'),
     _row('out unwritable', 'spawn', '--out {unwritable}/plots', '--out', 'cannot write in'),
+    _row('out under a device', 'spawn', '--out /dev/null/plots', '--out', 'not a directory'),
     # Limits checked against the site, and plain bad values.
     _row('10000 robots', 'spawn', '--robots 10000', '10000 robots', '91 m^2', 'at most 2632'),
     _row('101 robots', 'spawn', '--robots 101', '--robots must be in 1..100'),
@@ -102,6 +106,7 @@ ROWS = [
     _row('--param no =', 'spawn', '--param gas_threshold', 'gas_threshold'),
     _row('spawner-set --param', 'spawn', '--param variant=gas', 'variant'),
     _row('MSC target outside', 'spawn_msc_pf', '--target-positions 5000,5000', '(5000, 5000)'),
+    _row('MSC target negative', 'spawn_msc_pf', '--target-positions=-1,-1', '(-1, -1)', 'field'),
     _row('MSC bad points', 'spawn_msc_pf', '--target-positions 1,2;3', 'must look like'),
     _row('MSC nan point', 'spawn_msc_pf', '--target-positions nan,1', 'finite numbers'),
     _row('MSC 10000 robots', 'spawn_msc_pf', '--robots 10000', '--robots must be in 1..100'),
@@ -117,6 +122,7 @@ ROWS = [
     _row('Bayes nan noise', 'spawn_bayes_swarm', '--noise nan', '--noise', 'finite'),
     _row('Bayes negative T_max', 'spawn_bayes_swarm', '--t-max -1', '--t-max'),
     _row('Bayes depot outside', 'spawn_bayes_swarm', '--depots 100,100', 'inside the arena'),
+    _row('Bayes depot negative', 'spawn_bayes_swarm', '--depots=-1,0', 'inside the arena'),
     _row('Bayes bad depots', 'spawn_bayes_swarm', '--depots a,b', '--depots must look like'),
     _row('Bayes 10000 robots', 'spawn_bayes_swarm', '--robots 10000', '1..100'),
     _row('Bayes unknown case', 'spawn_bayes_swarm', '--case case9', '--case', 'invalid choice'),
@@ -129,6 +135,7 @@ ROWS = [
     _row('validate garbage', 'site_tool', 'validate {inputs}/garbage.yaml', 'not UTF-8'),
     _row('validate garbage .lay', 'site_tool', 'validate {inputs}/garbage.lay', 'not UTF-8'),
     _row('validate 0 rooms', 'site_tool', 'validate {inputs}/no_rooms.yaml', 'no rooms'),
+    _row('validate 0 rooms .lay', 'site_tool', 'validate {inputs}/box_only.lay', 'no rooms'),
     _row('validate unreachable', 'site_tool', 'validate {inputs}/unreachable.yaml', 'reachable'),
     _row('validate a directory', 'site_tool', 'validate {inputs}', 'is a directory'),
     _row('validate missing', 'site_tool', 'validate {inputs}/missing.yaml', 'No such file'),
@@ -160,6 +167,13 @@ ROWS = [
     _row(
         'report out is a file', 'swarm_report', '{inputs}/counts --out {inputs}/plain_file', 'file'
     ),
+    _row(
+        'report out unwritable',
+        'swarm_report',
+        '{inputs}/counts --out {unwritable}/r',
+        '--out',
+        'cannot write in',
+    ),
     _row('report both out', 'swarm_report', 'x --out a --out-dir b', 'give only --out'),
     _row('oabug_report missing', 'oabug_report', '{inputs}/nowhere', 'no such bag'),
     _row('oabug_report no topics', 'oabug_report', '{inputs}/counts', 'has no /sim/site'),
@@ -171,6 +185,13 @@ ROWS = [
     _row('bringup count', 'robot_bringup', '--robot-count 0', '--robot-count must be >= 1'),
     _row('bringup grace', 'robot_bringup', '--grace x', "invalid float value: 'x'"),
     _row('bringup params', 'robot_bringup', '--params-file {inputs}/none.yaml --fake', 'no such'),
+    _row(
+        'bringup params a list',
+        'robot_bringup',
+        '--params-file {inputs}/list.yaml --fake',
+        'list.yaml',
+        'node names',
+    ),
     _row('bench_oabug sites', 'bench_oabug', '--sites 0', '--sites must be >= 1'),
     _row('bench_oabug out', 'bench_oabug', '--out {inputs}/plain_file/t.md', 'not a directory'),
     _row('bench_oabug param', 'bench_oabug', '--set gas_threshold=high', 'gas_threshold'),
@@ -226,6 +247,8 @@ def inputs(tmp_path_factory: pytest.TempPathFactory) -> Path:
         'walls: []\n'
     )
     (root / 'empty.yaml').write_text('')
+    (root / 'list.yaml').write_text('- 1\n- 2\n')
+    (root / 'no_bounds.yaml').write_text('format: swarm_site/1\nname: x\n')
     (root / 'unreachable.yaml').write_text(UNREACHABLE_ROOM)
     no_rooms = UNREACHABLE_ROOM.replace('rooms:\n- {id: 1, rects: [[2.5, 1.5, 4.0, 3.0]]}\n', '')
     (root / 'no_rooms.yaml').write_text(no_rooms)
