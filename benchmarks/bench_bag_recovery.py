@@ -104,7 +104,7 @@ def _main(argv: list[str]) -> int:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Command-line entry point; exit codes as every tool's (README)."""
+    """Command-line entry point; exit codes as every tool's (docs/conventions.md)."""
     return run_tool('bench_bag_recovery', _main, argv)
 
 

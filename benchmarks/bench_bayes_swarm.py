@@ -418,8 +418,8 @@ def _report(job: Job, seed: int, outcome: RunOutcome) -> None:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Command-line entry point; exit codes as every tool's (README), 130 after Ctrl-C with
-    the table of the finished runs printed and written."""
+    """Command-line entry point; exit codes as every tool's (docs/conventions.md);
+    130 after Ctrl-C with the table of the finished runs printed and written."""
     return run_tool('bench_bayes_swarm', _main, argv)
 
 

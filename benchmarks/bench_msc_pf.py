@@ -652,8 +652,8 @@ def run(
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Command-line entry point; exit codes as every tool's (README), 130 after Ctrl-C (the
-    finished runs are kept in the CSV and their table printed)."""
+    """Command-line entry point; exit codes as every tool's (docs/conventions.md);
+    130 after Ctrl-C (the finished runs are kept in the CSV and their table printed)."""
     return run_tool('bench_msc_pf', _main, argv)
 
 

@@ -383,8 +383,8 @@ def run(
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Command line entry point; exit codes as every tool's (README), 130 after Ctrl-C with
-    the table of the finished runs printed and written."""
+    """Command line entry point; exit codes as every tool's (docs/conventions.md);
+    130 after Ctrl-C with the table of the finished runs printed and written."""
     return run_tool('bench_oabug', _main, argv)
 
 

@@ -383,7 +383,7 @@ def _main(argv: list[str]) -> int:
 
 def main(argv: list[str] | None = None) -> int:
     """Command-line entry point; prints the real-time factor of each configuration (exit codes
-    as every tool's, README)."""
+    as every tool's, docs/conventions.md)."""
     return run_tool('bench_runtime', _main, argv)
 
 

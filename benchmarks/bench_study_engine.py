@@ -423,7 +423,7 @@ def _main(argv: list[str]) -> int:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Command-line entry point; exit codes as every tool's (README)."""
+    """Command-line entry point; exit codes as every tool's (docs/conventions.md)."""
     return run_tool('bench_study_engine', _main, argv)
 
 

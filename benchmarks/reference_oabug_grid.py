@@ -285,8 +285,8 @@ def summary(runs: Sequence[GridRun]) -> list[str]:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Command line entry point; exit codes as every tool's (README), 130 after Ctrl-C with
-    the finished runs written."""
+    """Command line entry point; exit codes as every tool's (docs/conventions.md);
+    130 after Ctrl-C with the finished runs written."""
     return run_tool('reference_oabug_grid', _main, argv)
 
 

@@ -82,7 +82,7 @@ ROWS = [
     _row('no such departure', 'spawn', '--departure roof', "'roof'", 'center, edge'),
     _row('site is a list', 'spawn', '--site {inputs}/list.yaml', 'list.yaml:1', 'mapping'),
     _row('missing key', 'spawn', '--site {inputs}/no_bounds.yaml', 'no_bounds.yaml:1', "'bounds'"),
-    _row('site is a device', 'spawn', '--site /dev/null', "'/dev/null'", 'existing file'),
+    _row('site is a device', 'spawn', '--site /dev/null', "'/dev/null'", 'not a regular file'),
     # Outputs, checked before the run.
     _row('record into a bag', 'spawn', '--record {inputs}/old_bag', '--record', 'exists already'),
     _row('record under a file', 'spawn', '--record {inputs}/plain_file/bag', 'not a directory'),

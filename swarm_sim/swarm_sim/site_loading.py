@@ -32,6 +32,11 @@ def load_site(spec: str, *, seed: int = 0) -> Any:
     if path.is_dir():
         msg = f'site {spec!r} is a directory; expected a preset, a .lay layout or a site file'
         raise ConfigurationError(msg)
+    if path.exists() and not path.is_file():
+        msg = (
+            f'site {spec!r} is not a regular file; expected a preset, a .lay layout or a site file'
+        )
+        raise ConfigurationError(msg)
     if not path.is_file():
         presets = ', '.join(sites.PRESETS)
         msg = f'site {spec!r} is neither a preset ({presets}) nor an existing file'
