@@ -7,7 +7,7 @@ VARIANT ?= gas_sound
 SEED ?= 1
 OUT ?= runs/demo
 
-.PHONY: bootstrap demo test lint colcon-check bench clean
+.PHONY: bootstrap demo test lint typecheck colcon-check bench clean
 
 bootstrap:
 	@scripts/bootstrap.sh
@@ -23,6 +23,10 @@ test: bootstrap
 lint: bootstrap
 	$(VENV)/bin/ruff check .
 	$(VENV)/bin/ruff format --check .
+
+# mypy on the ROS-free packages; what it checks and how strictly: [tool.mypy] in pyproject.toml.
+typecheck: bootstrap
+	$(VENV)/bin/mypy
 
 colcon-check: bootstrap
 	scripts/colcon_check.sh

@@ -2,7 +2,7 @@
 
 Runs every (site, variant, departure) combination, one run per worker process at a time, and
 prints the mean +- std coverage beside the authors' simulator measured on this project's
-machines (REFERENCE_OABUG_SIM.md §5), plus CPU and wall seconds per run, robot-metres
+machines (docs/oabug_reference.md), plus CPU and wall seconds per run, robot-metres
 simulated per wall second and the projected time of the 1000-run Small sweep. ``--path
 batch`` (the default) runs each mission on the batch path (:mod:`swarm_experiments.oabug_batch`:
 the same engine and OA-Bug controller without the runtime, equal trajectories); ``--path
@@ -49,7 +49,7 @@ class ReferenceSweep:
 
     Attributes:
         sites: how many generated sites the figures average over.
-        section: where REFERENCE_OABUG_SIM.md gives them.
+        section: the table of docs/oabug_reference.md that gives them.
         coverage: (departure, variant) -> mean and population std of coverage [%].
     """
 
@@ -69,49 +69,49 @@ def _reference(
     return ReferenceSweep(sites, section, coverage)
 
 
-# The authors' simulator as measured for this project (REFERENCE_OABUG_SIM.md §5), keyed by
+# The authors' simulator as measured for this project (docs/oabug_reference.md), keyed by
 # (configuration, robots). Mean and std of coverage [%] in the order random, minimum, sound,
 # gas, gas_sound. Only figures measured at the Table II budget are listed.
 REFERENCE: dict[tuple[str, int], ReferenceSweep] = {
     ('small', 10): _reference(
         100,
-        '§5.1',
+        'Figures',
         (15.53, 6.17, 28.17, 7.53, 33.20, 7.70, 96.07, 7.14, 96.27, 5.40),
         (8.10, 4.99, 20.33, 7.36, 25.57, 9.76, 84.17, 21.07, 95.43, 6.64),
     ),
     ('small', 8): _reference(
         30,
-        '§5.3',
+        'Small, robot count',
         (13.4, 5.6, 24.9, 8.5, 27.8, 9.7, 95.7, 7.5, 95.6, 5.3),
         (7.9, 6.1, 16.0, 8.5, 21.1, 9.7, 81.3, 22.3, 94.4, 7.1),
     ),
     ('small', 6): _reference(
         30,
-        '§5.3',
+        'Small, robot count',
         (11.6, 4.3, 19.7, 7.6, 22.2, 7.3, 93.9, 11.6, 92.7, 7.6),
         (7.1, 4.9, 15.3, 7.3, 18.9, 8.5, 75.4, 27.2, 90.7, 9.8),
     ),
     ('small', 4): _reference(
         30,
-        '§5.3',
+        'Small, robot count',
         (7.7, 4.6, 14.6, 8.1, 15.3, 6.2, 93.7, 10.7, 91.3, 8.6),
         (5.8, 4.4, 11.6, 4.8, 13.7, 6.4, 71.3, 22.0, 89.1, 12.9),
     ),
     ('small', 2): _reference(
         30,
-        '§5.3',
+        'Small, robot count',
         (5.8, 3.7, 7.6, 5.2, 7.3, 3.9, 82.2, 15.8, 72.9, 19.3),
         (3.8, 3.6, 6.7, 4.0, 7.1, 4.2, 72.2, 21.5, 59.4, 25.1),
     ),
     ('medium', 10): _reference(
         20,
-        '§5.2',
+        'Figures',
         (14.00, 4.52, 17.25, 4.63, 19.25, 4.55, 93.75, 5.62, 92.25, 4.51),
         (10.75, 3.63, 13.50, 5.05, 13.83, 6.28, 74.75, 27.09, 88.25, 6.66),
     ),
     ('big', 10): _reference(
         10,
-        '§5.4',
+        'Figures',
         (11.58, 3.81, 8.58, 1.40, 10.17, 2.13, 92.75, 3.12, 85.17, 4.39),
         (8.25, 2.78, 5.42, 3.06, 7.00, 2.18, 76.42, 18.37, 80.58, 8.43),
     ),
@@ -241,7 +241,7 @@ def format_table(outcomes: Sequence[Outcome], reference: ReferenceSweep | None) 
     else:
         lines.append(
             f"\nAuthors' simulator: the same configuration, robot count and Table II budget, "
-            f'{reference.sites} sites (REFERENCE_OABUG_SIM.md {reference.section}).'
+            f'{reference.sites} sites (docs/oabug_reference.md, {reference.section}).'
         )
     return '\n'.join(lines)
 
@@ -329,7 +329,7 @@ def _collect(jobs: list[Job], workers: int) -> list[Outcome]:
     thresholds = gc.get_threshold()
     try:
         # Each worker lives for the whole sweep: a new process pays about 1.5 s of CPU for
-        # the imports and the compiled kernels' cache load (docs/simulation.md), once.
+        # the imports and the compiled kernels' cache load (docs/notes/simulation.md), once.
         for outcome in map_jobs(
             run_job, jobs, workers=workers, ordered=False, initializer=quiet_garbage_collector
         ):

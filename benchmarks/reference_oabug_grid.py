@@ -3,13 +3,13 @@
 The authors' simulator (github.com/kevintsq/SwarmSearchSimulation, commit 9d16ebb) is not part
 of this project and none of its code is copied here: this script imports its modules from a
 checkout the user provides (``--simulator DIR``; it needs pygame and numpy) and follows the
-measurement protocol of REFERENCE_OABUG_SIM.md §5: site s is generated after
+measurement protocol of docs/oabug_reference.md: site s is generated after
 ``random.seed(1000003 * (s + 1))``, each run seeds ``random.seed(site_seed * 100 +
 algo_index * 2 + edge)``, all variants and departures run on the same sites, and coverage is
 taken at the end of the search (every room covered, or the action budget spent).
 
 ``--robot-hit-turn left`` makes a robot that hits another turn left instead of right (the
-grid's only change for the measurement in docs/oabug.md, "Why Gas trails Gas+Sound from the
+grid's only change for the measurement in docs/notes/oabug.md, "Why Gas trails Gas+Sound from the
 edge on the authors' grid"). The grid's Gas robot keeps walls on its right, so its right turn
 at a robot hit points it into its own wall, and two robots can lock each other for the rest
 of the run; the report counts the robots standing still over the last 50 actions of runs
@@ -58,7 +58,7 @@ LOCK_WINDOW_ACTIONS = 50
 
 @dataclass(frozen=True)
 class GridConfig:
-    """One of the paper's Table II configurations on the grid (REFERENCE_OABUG_SIM.md §5)."""
+    """One of the paper's Table II configurations on the grid."""
 
     width_cells: int
     height_cells: int
@@ -89,7 +89,7 @@ class GridRun:
 
 
 def site_seed(site: int, attempt: int = 0) -> int:
-    """Seed set before generating site ``site`` (REFERENCE_OABUG_SIM.md §5)."""
+    """Seed set before generating site ``site`` (docs/oabug_reference.md, "Protocol")."""
     return 1000003 * (site + 1) + attempt
 
 

@@ -20,6 +20,7 @@ extends the Cholesky factor block-wise instead of fitting a second GP.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -356,7 +357,7 @@ def _inverse_factor(chol: np.ndarray) -> np.ndarray:
 
 
 def _likelihood_derivatives(
-    log_params: tuple[float, float] | np.ndarray,
+    log_params: Sequence[float] | np.ndarray,
     sq: np.ndarray,
     y: np.ndarray,
     noise_variance: float,

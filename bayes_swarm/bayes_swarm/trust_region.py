@@ -9,6 +9,7 @@ a general-purpose optimiser for every call.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -16,7 +17,7 @@ __all__ = ['projected_newton_step']
 
 
 def projected_newton_step(
-    x: tuple[float, float] | np.ndarray,
+    x: Sequence[float] | np.ndarray,
     grad: np.ndarray,
     hess: np.ndarray,
     lower: tuple[float, float] | np.ndarray,

@@ -365,7 +365,7 @@ class ParticleFilterBank:
         used = len(self._ids)
 
         def grow(arr: np.ndarray | None, shape: tuple[int, ...], dtype: type) -> np.ndarray:
-            new = np.zeros(shape, dtype=dtype)
+            new: np.ndarray = np.zeros(shape, dtype=dtype)
             if arr is not None and used:
                 new[:used] = arr[:used]
             return new
@@ -594,7 +594,9 @@ class ParticleFilterBank:
             out -= censor
         return out
 
-    def _add_extra_samples(self, q: np.ndarray, x: np.ndarray, y: np.ndarray, extra: np.ndarray):
+    def _add_extra_samples(
+        self, q: np.ndarray, x: np.ndarray, y: np.ndarray, extra: np.ndarray
+    ) -> None:
         """Add the misfits of the later samples to ``q`` (rows of the first samples).
 
         ``extra`` holds (row, observer x, observer y, P - P0) per sample, level by level; the
@@ -713,6 +715,7 @@ class ParticleFilterBank:
                     w, offsets, self._w_index[:k], self._w_cum[:k], dx.view(np.int32)
                 ).reshape(-1)
             else:
+                assert counts is not None  # one of the two draws is set
                 index = np.repeat(self._flat_index[: k * n], counts.ravel())
             # 'clip' writes straight to out (the default mode buffers); the index is in range.
             np.take(x.reshape(-1), index, out=new_x.reshape(-1), mode='clip')
@@ -794,6 +797,7 @@ class ParticleFilterBank:
         if offsets is not None:
             index = systematic_index(w32, offsets).reshape(-1)
         else:
+            assert counts is not None  # one of the two draws is set
             index = np.repeat(np.arange(self._n), counts.ravel())
         new_x = self._x[slot][index][None, :]
         new_y = self._y[slot][index][None, :]
@@ -828,6 +832,7 @@ class ParticleFilterBank:
         with :mod:`msc_pf.pf_kernel`; the first samples' offsets and squared distances go to
         ``dx``, ``dy``, ``d2``. ``log10`` stays numpy's (one call per block of samples)."""
         kernel = self._kernel
+        assert kernel is not None  # only called with the compiled backend
         k = x.shape[0]
         # q holds the first samples' logs until their misfits replace them, element by element.
         blocks = [(self._row_numbers[:k], first[:, 0], first[:, 1], first[:, 2], q)]

@@ -147,7 +147,7 @@ def add_misfit(
 
 
 @njit(cache=True)
-def _cumulate(weights: np.ndarray, cumulative: np.ndarray) -> float:  # pragma: no cover
+def _cumulate(weights: np.ndarray, cumulative: np.ndarray) -> np.float32:  # pragma: no cover
     """Sequential float32 cumulative sum of one row (``np.cumsum``'s order); returns the
     total."""
     acc = np.float32(0.0)

@@ -303,7 +303,9 @@ class RobotController:
     ) -> None:
         """Keep every (time, x, y, RSSI) sample of the recent window, own and neighbours'."""
         horizon = now_s - self.config.msc.pbest_window * self.config.period_s
-        batches = [(position[0], position[1], own.items())]
+        batches: list[tuple[float, float, Iterable[tuple[int, float]]]] = [
+            (position[0], position[1], own.items())
+        ]
         batches += [(p.position_m[0], p.position_m[1], p.readings) for p in fresh]
         for x, y, readings in batches:
             for target, value in readings:
@@ -332,9 +334,11 @@ class RobotController:
     ) -> list[str]:
         assert self._bank is not None
         events: list[str] = []
-        batches = [(position, own)]
+        batches: list[tuple[np.ndarray, Mapping[int, float]]] = [(position, own)]
         for peer in fresh:
-            batch = {t: v for t, v in peer.readings if math.isfinite(v) and t not in self._captured}
+            batch: Mapping[int, float] = {
+                t: v for t, v in peer.readings if math.isfinite(v) and t not in self._captured
+            }
             if batch:
                 batches.append((np.asarray(peer.position_m, dtype=np.float64), batch))
         observations = []

@@ -409,8 +409,8 @@ class PhaseConfig:
             'can directly approach the searching target once its location estimation is '
             'converged"). Off by default: MSC+PF filters often converge at the detection '
             'edge on a wrong point, and following such an estimate after the signal is gone '
-            'cost MSC+PF seed 0 (10 targets) 13419 s of CCT instead of 4888 s; off, the '
-            'robot searches again once nothing is heard.'
+            'leads the swarm away from the target (docs/msc_pf.md); off, the robot '
+            'searches again once nothing is heard.'
         ),
     )
     retarget_unconverged: bool = parameter(
@@ -453,8 +453,7 @@ class PhaseConfig:
             'gamma_D), so an estimate on the wrong side of the ring of distances a far '
             "swarm observed moves to the side not yet ruled out. The paper's filter uses "
             "only the samples heard; this is the same observation model's other half. Off "
-            'by default: on 8 screened runs it fixed such losses but did not lower the mean '
-            'CCT.'
+            'by default: it did not lower the mean CCT (docs/notes/msc_pf.md).'
         ),
     )
     unheard_exhausted_share: float = parameter(

@@ -245,7 +245,7 @@ class OABugFsm:
             if mem.mode is Mode.TURN:
                 error = angle_difference(mem.target_yaw_rad, snap.yaw_rad)
                 return turn_in_place(error, cfg.motion)
-            if mem.mode is Mode.WRAP:
+            if mem.mode is Mode.WRAP:  # type: ignore[comparison-overlap]  # set by _wrap
                 return wrap_corner(mem.wall_side, cfg.motion)
         wall = scan.side(mem.wall_side)
         if mem.mode is Mode.FOLLOW and self._wall_lost(wall.found, front_blocked, yaw_change):

@@ -234,7 +234,7 @@ class MotionConfig:
             authors' grid robots hug their wall at 0.1-0.2 m centre to wall; 0.15 m is the
             middle of that range and the closest a lidar with the RPLidar A1's 0.15 m minimum
             range still measures (nearer returns read -inf, i.e. at the minimum range).
-            Measured against 0.16, 0.18 and 0.2 m in docs/oabug_measurements.md.
+            Chosen against 0.16, 0.18 and 0.2 m (docs/notes/oabug_measurements.md).
         wall_distance_gain_radps_per_m: yaw rate per metre of wall-distance error [rad/(s m)].
         wall_angle_gain_per_s: yaw rate per radian of wall-direction error [1/s].
         random_step_m: the Random variant redraws its heading with probability
@@ -317,8 +317,9 @@ class OABugConfig:
         robot_hit_turn: side turned to by 90 deg after hitting another robot (paper: "all
             turn right"). Turning towards the followed wall, as the authors' simulator does
             (fixed_turn left, walls on the right, robot hits right), can lock two robots
-            for good: turn into the wall, turn back to the peer, hit it again (measured in
-            docs/oabug.md, "Why Gas trails Gas+Sound from the edge on the authors' grid").
+            for good: turn into the wall, turn back to the peer, hit it again
+            (docs/notes/oabug.md, "Why Gas trails Gas+Sound from the edge on the authors'
+            grid").
         robot_hit_repeat_s: a robot hit this soon after the previous one turns to a random
             heading instead of ``robot_hit_turn``, to break jams of two robots (0
             disables) [s].
@@ -332,8 +333,8 @@ class OABugConfig:
             paper's discussion explains Gas+Sound's lead from the edge by robots that "turn
             in different directions" when first hitting the wall. Default (not Table I):
             the first contact only, the fixed side after it, so followers keep one hand and
-            do not meet head on along a wall; measured against every contact and never in
-            docs/oabug.md ("The wall side of Gas+Sound").
+            do not meet head on along a wall; compared with every contact and never in
+            docs/notes/oabug.md ("The wall side of Gas+Sound").
         sound_side_deadband_rad: for the Sound variant, a theta_opp within this angle of
             straight ahead or straight behind gives no side (both turns point equally
             towards it, and bearing noise decides): such a contact takes ``fixed_turn``.
@@ -341,8 +342,8 @@ class OABugConfig:
             Sound variant, which has no scent trail, spreads by those split sides [rad].
         gas_sound_side_deadband_rad: the same for Gas+Sound. Default 45 deg (not in the
             paper): robots that leave the centre in a symmetric fan hear their peers behind
-            them, and splitting their sides at random cost Gas+Sound 3-14 points of
-            coverage with 2-8 robots; measured in docs/oabug.md ("Robot count") [rad].
+            them, and splitting their sides at random lowers Gas+Sound's coverage with 2-8
+            robots (docs/notes/oabug.md, "Robot count") [rad].
         sound_weighting: see SoundWeighting (paper: distance).
         sound_memory: see SoundMemory; the paper's text says stored, its 180 deg flip
             ("an area symmetrical ... with respect to the departure point") only makes sense

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from typing import overload
 
 import numpy as np
 
@@ -17,6 +18,10 @@ __all__ = [
 TWO_PI = 2.0 * math.pi
 
 
+@overload
+def wrap_angle(angle_rad: float) -> float: ...
+@overload
+def wrap_angle(angle_rad: np.ndarray) -> np.ndarray: ...
 def wrap_angle(angle_rad: np.ndarray | float) -> np.ndarray | float:
     """Wrap angles [rad] to (-pi, pi]: a float for a scalar, an array for an array.
 

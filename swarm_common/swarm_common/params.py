@@ -40,7 +40,7 @@ import math
 import re
 import types
 import typing
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import MISSING, dataclass
 from enum import Enum
 from typing import Any
@@ -422,7 +422,7 @@ class ParameterDef:
         if isinstance(value, float) and not math.isfinite(value) and info.finite:
             raise error(self.name, f'must be a finite number, got {value!r}')
         unit = f' {info.unit}' if info.unit else ''
-        bounds = (
+        bounds: tuple[tuple[str, Any, Callable[[Any, Any], bool]], ...] = (
             ('>=', info.ge, lambda v, b: v >= b),
             ('>', info.gt, lambda v, b: v > b),
             ('<=', info.le, lambda v, b: v <= b),
@@ -555,7 +555,7 @@ class ParameterSpec:
             raise SpecError(f'{root.__name__}: parameter names used twice: {", ".join(twice)}')
 
     def _walk(
-        self, cls: type, instance: Any, path: tuple[str, ...], prefix: str, out: list
+        self, cls: type, instance: Any, path: tuple[str, ...], prefix: str, out: list[ParameterDef]
     ) -> None:
         hints = typing.get_type_hints(cls)
         for f in dataclasses.fields(cls):

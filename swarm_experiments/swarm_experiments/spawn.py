@@ -370,7 +370,7 @@ def _parser() -> argparse.ArgumentParser:
     parser = ToolParser(
         prog='spawn',
         description=(
-            'Run an OA-Bug swarm search in the simulation until every room is covered '
+            'Run an OA-Bug swarm search in the simulator until every room is covered '
             'or the action budget ends; print the coverage summary and write the plots.'
         ),
         epilog=SPAWNER_EXIT_CODES,

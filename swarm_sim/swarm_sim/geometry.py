@@ -5,9 +5,8 @@ metres. Robots are discs. Everything here is pure and deterministic.
 
 The lidar caster works per (robot, wall) pair on the angular interval the wall covers as seen
 from the robot, so its cost grows with the number of bins actually hit (a few thousand per
-robot in a room-and-corridor site) rather than with bins x walls. On this project's Small
-sites it is about 30 times faster than pybullet's ``rayTestBatch`` for the same rays (see
-docs/simulation.md for the measurement).
+robot in a room-and-corridor site) rather than with bins x walls, which makes it much faster
+than pybullet's ``rayTestBatch`` for the same rays (docs/notes/simulation.md).
 """
 
 from __future__ import annotations

@@ -19,7 +19,7 @@ catch if a platform broke them:
 Faces within ``near_range_m`` and the other robots' discs are cast first, then the farther
 faces that may still be visible, with the numpy caster's conservative sector test. The kernel
 is compiled on first use and cached next to this module (``cache=True``): a process pays the
-numba import and the cache load once (docs/simulation.md has the figures).
+numba import and the cache load once (docs/notes/simulation.md).
 """
 
 from __future__ import annotations

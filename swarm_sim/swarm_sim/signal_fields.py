@@ -25,7 +25,7 @@ Choices where the paper is silent or inconsistent (see docs/bayes_swarm.md):
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 from typing import Protocol
 
 import numpy as np
@@ -119,7 +119,11 @@ class DipoleField:
 
     @classmethod
     def with_peak(
-        cls, beacon_m: tuple[float, float], depth_m: float, peak: float, direction=(1.0, 0.0, 0.0)
+        cls,
+        beacon_m: tuple[float, float],
+        depth_m: float,
+        peak: float,
+        direction: tuple[float, float, float] = (1.0, 0.0, 0.0),
     ) -> DipoleField:
         """Dipole whose |H| directly above a horizontal moment equals ``peak``."""
         unit = np.asarray(direction, dtype=float)
@@ -161,7 +165,7 @@ class SignalCase:
     direction_range_deg: float
     observation_rate_hz: float = 1.0
     default_robots: int = 5
-    depot_direction_offsets_deg: tuple[float, ...] = field(default=(0.0,))
+    depot_direction_offsets_deg: tuple[float, ...] = (0.0,)
     dimensionless_acquisition: bool = False
 
     def depot_of(self, robot_index: int) -> int:

@@ -103,6 +103,7 @@ class SignalMissionModel:
 
     def _detect(self, time_s: float, pos: np.ndarray) -> None:
         best: tuple[float, int] | None = None
+        assert self._last_positions is not None  # set by the first step
         for i, (p0, p1) in enumerate(zip(self._last_positions, pos, strict=True)):
             s = first_entry_fraction(p0, p1, self.case.source_m, self.case.detection_radius_m)
             if s is not None:

@@ -1,4 +1,4 @@
-"""Exhaustive partitioned boustrophedon sweep (ALGORITHM_SPECS.md §4).
+"""Exhaustive partitioned boustrophedon sweep (docs/bayes_swarm.md).
 
 The arena is cut into equal vertical strips, one per robot ('strips'), or into quadrants
 that are shared out among the robots and then cut into strips ('quadrants', the paper's
@@ -34,9 +34,9 @@ def partition_arena(arena: Arena, n_robots: int, partition: str = 'strips') -> l
     for quarter in (0, 2, 1, 3)[: n_robots % 4]:  # extra robots: 1st, 3rd, 2nd quarter
         counts[quarter] += 1
     parts: list[Arena] = []
-    for quarter, count in zip(quarters, counts, strict=True):
+    for area, count in zip(quarters, counts, strict=True):
         if count:
-            parts.extend(_strips(quarter, count))
+            parts.extend(_strips(area, count))
     return parts
 
 

@@ -240,7 +240,7 @@ class DaskEngine(Engine):
     def close(self) -> None:
         client = getattr(self, '_client', None)
         if client is not None:
-            self._client = None
+            self._client = None  # type: ignore[assignment]  # closed: never used again
             client.close()
         cluster, self._cluster = self._cluster, None
         if cluster is not None:

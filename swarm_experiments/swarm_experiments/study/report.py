@@ -56,7 +56,8 @@ def _format(value: Any, digits: int) -> str:
     if isinstance(value, (float, np.floating)):
         if math.isnan(value):
             return ''
-        if value != 0 and (abs(value) >= 10**6 or abs(value) < 10 ** (-digits)):
+        magnitude = abs(float(value))
+        if value != 0 and (magnitude >= 10**6 or magnitude < 10.0 ** (-digits)):
             return f'{value:.{digits}g}'
         return f'{value:.{digits}f}'
     if isinstance(value, (list, tuple, np.ndarray)):

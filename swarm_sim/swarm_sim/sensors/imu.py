@@ -1,4 +1,4 @@
-"""Gyro-integrated yaw, as the MPU6050 driver computes it (HARDWARE.md §3.5-3.6).
+"""Gyro-integrated yaw, as the MPU6050 driver computes it (docs/hardware.md, "Sensor figures").
 
 The measured yaw rate is the true rate plus white noise (the MPU6050's rate noise density is
 0.005 deg/s/sqrt(Hz)) plus a residual bias left after the start-up calibration, which may

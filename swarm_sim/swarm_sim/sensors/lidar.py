@@ -1,7 +1,8 @@
 """RPLidar A1 model: 360 one-degree bins, 0.15-12 m, range noise and dropouts.
 
-Figures from the A1 datasheet and HARDWARE.md §2.7: range 0.15-12 m, angular resolution about
-1 degree, 5.5 Hz rotation in standard mode, distance resolution better than 1 % of the range.
+Figures from the A1 datasheet (docs/hardware.md, "Sensor figures"): range 0.15-12 m, angular
+resolution about 1 degree, 5.5 Hz rotation in standard mode, distance resolution better than
+1 % of the range.
 Following REP 117 as the RPLidar driver does: no return within range_max_m and dropped
 samples are ``+inf``, returns closer than range_min_m are ``-inf``.
 """

@@ -53,7 +53,7 @@ from dataclasses import dataclass
 from enum import StrEnum
 from functools import cached_property
 from pathlib import Path
-from typing import Final
+from typing import Any, Final
 
 import numpy as np
 from scipy import ndimage
@@ -627,10 +627,12 @@ class _SiteBuilder:
         r0, r1, c0, c1 = int(rows.min()), int(rows.max()), int(cols.min()), int(cols.max())
         named = f'room {room.label!r} is not closed'
         what = "neither '%' nor a door mark ('/' or '#')"
-        first = tuple(int(v) for v in np.argwhere(holes)[0])
+        first_row, first_col = (int(v) for v in np.argwhere(holes)[0])
         if not np.all(letters[r0 : r1 + 1, c0 : c1 + 1]):  # not a rectangle
-            return self.error(*first, f'{named}: its wall has an opening here, {what}')
-        lines = {
+            return self.error(
+                first_row, first_col, f'{named}: its wall has an opening here, {what}'
+            )
+        lines: dict[str, tuple[Any, Any]] = {
             'top': (r0 - 1, slice(c0, c1 + 1)),
             'bottom': (r1 + 1, slice(c0, c1 + 1)),
             'left': (slice(r0, r1 + 1), c0 - 1),
@@ -646,7 +648,7 @@ class _SiteBuilder:
                     span = f'column {col + 1}, lines {r0 + 1}-{r1 + 1}'
                     place = (r0, int(col))
                 return self.error(*place, f'{named}: its {side} wall ({span}) is missing')
-        r, c = first
+        r, c = first_row, first_col
         sides = [s for s, hit in zip(_SIDES, (r < r0, r > r1, c < c0, c > c1), strict=True) if hit]
         where = f'{sides[0]} wall' if len(sides) == 1 else f'{sides[0]}-{sides[1]} corner'
         return self.error(r, c, f'{named}: its {where} has an opening here, {what}')

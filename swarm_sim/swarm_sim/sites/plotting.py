@@ -16,7 +16,7 @@ from matplotlib.axes import Axes
 from matplotlib.collections import LineCollection, PatchCollection
 from matplotlib.colors import ListedColormap
 from matplotlib.figure import Figure
-from matplotlib.patches import Polygon, Rectangle
+from matplotlib.patches import Patch, Polygon, Rectangle
 from scipy import ndimage
 from swarm_common.outputs import atomic_output
 
@@ -63,7 +63,7 @@ def draw_site(
     if shade_solid and site.departure_points:
         _shade_unreachable(ax, site)
     colours = dict(room_colors or {})
-    patches = []
+    patches: list[Patch] = []
     faces = []
     for room in site.rooms:
         face = colours.get(room.room_id, VICTIM_FILL if room.has_victim else ROOM_FILL)
@@ -75,19 +75,17 @@ def draw_site(
             faces.append(face)
     if patches:
         ax.add_collection(PatchCollection(patches, facecolors=faces, edgecolors='none', zorder=1))
+    # The segments go in as (N, 2, 2) arrays, which matplotlib takes; its stubs say Sequence.
     if len(site.walls):
-        ax.add_collection(
-            LineCollection(
-                site.walls.reshape(-1, 2, 2), colors='black', linewidths=wall_width_pt, zorder=3
-            )
-        )
+        walls: Any = site.walls.reshape(-1, 2, 2)
+        ax.add_collection(LineCollection(walls, colors='black', linewidths=wall_width_pt, zorder=3))
     if show_doors and site.doors:
-        segments = np.array([door.segment for door in site.doors]).reshape(-1, 2, 2)
+        segments: Any = np.array([door.segment for door in site.doors]).reshape(-1, 2, 2)
         ax.add_collection(
             LineCollection(segments, colors='#888888', linewidths=0.6, linestyles=':', zorder=2)
         )
     if site.entrance is not None:
-        entrance = np.asarray(site.entrance.segment).reshape(1, 2, 2)
+        entrance: Any = np.asarray(site.entrance.segment).reshape(1, 2, 2)
         ax.add_collection(
             LineCollection(
                 entrance, colors=_ENTRANCE_COLOUR, linewidths=2 * wall_width_pt, zorder=3

@@ -66,10 +66,10 @@ def site_to_dict(site: Site) -> dict[str, Any]:
     data['bounds'] = {'width_m': _round(site.width_m), 'height_m': _round(site.height_m)}
     points: dict[str, Any] = {}
     for name, point in site.departure_points.items():
-        entry = {'x_m': _round(point.x_m), 'y_m': _round(point.y_m)}
+        point_entry = {'x_m': _round(point.x_m), 'y_m': _round(point.y_m)}
         if point.heading_rad is not None:
-            entry['heading_rad'] = _round(point.heading_rad)
-        points[name] = entry
+            point_entry['heading_rad'] = _round(point.heading_rad)
+        points[name] = point_entry
     data['departure_points'] = points
     if site.entrance is not None:
         data['entrance'] = _door_to_dict(site.entrance)
@@ -262,7 +262,7 @@ class _Reader:
         seed = top.get('seed')
         grid = top.get('grid_m')
         entrance = top.get('entrance')
-        parts = {
+        parts: dict[str, Any] = {
             'name': self.text(top['name'], ('name',)),
             'walls': self.each(top['walls'], ('walls',), self.wall),
             'rooms': tuple(self.each(top.get('rooms') or [], ('rooms',), self.room)),
@@ -325,7 +325,8 @@ class _Reader:
         label = entry.get('label', '')
         if not isinstance(label, str):
             label = str(label)
-        return Room(room_id, rects, label=label, has_victim=victim, polygon=polygon)
+        # Room's __post_init__ turns the lists into read-only float arrays.
+        return Room(room_id, rects, label=label, has_victim=victim, polygon=polygon)  # type: ignore[arg-type]
 
     def door(self, value: Any, path: KeyPath) -> Door:
         entry = self.mapping(value, path, ('segment', 'rooms'), ('segment',))

@@ -253,7 +253,9 @@ def _room_name(room: Room) -> str:
 
 
 def _check_door_widths(site: Site, robot_radius_m: float) -> None:
-    doors = [(('doors', i), door, 'door') for i, door in enumerate(site.doors)]
+    doors: list[tuple[tuple[str | int, ...], Door, str]] = [
+        (('doors', i), door, 'door') for i, door in enumerate(site.doors)
+    ]
     if site.entrance is not None:
         doors.append((('entrance',), site.entrance, 'the entrance'))
     for key_path, door, what in doors:
