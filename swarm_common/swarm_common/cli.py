@@ -23,7 +23,7 @@ import argparse
 import sys
 import traceback
 from collections.abc import Callable, Sequence
-from typing import NoReturn, TextIO
+from typing import Any, NoReturn, TextIO
 
 __all__ = [
     'EXIT_CODES_HELP',
@@ -103,9 +103,9 @@ class ToolParser(argparse.ArgumentParser):
         if debug_option:
             self.add_argument('--debug', action='store_true', help='show the traceback of an error')
 
-    def add_subparsers(self, **kwargs: object) -> argparse._SubParsersAction:  # type: ignore[override]
+    def add_subparsers(self, **kwargs: Any) -> Any:
         kwargs.setdefault('parser_class', _SubcommandParser)
-        return super().add_subparsers(**kwargs)  # type: ignore[arg-type]
+        return super().add_subparsers(**kwargs)
 
     def error(self, message: str) -> NoReturn:
         from swarm_common.errors import UsageError
