@@ -19,7 +19,6 @@ truncates its .mcap file there, reads it back with recovery and prints:
 
 from __future__ import annotations
 
-import argparse
 import shlex
 import shutil
 import subprocess
@@ -29,6 +28,8 @@ import time
 import warnings
 from pathlib import Path
 
+from swarm_common.cli import ToolParser, run_tool
+from swarm_common.errors import UsageError
 from swarm_runtime.bag.testing import message_record_ends
 
 DEFAULT_CUTS = (0.1, 0.25, 0.5, 0.75, 0.9, 0.99)
@@ -67,12 +68,14 @@ def recovered_count(bag: Path) -> int:
         return sum(1 for _ in read_messages(bag, allow_truncated=True, raw=True))
 
 
-def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+def _main(argv: list[str]) -> int:
+    parser = ToolParser(prog='bench_bag_recovery', description=__doc__.splitlines()[0])
     parser.add_argument('--bag', type=Path, help='bag to cut (default: record a mission)')
     parser.add_argument('--cuts', type=float, nargs='+', default=list(DEFAULT_CUTS))
     args = parser.parse_args(argv)
-    print('command:', shlex.join([Path(sys.argv[0]).name, *sys.argv[1:]]))
+    if any(not 0.0 <= fraction <= 1.0 for fraction in args.cuts):
+        raise UsageError(f'--cuts are fractions of the file in [0, 1], got {args.cuts}')
+    print('command:', shlex.join([Path(sys.argv[0]).name, *argv]))
 
     with tempfile.TemporaryDirectory() as tmp:
         work = Path(tmp)
@@ -98,6 +101,11 @@ def main(argv: list[str] | None = None) -> int:
             )
             shutil.rmtree(copy)
     return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Command-line entry point; exit codes as every tool's (docs/conventions.md)."""
+    return run_tool('bench_bag_recovery', _main, argv)
 
 
 if __name__ == '__main__':

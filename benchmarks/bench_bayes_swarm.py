@@ -34,17 +34,19 @@ import os
 for _var in ('OMP_NUM_THREADS', 'OPENBLAS_NUM_THREADS', 'MKL_NUM_THREADS'):
     os.environ.setdefault(_var, '1')
 
-import argparse  # noqa: E402
 import math  # noqa: E402
 import sys  # noqa: E402
 import time  # noqa: E402
-from concurrent.futures import ProcessPoolExecutor  # noqa: E402
 from dataclasses import dataclass, field, replace  # noqa: E402
 from pathlib import Path  # noqa: E402
 from typing import Any  # noqa: E402
 
 import numpy as np  # noqa: E402
 from bayes_swarm.messages import DecisionKind  # noqa: E402
+from swarm_common.cli import EXIT_INTERRUPTED, ToolParser, fail, run_tool  # noqa: E402
+from swarm_common.errors import UsageError  # noqa: E402
+from swarm_common.jobs import map_jobs  # noqa: E402
+from swarm_common.outputs import check_output_file, write_text_atomic  # noqa: E402
 from swarm_experiments.bayes_batch import MissionSpec, run_mission  # noqa: E402
 from swarm_experiments.spawn_bayes_swarm import batch_mission_spec  # noqa: E402
 from swarm_sim.signal_fields import avalanche_case, get_case  # noqa: E402
@@ -369,23 +371,40 @@ def run(
     first_seed: int = 0,
     progress: bool = True,
 ) -> list[dict[str, str]]:
-    """Run the experiments and return the table rows (one per job)."""
+    """Run the experiments and return the table rows (one per job).
+
+    Raises:
+        Interrupted: Ctrl-C; its ``rows`` summarize the runs that finished.
+    """
     jobs = plan_jobs(experiments, runs, baseline_runs, large_runs)
     tasks = [(i, job, first_seed + s) for i, job in enumerate(jobs) for s in range(job.runs)]
     results: list[list[RunOutcome]] = [[] for _ in jobs]
-    if processes > 1:
-        with ProcessPoolExecutor(max_workers=processes) as pool:
-            for index, job, seed, outcome in pool.map(_run_job, tasks):
-                results[index].append(outcome)
-                if progress:
-                    _report(job, seed, outcome)
-    else:
-        for task in tasks:
-            index, job, seed, outcome = _run_job(task)
+
+    def rows() -> list[dict[str, str]]:
+        return [
+            summarize(job, outcomes)
+            for job, outcomes in zip(jobs, results, strict=True)
+            if outcomes
+        ]
+
+    try:
+        for index, job, seed, outcome in map_jobs(_run_job, tasks, workers=processes):
             results[index].append(outcome)
             if progress:
                 _report(job, seed, outcome)
-    return [summarize(job, outcomes) for job, outcomes in zip(jobs, results, strict=True)]
+    except KeyboardInterrupt:
+        raise Interrupted(rows(), sum(len(r) for r in results), len(tasks)) from None
+    return rows()
+
+
+class Interrupted(KeyboardInterrupt):
+    """Ctrl-C during :func:`run`; ``rows`` summarize the ``done`` of ``planned`` runs."""
+
+    def __init__(self, rows: list[dict[str, str]], done: int, planned: int) -> None:
+        super().__init__()
+        self.rows = rows
+        self.done = done
+        self.planned = planned
 
 
 def _report(job: Job, seed: int, outcome: RunOutcome) -> None:
@@ -399,7 +418,13 @@ def _report(job: Job, seed: int, outcome: RunOutcome) -> None:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
+    """Command-line entry point; exit codes as every tool's (docs/conventions.md);
+    130 after Ctrl-C with the table of the finished runs printed and written."""
+    return run_tool('bench_bayes_swarm', _main, argv)
+
+
+def _main(argv: list[str]) -> int:
+    parser = ToolParser(prog='bench_bayes_swarm', description=__doc__.split('\n\n')[0])
     parser.add_argument('--experiments', nargs='+', choices=EXPERIMENTS, default=list(EXPERIMENTS))
     parser.add_argument('--runs', type=int, default=20, help='seeds per Bayes-Swarm row')
     parser.add_argument('--baseline-runs', type=int, default=5, help='seeds per baseline row')
@@ -409,19 +434,38 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument('--out', type=Path, default=None, help='also write the table here')
     parser.add_argument('--quiet', action='store_true', help='no per-run progress on stderr')
     args = parser.parse_args(argv)
-    rows = run(
-        args.experiments,
-        runs=args.runs,
-        baseline_runs=args.baseline_runs,
-        large_runs=args.large_runs,
-        processes=args.processes,
-        first_seed=args.first_seed,
-        progress=not args.quiet,
-    )
+    for name in ('runs', 'baseline_runs', 'large_runs'):
+        if getattr(args, name) < 1:
+            flag = '--' + name.replace('_', '-')
+            raise UsageError(f'{flag} must be >= 1, got {getattr(args, name)}')
+    if args.first_seed < 0:
+        raise UsageError(f'--first-seed must be >= 0, got {args.first_seed}')
+    if args.out is not None:
+        check_output_file(args.out, option='--out')
+    interrupted = None
+    try:
+        rows = run(
+            args.experiments,
+            runs=args.runs,
+            baseline_runs=args.baseline_runs,
+            large_runs=args.large_runs,
+            processes=args.processes,
+            first_seed=args.first_seed,
+            progress=not args.quiet,
+        )
+    except Interrupted as stop:
+        interrupted, rows = stop, stop.rows
     table = format_table(rows)
     print(table)
     if args.out is not None:
-        args.out.write_text(table + '\n')
+        write_text_atomic(args.out, table + '\n')
+    if interrupted is not None:
+        fail(
+            'bench_bayes_swarm',
+            f'interrupted: the table covers the {interrupted.done} of {interrupted.planned} '
+            'runs that finished',
+        )
+        return EXIT_INTERRUPTED
     return 0
 
 

@@ -17,7 +17,6 @@ Runs the drivers one after the other so that they do not compete for the cores.
 
 from __future__ import annotations
 
-import argparse
 import os
 import signal
 import subprocess
@@ -26,6 +25,10 @@ import tempfile
 import time
 from dataclasses import dataclass
 from pathlib import Path
+
+from swarm_common.cli import ToolParser, run_tool
+from swarm_common.errors import UsageError
+from swarm_common.outputs import check_output_file, write_text_atomic
 
 DRIVERS: dict[str, tuple[str, tuple[str, ...]]] = {
     'rplidar_node': ('hw_drivers.rplidar_node', ()),
@@ -127,15 +130,18 @@ def format_table(rows: list[IdleRow]) -> str:
     return '\n'.join(lines)
 
 
-def main() -> None:
-    """Command line."""
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+def _main(argv: list[str]) -> int:
+    parser = ToolParser(prog='bench_driver_idle', description=__doc__.splitlines()[0])
     parser.add_argument('--runtime', choices=('rclpy', 'builtin', 'both'), default='both')
     parser.add_argument('--seconds', type=float, default=10.0)
     parser.add_argument('--warmup', type=float, default=4.0)
     parser.add_argument('--drivers', nargs='*', default=list(DRIVERS), choices=list(DRIVERS))
     parser.add_argument('--output', default='', help='also write the table to this file')
-    args = parser.parse_args()
+    args = parser.parse_args(argv)
+    if not (args.seconds > 0.0 and args.warmup >= 0.0):
+        raise UsageError('--seconds must be > 0 and --warmup >= 0')
+    if args.output:
+        check_output_file(args.output, option='--output')
     runtimes = ('rclpy', 'builtin') if args.runtime == 'both' else (args.runtime,)
     rows = []
     domain_id = 150 + os.getpid() % 50
@@ -150,8 +156,14 @@ def main() -> None:
     table = format_table(rows)
     print(table)
     if args.output:
-        Path(args.output).write_text(table + '\n', encoding='utf-8')
+        write_text_atomic(args.output, table + '\n')
+    return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Command-line entry point; exit codes as every tool's (docs/conventions.md)."""
+    return run_tool('bench_driver_idle', _main, argv)
 
 
 if __name__ == '__main__':
-    main()
+    sys.exit(main())

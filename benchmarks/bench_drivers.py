@@ -24,7 +24,7 @@ seeded generator:
 
 from __future__ import annotations
 
-import argparse
+import sys
 import time
 from collections import Counter
 from collections.abc import Iterable
@@ -42,6 +42,9 @@ from hw_drivers.rplidar_protocol import (
     bin_revolution,
     decode_samples,
 )
+from swarm_common.cli import ToolParser, run_tool
+from swarm_common.errors import UsageError
+from swarm_common.outputs import check_output_file, write_text_atomic
 
 A1_PEAK_SAMPLES_PER_S = 8000.0
 PI4_SLOWDOWN = 5.0
@@ -304,25 +307,34 @@ def quality_table(seeds: int, junk_kb: int) -> str:
     return '\n'.join(lines)
 
 
-def main() -> None:
-    """Command line."""
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+def _main(argv: list[str]) -> int:
+    parser = ToolParser(prog='bench_drivers', description=__doc__.splitlines()[0])
     parser.add_argument('--revolutions', type=int, default=200)
     parser.add_argument('--repeats', type=int, default=3)
     parser.add_argument('--quality', action='store_true', help='resynchronisation figures')
     parser.add_argument('--seeds', type=int, default=20, help='streams per quality scenario')
     parser.add_argument('--junk-kb', type=int, default=2000, help='pure junk for phantoms/kB')
     parser.add_argument('--output', default='', help='also write the table to this file')
-    args = parser.parse_args()
+    args = parser.parse_args(argv)
+    for name in ('revolutions', 'repeats', 'seeds'):
+        if getattr(args, name) < 1:
+            raise UsageError(f'--{name} must be >= 1, got {getattr(args, name)}')
+    if args.output:
+        check_output_file(args.output, option='--output')
     if args.quality:
         table = quality_table(args.seeds, args.junk_kb)
     else:
         table = format_table(run(revolutions=args.revolutions, repeats=args.repeats))
     print(table)
     if args.output:
-        with open(args.output, 'w', encoding='utf-8') as handle:
-            handle.write(table + '\n')
+        write_text_atomic(args.output, table + '\n')
+    return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Command-line entry point; exit codes as every tool's (docs/conventions.md)."""
+    return run_tool('bench_drivers', _main, argv)
 
 
 if __name__ == '__main__':
-    main()
+    sys.exit(main())

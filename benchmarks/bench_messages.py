@@ -11,7 +11,6 @@ in microseconds per call, in one process. Example::
 
 from __future__ import annotations
 
-import argparse
 import os
 import subprocess
 import sys
@@ -20,6 +19,8 @@ from collections.abc import Callable
 from typing import Any
 
 import numpy as np
+from swarm_common.cli import ToolParser, run_tool
+from swarm_common.errors import UsageError
 
 
 def _cases() -> dict[str, Callable[[], Any]]:
@@ -94,12 +95,14 @@ def measure(number: int, repeat: int) -> list[tuple[str, float, float, float, fl
     return rows
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.split('\n', 1)[0])
+def _main(argv: list[str]) -> int:
+    parser = ToolParser(prog='bench_messages', description=__doc__.split('\n', 1)[0])
     parser.add_argument('--number', type=int, default=5000, help='calls per timing run')
     parser.add_argument('--repeat', type=int, default=5, help='timing runs (best is kept)')
     parser.add_argument('--checks', choices=('both', 'on', 'off'), default='both')
-    args = parser.parse_args()
+    args = parser.parse_args(argv)
+    if args.number < 1 or args.repeat < 1:
+        raise UsageError('--number and --repeat must be >= 1')
     if args.checks == 'both':
         # ROS_PYTHON_CHECK_FIELDS is read once per process (as rclpy does): one child per setting.
         for setting in ('on', 'off'):
@@ -117,14 +120,20 @@ def main() -> None:
                 check=True,
                 env={**os.environ, 'ROS_PYTHON_CHECK_FIELDS': '1' if setting == 'on' else '0'},
             )
-        return
+        return 0
     setting = os.environ.get('ROS_PYTHON_CHECK_FIELDS', '')
     print(f'field checks {args.checks} (ROS_PYTHON_CHECK_FIELDS={setting})')
     columns = ('construct', 'serialize', 'decode', 'roundtrip')
     print(f'{"message":44s} ' + ' '.join(f'{c:>10s}' for c in columns) + '  [us per call]')
     for name, *figures in measure(args.number, args.repeat):
         print(f'{name:44s} ' + ' '.join(f'{value:10.2f}' for value in figures))
+    return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Command-line entry point; exit codes as every tool's (docs/conventions.md)."""
+    return run_tool('bench_messages', _main, argv)
 
 
 if __name__ == '__main__':
-    main()
+    sys.exit(main())

@@ -30,12 +30,10 @@ import os
 for _var in ('OMP_NUM_THREADS', 'OPENBLAS_NUM_THREADS', 'MKL_NUM_THREADS'):
     os.environ.setdefault(_var, '1')
 
-import argparse  # noqa: E402
 import itertools  # noqa: E402
 import math  # noqa: E402
 import time  # noqa: E402
 from collections.abc import Callable, Iterator, Sequence  # noqa: E402
-from concurrent.futures import ProcessPoolExecutor  # noqa: E402
 from dataclasses import dataclass  # noqa: E402
 from pathlib import Path  # noqa: E402
 from typing import TypeVar  # noqa: E402
@@ -45,6 +43,10 @@ from msc_pf.parameters import MSC_PF_PARAMETERS  # noqa: E402
 from msc_pf.particle_filter import ParticleFilterBank, resolve_backend  # noqa: E402
 from msc_pf.schemes import Scheme  # noqa: E402
 from msc_pf.settings import MscPfConfig, ParticleFilterConfig, RadioConfig  # noqa: E402
+from swarm_common.cli import EXIT_INTERRUPTED, ToolParser, fail, run_tool  # noqa: E402
+from swarm_common.errors import UsageError  # noqa: E402
+from swarm_common.jobs import map_jobs  # noqa: E402
+from swarm_common.outputs import check_output_file, write_text_atomic  # noqa: E402
 from swarm_experiments.msc_pf_batch import (  # noqa: E402
     BatchScenario,
     SearchCoverage,
@@ -52,7 +54,6 @@ from swarm_experiments.msc_pf_batch import (  # noqa: E402
     search_coverage,
 )
 from swarm_experiments.node_overrides import parse_overrides  # noqa: E402
-from swarm_sim.errors import ConfigurationError  # noqa: E402
 
 SCHEMES = ('proposed', 'msc_pf', 'msc')
 CSV_HEADER = (
@@ -202,16 +203,19 @@ def _csv_row(o: RunOutcome) -> str:
 
 
 def _map(function: Callable[[J], R], jobs: Sequence[J], workers: int) -> Iterator[R]:
-    """``function`` over ``jobs`` in order, in ``workers`` processes (here when 1)."""
-    if workers <= 1:
-        yield from map(function, jobs)
-        return
-    with ProcessPoolExecutor(max_workers=workers) as pool:
-        yield from pool.map(function, jobs)
+    """``function`` over ``jobs`` in order, in ``workers`` processes (here when 1); Ctrl-C
+    stops the workers and raises KeyboardInterrupt here."""
+    yield from map_jobs(function, jobs, workers=workers)
 
 
-def _run_all(jobs: list[Job], workers: int, csv_path: Path | None) -> list[RunOutcome]:
-    return [_log(outcome, csv_path) for outcome in _map(_run_one, jobs, workers)]
+def _run_all(
+    jobs: list[Job], workers: int, csv_path: Path | None, finished: list[RunOutcome]
+) -> list[RunOutcome]:
+    done: list[RunOutcome] = []
+    for outcome in _map(_run_one, jobs, workers):
+        done.append(_log(outcome, csv_path))
+        finished.append(outcome)
+    return done
 
 
 def _stats(outcomes: list[RunOutcome]) -> tuple[float, float, int, str]:
@@ -606,15 +610,18 @@ def run(
     csv_path: Path | None = None,
     pf_backends: tuple[str, ...] = ('auto',),
     overrides: Overrides = (),
+    finished: list[RunOutcome] | None = None,
 ) -> tuple[str, list[RunOutcome]]:
     """Run the experiments; return the report (markdown) and every run's outcome.
 
-    With ``csv_path``, every outcome is appended to that CSV file as soon as it is known;
+    With ``csv_path``, every outcome is appended to that CSV file as soon as it is known,
+    and to ``finished`` if given (what is left of a run stopped by Ctrl-C);
     ``overrides`` change controller settings of the main, robots and search experiments.
     """
     controller_config(overrides)  # fail before any run on a bad setting
     lines: list[str] = []
     outcomes: list[RunOutcome] = []
+    finished = [] if finished is None else finished
     if 'main' in experiments:
         jobs = [
             (scheme, n, robots, first_seed + s, max_time_s, overrides)
@@ -622,7 +629,7 @@ def run(
             for s in range(runs)
             for scheme in schemes
         ]
-        main = _run_all(jobs, workers, csv_path)
+        main = _run_all(jobs, workers, csv_path, finished)
         outcomes += main
         lines += main_table(main, robots, schemes)
     if 'robots' in experiments:
@@ -632,7 +639,7 @@ def run(
             for s in range(sweep_runs)
             for scheme in schemes
         ]
-        sweep = _run_all(jobs, workers, csv_path)
+        sweep = _run_all(jobs, workers, csv_path, finished)
         outcomes += sweep
         lines += robot_table(sweep, sweep_targets, schemes)
     if 'search' in experiments:
@@ -644,9 +651,14 @@ def run(
     return '\n'.join(lines), outcomes
 
 
-def main() -> None:
-    """Command-line entry point."""
-    parser = argparse.ArgumentParser(description=__doc__.split('\n')[0])
+def main(argv: Sequence[str] | None = None) -> int:
+    """Command-line entry point; exit codes as every tool's (docs/conventions.md);
+    130 after Ctrl-C (the finished runs are kept in the CSV and their table printed)."""
+    return run_tool('bench_msc_pf', _main, argv)
+
+
+def _main(argv: list[str]) -> int:
+    parser = ToolParser(prog='bench_msc_pf', description=__doc__.split('\n')[0])
     parser.add_argument('--experiments', nargs='+', choices=EXPERIMENTS, default=EXPERIMENTS)
     parser.add_argument('--targets', nargs='+', type=int, default=[10, 15, 20])
     parser.add_argument('--robots', type=int, default=15)
@@ -681,11 +693,14 @@ def main() -> None:
     parser.add_argument(
         '--table-from', type=Path, help='only print the tables of a CSV of finished runs'
     )
-    args = parser.parse_args()
-    try:
-        overrides = controller_overrides(args.set)
-    except ConfigurationError as err:
-        parser.error(str(err))
+    args = parser.parse_args(argv)
+    overrides = controller_overrides(args.set)
+    for name in ('runs', 'sweep_runs', 'search_runs', 'robots', 'workers'):
+        if getattr(args, name) < 1:
+            flag = '--' + name.replace('_', '-')
+            raise UsageError(f'{flag} must be >= 1, got {getattr(args, name)}')
+    if not (math.isfinite(args.max_time) and args.max_time > 0.0):
+        raise UsageError(f'--max-time must be a finite number > 0, got {args.max_time}')
     if args.table_from is not None:
         outcomes = read_outcomes(args.table_from)
         schemes = tuple(args.schemes)
@@ -693,25 +708,38 @@ def main() -> None:
         if len({o.n_robots for o in outcomes}) > 1:
             lines += robot_table(outcomes, args.sweep_targets, schemes)
         print('\n'.join(lines))
-        return
+        return 0
+    if args.out is not None:
+        check_output_file(args.out, option='--out')
+        check_output_file(args.out.with_suffix('.csv'), option='--out (its .csv)')
     start = time.perf_counter()
-    report, outcomes = run(
-        experiments=tuple(args.experiments),
-        targets=tuple(args.targets),
-        robots=args.robots,
-        robot_counts=tuple(args.robot_counts),
-        sweep_targets=args.sweep_targets,
-        runs=args.runs,
-        sweep_runs=args.sweep_runs,
-        search_runs=args.search_runs,
-        schemes=tuple(args.schemes),
-        max_time_s=args.max_time,
-        first_seed=args.first_seed,
-        workers=args.workers,
-        csv_path=args.out.with_suffix('.csv') if args.out is not None else None,
-        pf_backends=tuple(args.pf_backend),
-        overrides=overrides,
-    )
+    finished: list[RunOutcome] = []
+    try:
+        report, outcomes = run(
+            experiments=tuple(args.experiments),
+            targets=tuple(args.targets),
+            robots=args.robots,
+            robot_counts=tuple(args.robot_counts),
+            sweep_targets=args.sweep_targets,
+            runs=args.runs,
+            sweep_runs=args.sweep_runs,
+            search_runs=args.search_runs,
+            schemes=tuple(args.schemes),
+            max_time_s=args.max_time,
+            first_seed=args.first_seed,
+            workers=args.workers,
+            csv_path=args.out.with_suffix('.csv') if args.out is not None else None,
+            pf_backends=tuple(args.pf_backend),
+            overrides=overrides,
+            finished=finished,
+        )
+    except KeyboardInterrupt:
+        schemes = tuple(args.schemes)
+        if finished:
+            print('\n'.join(main_table(finished, args.robots, schemes)))
+        where = f' (kept in {args.out.with_suffix(".csv")})' if args.out is not None else ''
+        fail('bench_msc_pf', f'interrupted after {len(finished)} finished runs{where}')
+        return EXIT_INTERRUPTED
     report += f'\nTotal wall time: {time.perf_counter() - start:.0f} s'
     if outcomes:
         cpu = sum(o.cpu_time_s for o in outcomes)
@@ -719,8 +747,9 @@ def main() -> None:
     report += '\n'
     print(report)
     if args.out is not None:
-        args.out.write_text(report)
+        write_text_atomic(args.out, report)
+    return 0
 
 
 if __name__ == '__main__':
-    main()
+    raise SystemExit(main())

@@ -25,13 +25,17 @@ import argparse
 import csv
 import gc
 import math
-import multiprocessing
 import sys
 import time
 from collections import defaultdict
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
+
+from swarm_common.cli import EXIT_INTERRUPTED, ToolParser, fail, run_tool
+from swarm_common.errors import UsageError
+from swarm_common.jobs import map_jobs
+from swarm_common.outputs import atomic_output, check_output_file, write_text_atomic
 
 VARIANTS = ('random', 'minimum', 'sound', 'gas', 'gas_sound')
 DEPARTURES = ('center', 'edge')
@@ -265,7 +269,7 @@ def write_csv(outcomes: Sequence[Outcome], path: Path) -> None:
     rows = sorted(
         outcomes, key=lambda o: (o.job.site_seed, o.job.departure, VARIANTS.index(o.job.variant))
     )
-    with path.open('w', newline='', encoding='utf-8') as stream:
+    with atomic_output(path) as partial, partial.open('w', newline='', encoding='utf-8') as stream:
         writer = csv.writer(stream)
         writer.writerow(CSV_FIELDS)
         for o in rows:
@@ -310,6 +314,48 @@ def format_footer(outcomes: Sequence[Outcome], total_s: float, args: argparse.Na
     )
 
 
+class Interrupted(KeyboardInterrupt):
+    """Ctrl-C during a sweep; ``outcomes`` holds the runs that finished."""
+
+    def __init__(self, outcomes: list[Outcome], planned: int) -> None:
+        super().__init__()
+        self.outcomes = outcomes
+        self.planned = planned
+
+
+def _collect(jobs: list[Job], workers: int) -> list[Outcome]:
+    """Run the jobs (in ``workers`` processes), reporting each on stderr as it ends.
+
+    Raises:
+        Interrupted: Ctrl-C, with the finished outcomes.
+    """
+    outcomes: list[Outcome] = []
+    thresholds = gc.get_threshold()
+    try:
+        # Each worker lives for the whole sweep: a new process pays about 1.5 s of CPU for
+        # the imports and the compiled kernels' cache load (docs/notes/simulation.md), once.
+        for outcome in map_jobs(
+            run_job, jobs, workers=workers, ordered=False, initializer=quiet_garbage_collector
+        ):
+            outcomes.append(outcome)
+            job = outcome.job
+            if workers > 1:
+                print(
+                    f'[{len(outcomes)}/{len(jobs)}] site {job.site_seed} {job.departure} '
+                    f'{job.variant}: {100.0 * outcome.coverage:.1f} % '
+                    f'in {outcome.wall_time_s:.0f} s wall',
+                    file=sys.stderr,
+                    flush=True,
+                )
+    except KeyboardInterrupt:
+        raise Interrupted(outcomes, len(jobs)) from None
+    finally:
+        if workers <= 1:
+            gc.unfreeze()
+            gc.set_threshold(*thresholds)
+    return outcomes
+
+
 def run(
     *,
     config: str = 'small',
@@ -337,36 +383,18 @@ def run(
         for variant in variants
     ]
     start = time.perf_counter()
-    if workers <= 1:
-        thresholds = gc.get_threshold()
-        quiet_garbage_collector()
-        try:
-            outcomes = [run_job(job) for job in jobs]
-        finally:
-            gc.unfreeze()
-            gc.set_threshold(*thresholds)
-    else:
-        context = multiprocessing.get_context('spawn')
-        # Each worker lives for the whole sweep: a new process pays about 1.5 s of CPU for
-        # the imports and the compiled kernels' cache load (docs/notes/simulation.md), once.
-        with context.Pool(workers, initializer=quiet_garbage_collector) as pool:
-            outcomes = []
-            for outcome in pool.imap_unordered(run_job, jobs, chunksize=1):
-                outcomes.append(outcome)
-                job = outcome.job
-                print(
-                    f'[{len(outcomes)}/{len(jobs)}] site {job.site_seed} {job.departure} '
-                    f'{job.variant}: {100.0 * outcome.coverage:.1f} % '
-                    f'in {outcome.wall_time_s:.0f} s wall',
-                    file=sys.stderr,
-                    flush=True,
-                )
+    outcomes = _collect(jobs, workers)
     return outcomes, time.perf_counter() - start
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Command line entry point."""
-    parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
+    """Command line entry point; exit codes as every tool's (docs/conventions.md);
+    130 after Ctrl-C with the table of the finished runs printed and written."""
+    return run_tool('bench_oabug', _main, argv)
+
+
+def _main(argv: list[str]) -> int:
+    parser = ToolParser(prog='bench_oabug', description=__doc__.split('\n\n')[0])
     parser.add_argument('--config', choices=('small', 'medium', 'big'), default='small')
     parser.add_argument('--sites', type=int, default=20, help='number of generated sites')
     parser.add_argument('--first-site-seed', type=int, default=0)
@@ -403,32 +431,46 @@ def main(argv: Sequence[str] | None = None) -> int:
     )
     args = parser.parse_args(argv)
     from swarm_experiments.spawn import oabug_parameter_overrides
-    from swarm_sim.errors import ConfigurationError
 
+    for name in ('sites', 'robots', 'workers'):
+        if getattr(args, name) < 1:
+            raise UsageError(f'--{name} must be >= 1, got {getattr(args, name)}')
+    parameters = oabug_parameter_overrides(args.set)
+    if args.out is not None:
+        check_output_file(args.out, option='--out')
+    interrupted = None
+    started = time.perf_counter()
     try:
-        parameters = oabug_parameter_overrides(args.set)
-    except ConfigurationError as err:
-        parser.error(str(err))
-    outcomes, total_s = run(
-        config=args.config,
-        sites=args.sites,
-        first_site_seed=args.first_site_seed,
-        variants=args.variants,
-        departures=args.departures,
-        robots=args.robots,
-        actions=args.actions,
-        speed_mps=args.speed,
-        workers=args.workers,
-        path=args.path,
-        parameters=parameters,
-        physics=args.physics,
-    )
+        outcomes, total_s = run(
+            config=args.config,
+            sites=args.sites,
+            first_site_seed=args.first_site_seed,
+            variants=args.variants,
+            departures=args.departures,
+            robots=args.robots,
+            actions=args.actions,
+            speed_mps=args.speed,
+            workers=args.workers,
+            path=args.path,
+            parameters=parameters,
+            physics=args.physics,
+        )
+    except Interrupted as stop:
+        interrupted = stop
+        outcomes, total_s = stop.outcomes, time.perf_counter() - started
     table = format_table(outcomes, reference_for(args.config, args.robots, args.actions))
-    footer = '\n' + format_footer(outcomes, total_s, args)
+    footer = '\n' + format_footer(outcomes, total_s, args) if outcomes else ''
     print(table + footer)
     if args.out is not None:
-        args.out.write_text(table + '\n' + footer + '\n', encoding='utf-8')
+        write_text_atomic(args.out, table + '\n' + footer + '\n')
         write_csv(outcomes, args.out.with_suffix('.csv'))
+    if interrupted is not None:
+        fail(
+            'bench_oabug',
+            f'interrupted: the table covers the {len(outcomes)} of {interrupted.planned} runs '
+            'that finished',
+        )
+        return EXIT_INTERRUPTED
     return 0
 
 

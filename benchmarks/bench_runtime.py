@@ -35,6 +35,9 @@ import time
 from dataclasses import asdict, dataclass
 from typing import Any
 
+from swarm_common.cli import ToolParser, run_tool
+from swarm_common.errors import UsageError
+
 #: Real-time factor goals (per CPU second) without and with the CDR round trip.
 GOAL_WITHOUT_CDR = 100.0
 GOAL_WITH_CDR = 50.0
@@ -304,9 +307,8 @@ def _describe(result: dict[str, Any]) -> str:
     )
 
 
-def main(argv: list[str] | None = None) -> None:
-    """Command-line entry point; prints the real-time factor of each configuration."""
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+def _main(argv: list[str]) -> int:
+    parser = ToolParser(prog='bench_runtime', description=__doc__.splitlines()[0])
     parser.add_argument('--robots', type=int, default=10)
     parser.add_argument('--sim-seconds', type=float, default=20.0)
     parser.add_argument('--clock-hz', type=float, default=100.0)
@@ -331,9 +333,9 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument('--profile', metavar='PATH', help='write cProfile stats (with current)')
     parser.add_argument('--json', action='store_true', help='print the result as JSON')
     args = parser.parse_args(argv)
-    command = shlex.join(
-        ['python', 'benchmarks/bench_runtime.py', *(sys.argv[1:] if argv is None else argv)]
-    )
+    if args.robots < 1 or not args.sim_seconds > 0.0 or not args.clock_hz > 0.0:
+        raise UsageError('--robots must be >= 1, --sim-seconds and --clock-hz > 0')
+    command = shlex.join(['python', 'benchmarks/bench_runtime.py', *argv])
 
     if args.configs == 'current':
         result = run(
@@ -350,7 +352,7 @@ def main(argv: list[str] | None = None) -> None:
         }
         if args.json:
             print(json.dumps(summary))
-            return
+            return 0
         print(f'$ {command}')
         print(
             f'CDR round trip {"on" if result.cdr_roundtrip else "off"}, field checks '
@@ -358,7 +360,7 @@ def main(argv: list[str] | None = None) -> None:
         )
         if args.profile:
             pstats.Stats(args.profile).sort_stats('tottime').print_stats(25)
-        return
+        return 0
 
     print(f'$ {command}')
     print(
@@ -376,7 +378,14 @@ def main(argv: list[str] | None = None) -> None:
         'The factor per CPU second is the primary figure: the wall-clock factor also counts '
         'the time other processes hold the CPU.'
     )
+    return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Command-line entry point; prints the real-time factor of each configuration (exit codes
+    as every tool's, docs/conventions.md)."""
+    return run_tool('bench_runtime', _main, argv)
 
 
 if __name__ == '__main__':
-    main()
+    sys.exit(main())

@@ -19,7 +19,6 @@ and 10 Big sites) gives. One process. Example::
 
 from __future__ import annotations
 
-import argparse
 import statistics
 import sys
 import time
@@ -28,6 +27,9 @@ from pathlib import Path
 
 import numpy as np
 from scipy import ndimage
+from swarm_common.cli import ToolParser, run_tool
+from swarm_common.errors import UsageError
+from swarm_common.outputs import check_output_file, write_text_atomic
 from swarm_sim.sites import PRESETS, Layout, generate_layout, layout_to_site
 
 # The authors' generator, as measured: interior cells (min, median, max), doors per site
@@ -147,26 +149,41 @@ def run(
     configs: list[str] | None = None, sites: int | None = None, out: Path | None = None
 ) -> list[ConfigResult]:
     """Measure ``configs`` (default all) with ``sites`` sites each (default 100/20/10), print
-    the table and write it to ``out`` if given."""
-    results = [
-        measure(config, sites if sites is not None else DEFAULT_SITES[config])
-        for config in (configs or list(PRESETS))
-    ]
-    table = format_table(results)
-    print(table)
-    if out is not None:
-        out.write_text(table)
+    the table and write it to ``out`` if given.
+
+    Ctrl-C prints and writes the table of the configurations measured so far, then raises
+    KeyboardInterrupt.
+    """
+    results: list[ConfigResult] = []
+    try:
+        for config in configs or list(PRESETS):
+            results.append(measure(config, sites if sites is not None else DEFAULT_SITES[config]))
+    finally:
+        if results:
+            table = format_table(results)
+            print(table)
+            if out is not None:
+                write_text_atomic(out, table)
     return results
 
 
-def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+def _main(argv: list[str]) -> int:
+    parser = ToolParser(prog='bench_sites', description=__doc__.splitlines()[0])
     parser.add_argument('--configs', nargs='+', choices=sorted(PRESETS), help='default: all')
     parser.add_argument('--sites', type=int, help='sites per configuration (default 100/20/10)')
     parser.add_argument('--out', type=Path, help='also write the table to this file')
     args = parser.parse_args(argv)
+    if args.sites is not None and args.sites < 1:
+        raise UsageError(f'--sites must be >= 1, got {args.sites}')
+    if args.out is not None:
+        check_output_file(args.out, option='--out')
     run(args.configs, args.sites, args.out)
     return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Command-line entry point; exit codes as every tool's (docs/conventions.md)."""
+    return run_tool('bench_sites', _main, argv)
 
 
 if __name__ == '__main__':

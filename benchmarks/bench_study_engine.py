@@ -41,6 +41,8 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
+from swarm_common.cli import ToolParser, run_tool
+
 REPO = Path(__file__).resolve().parents[1]
 #: Packages each engine needs (versions come from constraints.txt).
 ENGINE_PACKAGES = {'ray': ['ray'], 'dask': ['dask', 'distributed']}
@@ -372,8 +374,8 @@ def _report(
     return '\n'.join(lines)
 
 
-def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.split('\n', 1)[0])
+def _main(argv: list[str]) -> int:
+    parser = ToolParser(prog='bench_study_engine', description=__doc__.split('\n', 1)[0])
     parser.add_argument('--measure', choices=sorted(MEASURES), help='measure one engine here')
     parser.add_argument('--json', action='store_true', help='print the figures as JSON')
     parser.add_argument('--venv-dir', type=Path, help='where the per-engine venvs live')
@@ -418,6 +420,11 @@ def main(argv: list[str] | None = None) -> int:
     command = shlex.join(['python', 'benchmarks/bench_study_engine.py', *sys.argv[1:]])
     print(_report(figures, sizes, command, args.failure_task_s))
     return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Command-line entry point; exit codes as every tool's (docs/conventions.md)."""
+    return run_tool('bench_study_engine', _main, argv)
 
 
 if __name__ == '__main__':

@@ -23,7 +23,6 @@ that used the whole budget. Example::
 
 from __future__ import annotations
 
-import argparse
 import contextlib
 import csv
 import importlib
@@ -32,6 +31,7 @@ import math
 import multiprocessing
 import os
 import random
+import signal
 import statistics
 import sys
 import time
@@ -39,6 +39,9 @@ from collections.abc import Callable, Sequence
 from dataclasses import astuple, dataclass, fields
 from pathlib import Path
 from typing import Any
+
+from swarm_common.cli import EXIT_INTERRUPTED, ToolParser, fail, run_tool
+from swarm_common.outputs import atomic_output, check_output_file
 
 VARIANTS = ('random', 'minimum', 'sound', 'gas', 'gas_sound')
 """In the simulator's algorithm order (its run seed uses the index)."""
@@ -226,6 +229,7 @@ _WORKER: GridSimulator | None = None
 
 def _init_worker(checkout: str, config: GridConfig, robot_hit_turn: str) -> None:
     global _WORKER
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's: it keeps the runs
     _WORKER = GridSimulator(Path(checkout), config, robot_hit_turn)
 
 
@@ -281,8 +285,13 @@ def summary(runs: Sequence[GridRun]) -> list[str]:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Command line entry point."""
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    """Command line entry point; exit codes as every tool's (docs/conventions.md);
+    130 after Ctrl-C with the finished runs written."""
+    return run_tool('reference_oabug_grid', _main, argv)
+
+
+def _main(argv: list[str]) -> int:
+    parser = ToolParser(prog='reference_oabug_grid', description=__doc__.splitlines()[0])
     parser.add_argument(
         '--simulator', type=Path, required=True, help='SwarmSearchSimulation checkout'
     )
@@ -300,6 +309,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         parser.error('--sites, --robots and --workers must be at least 1')
     checkout = args.simulator.resolve()
     out = args.out.resolve() if args.out is not None else None  # before the chdir below
+    if out is not None:
+        check_output_file(out, option='--out')
     config = CONFIGS[args.config]
     try:
         GridSimulator(checkout, config, args.robot_hit_turn)  # fail fast, in this process
@@ -313,20 +324,28 @@ def main(argv: Sequence[str] | None = None) -> int:
     ]
     runs: list[GridRun] = []
     init = (str(checkout), config, args.robot_hit_turn)
+    interrupted = False
     with multiprocessing.Pool(args.workers, _init_worker, init) as pool:
-        for run in pool.imap(_run_job, jobs):
-            runs.append(run)
-            print(
-                f'[{len(runs)}/{len(jobs)}] site {run.site} {run.departure} {run.variant}:'
-                f' {run.coverage_pct:.1f} %, {run.locked_robots} locked',
-                flush=True,
-            )
+        try:
+            for run in pool.imap(_run_job, jobs):
+                runs.append(run)
+                print(
+                    f'[{len(runs)}/{len(jobs)}] site {run.site} {run.departure} {run.variant}:'
+                    f' {run.coverage_pct:.1f} %, {run.locked_robots} locked',
+                    flush=True,
+                )
+        except KeyboardInterrupt:
+            interrupted = True  # leaving the pool terminates the workers
     if out is not None:
-        with out.open('w', newline='') as stream:
+        with atomic_output(out) as partial, partial.open('w', newline='') as stream:
             writer = csv.writer(stream)
             writer.writerow([f.name for f in fields(GridRun)])
             writer.writerows(astuple(run) for run in runs)
-    print('\n'.join(summary(runs)))
+    if runs:
+        print('\n'.join(summary(runs)))
+    if interrupted:
+        fail('reference_oabug_grid', f'interrupted after {len(runs)} of {len(jobs)} runs')
+        return EXIT_INTERRUPTED
     return 0
 
 

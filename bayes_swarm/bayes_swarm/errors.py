@@ -5,6 +5,8 @@ Library code raises these; nodes and scripts catch them and log or print the mes
 
 from __future__ import annotations
 
+from swarm_common.errors import SwarmError
+
 from swarm_common import params
 
 __all__ = [
@@ -17,7 +19,7 @@ __all__ = [
 ]
 
 
-class BayesSwarmError(Exception):
+class BayesSwarmError(SwarmError):
     """Base class of every error raised by this package."""
 
 

@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+from swarm_common.errors import SwarmError
+
 from swarm_common import params
 
 __all__ = ['ConfigError', 'MscPfError', 'ObservationError', 'ParameterError']
 
 
-class MscPfError(Exception):
+class MscPfError(SwarmError):
     """Base class of every error the msc_pf package raises."""
 
 

@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+from swarm_common.errors import SwarmError
+
 from swarm_common import params
 
 __all__ = ['ConfigError', 'OABugError', 'ParameterError', 'ScanError']
 
 
-class OABugError(Exception):
+class OABugError(SwarmError):
     """Base class of every error the oabug_robot package raises."""
 
 

@@ -1,10 +1,10 @@
-"""The base of the errors the suite raises on purpose."""
+"""The base of the errors the suite raises on purpose, and the two every tool shares."""
 
 from __future__ import annotations
 
 from swarm_common.cli import EXIT_USAGE
 
-__all__ = ['SwarmError']
+__all__ = ['OutputError', 'SwarmError', 'UsageError']
 
 
 class SwarmError(Exception):
@@ -16,3 +16,11 @@ class SwarmError(Exception):
     """
 
     exit_code: int = EXIT_USAGE
+
+
+class UsageError(SwarmError, ValueError):
+    """A command line that cannot be parsed: an unknown option, a malformed value."""
+
+
+class OutputError(SwarmError, OSError):
+    """An output (a directory, a file, a bag) cannot be written where the user asked."""

@@ -1,16 +1,37 @@
-"""Command-line value types and options shared by the spawners."""
+"""Command-line pieces shared by the spawners: value types, common options, output checks."""
 
 from __future__ import annotations
 
 import argparse
+import math
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
 import numpy as np
+from swarm_common.outputs import check_new_output, check_output_directory
 from swarm_sim.errors import ConfigurationError
 from swarm_sim.physics import PHYSICS_BACKENDS, RenderConfig
 
-__all__ = ['add_physics_option', 'add_render_option', 'points_argument', 'render_config']
+from swarm_experiments.errors import ExperimentError
+
+__all__ = [
+    'SPAWNER_EXIT_CODES',
+    'add_physics_option',
+    'add_render_option',
+    'add_run_options',
+    'check_finite',
+    'check_run_outputs',
+    'points_argument',
+    'render_config',
+]
+
+SPAWNER_EXIT_CODES = (
+    'exit codes: 0 the mission finished (every room covered, source found, every target '
+    'captured); 1 it did not finish within its budget; 2 bad options or input (one line on '
+    'stderr, nothing run or written); 130 stopped by Ctrl-C: the mission stops at the next '
+    'step, the outcome so far is printed and the bag is closed (a second Ctrl-C stops at '
+    'once). --debug adds the traceback of an error.'
+)
 
 
 def points_argument(option: str) -> Callable[[str], np.ndarray]:
@@ -21,13 +42,13 @@ def points_argument(option: str) -> Callable[[str], np.ndarray]:
     """
 
     def parse(text: str) -> np.ndarray:
-        msg = f"{option} must look like 'x,y;x,y', got {text!r}"
+        msg = f"{option} must look like 'x,y;x,y' with finite numbers, got {text!r}"
         try:
             rows = [[float(v) for v in item.split(',')] for item in text.split(';') if item.strip()]
             points = np.array(rows, dtype=float)
         except ValueError as err:
             raise argparse.ArgumentTypeError(msg) from err
-        if points.ndim != 2 or points.shape[1] != 2:
+        if points.ndim != 2 or points.shape[1] != 2 or not np.all(np.isfinite(points)):
             raise argparse.ArgumentTypeError(msg)
         return points
 
@@ -73,3 +94,52 @@ def render_config(values: Sequence[str] | None) -> RenderConfig:
         return RenderConfig(mode='frames', frames_dir=Path(rest[0]))
     msg = f"--render takes 'gui' or 'frames DIR', got {' '.join(values)!r}"
     raise ConfigurationError(msg)
+
+
+def add_run_options(parser: argparse.ArgumentParser, *, out_default: Path, plots: str) -> None:
+    """``--record``, ``--out``, ``--no-plots`` and ``--quiet``, the same in every spawner."""
+    parser.add_argument(
+        '--record',
+        type=Path,
+        default=None,
+        help='write a rosbag2 (MCAP) bag to this new directory; it appears under this name '
+        'when the recording is complete',
+    )
+    parser.add_argument('--out', type=Path, default=out_default, help=f'directory for {plots}')
+    parser.add_argument('--no-plots', action='store_true', help='do not write plots')
+    parser.add_argument(
+        '--quiet',
+        action='store_true',
+        help='no progress on stderr (a bar on a terminal, else a line per tenth of the budget)',
+    )
+
+
+def check_run_outputs(record: Path | None, out_dir: Path | None) -> None:
+    """Before a run: the bag directory is new and can be created, the plot directory written.
+
+    Raises:
+        swarm_common.errors.OutputError: the option, the path and what is in the way.
+    """
+    if record is not None:
+        check_new_output(record, option='--record', what='bag')
+    if out_dir is not None:
+        check_output_directory(out_dir, option='--out')
+
+
+def check_finite(
+    name: str,
+    value: float,
+    *,
+    minimum: float | None = None,
+    above: bool = False,
+    allow_inf: bool = False,
+) -> None:
+    """Raise :class:`ExperimentError` unless ``value`` is a number (finite unless
+    ``allow_inf``) and at least (or, with ``above``, greater than) ``minimum``."""
+    ok = not math.isnan(value) and (allow_inf or math.isfinite(value))
+    if ok and minimum is not None:
+        ok = value > minimum if above else value >= minimum
+    if not ok:
+        bound = '' if minimum is None else f' {">" if above else ">="} {minimum:g}'
+        kind = 'a number' if allow_inf else 'a finite number'
+        raise ExperimentError(f'{name} must be {kind}{bound}, got {value}')

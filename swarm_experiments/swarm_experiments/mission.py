@@ -5,7 +5,11 @@ algorithm node per robot in its namespace (``/r0``, ``/r1``, ...) with ``use_sim
 an optional rosbag2 recorder, all in one executor. :func:`run_mission` spins it until every
 room is covered, an extension reports its mission done, a caller's predicate says stop, or
 the sim-time budget ends, and returns a :class:`MissionResult` (coverage, trajectories,
-timing). The runner is the only place that knows how the pieces are wired, so the OA-Bug,
+timing). Ctrl-C (SIGINT, in the main thread) stops it at the next physics step like any other
+stop condition (``StopReason.INTERRUPTED``): the result covers the run so far and the bag is
+closed; a second Ctrl-C raises KeyboardInterrupt at once (the bag is still closed).
+
+The runner is the only place that knows how the pieces are wired, so the OA-Bug,
 Bayes-Swarm and MSC spawners are short scripts around it::
 
     spec = MissionSpec(
@@ -20,10 +24,13 @@ Bayes-Swarm and MSC spawners are short scripts around it::
 from __future__ import annotations
 
 import math
+import signal
+import threading
 import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from types import FrameType
 from typing import Any
 
 import numpy as np
@@ -71,6 +78,7 @@ class StopReason:
     BUDGET = 'budget'
     EXTENSION_DONE = 'extension_done'
     PREDICATE = 'predicate'
+    INTERRUPTED = 'interrupted'
 
 
 @dataclass(frozen=True)
@@ -98,11 +106,14 @@ class RecordingSpec:
             (the site, the coverage, the static transforms, the markers): the recorder
             subscribes to them transient-local so it gets what was published before it
             started.
+        staging: record into a hidden sibling ``.<name>.<pid>.partial`` and rename it to
+            ``path`` when the bag is closed, so a killed run leaves no bag under ``path``.
     """
 
     path: Path
     topics: tuple[str, ...] | None = None
     latched_topics: tuple[str, ...] = ('/sim/site', '/sim/coverage', '/tf_static', '/sim/markers/*')
+    staging: bool = True
 
 
 @dataclass(frozen=True)
@@ -278,7 +289,34 @@ def _make_recorder(recording: RecordingSpec) -> Any:
         topics=topics,
         offered_qos=dict.fromkeys(recording.latched_topics, latched),
         use_sim_time=True,
+        staging=recording.staging,
     )
+
+
+class _InterruptRequest:
+    """While entered (in the main thread): the first SIGINT asks the mission to stop at the
+    next step, a second one raises KeyboardInterrupt."""
+
+    def __init__(self) -> None:
+        self.requested = False
+        self._previous: Any = None
+        self._installed = False
+
+    def _handle(self, signum: int, frame: FrameType | None) -> None:
+        if self.requested:
+            raise KeyboardInterrupt
+        self.requested = True
+
+    def __enter__(self) -> _InterruptRequest:
+        if threading.current_thread() is threading.main_thread():
+            self._previous = signal.signal(signal.SIGINT, self._handle)
+            self._installed = True
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        if self._installed:
+            signal.signal(signal.SIGINT, self._previous)
+            self._installed = False
 
 
 def run_mission(
@@ -294,6 +332,8 @@ def run_mission(
         progress: called every ``spec.progress_period_s`` of sim time and at the end.
         stop: optional extra stop predicate, checked at every progress period.
 
+    Ctrl-C ends the run at the next physics step with ``StopReason.INTERRUPTED``.
+
     Raises:
         MissionError: a node could not be built or failed during the run.
         ConfigurationError: the spec or a parameter is invalid.
@@ -304,6 +344,7 @@ def run_mission(
     nodes: list[Any] = []
     executor = SingleThreadedExecutor()
     wall_start = time.perf_counter()
+    interrupt = _InterruptRequest()
     try:
         bridge_overrides = [Parameter(k, value=v) for k, v in spec.bridge_parameters.items()]
         bridge = SimBridgeNode(
@@ -339,6 +380,9 @@ def run_mission(
             return MissionProgress.of_engine(engine, wall_start)
 
         def finished() -> bool:
+            if interrupt.requested:
+                state['reason'] = StopReason.INTERRUPTED
+                return True
             # The state only changes at physics steps; skip the checks between them.
             if engine.step_index == state['checked_step']:
                 return False
@@ -363,7 +407,8 @@ def run_mission(
             return False
 
         try:
-            _spin_until(executor, finished)
+            with interrupt:
+                _spin_until(executor, finished)
         except (MissionError, ConfigurationError):
             raise
         except Exception as err:

@@ -2,14 +2,19 @@
 
 Plain script, no launch file (``ros2 run swarm_experiments spawn`` or ``python -m
 swarm_experiments.spawn``). It builds the site, starts the sim bridge and one OA-Bug node
-per robot on sim time, shows progress, prints the summary (coverage, rooms covered/total,
-time, rooms first visited per robot) and writes two PNGs: the paper's Fig. 6 view (paths per
-robot, rooms coloured by first visitor) and coverage over time. With ``--record`` it also
-writes a rosbag2 (MCAP) bag from which ``python -m swarm_analysis.oabug_report`` reproduces
-the same summary and figures.
+per robot on sim time, shows a progress bar (on a terminal), prints the summary (coverage,
+rooms covered/total, time, rooms first visited per robot) and writes two PNGs: the paper's
+Fig. 6 view (paths per robot, rooms coloured by first visitor) and coverage over time. With
+``--record`` it also writes a rosbag2 (MCAP) bag from which ``swarm_report`` reproduces the
+same summary and figures.
 
 The budget follows the paper: max actions per robot (Table II: Small 1000, Medium 2000, Big
 4000), one action being a 0.1 m step, so mission time = actions x 0.1 m / robot speed.
+
+Everything is checked before the mission starts: the options, the site, that the robots fit
+around the departure point, that ``--record`` is a new bag and ``--out`` can be written.
+Exit codes: 0 every room covered, 1 the budget ended first, 2 bad options or input, 130
+Ctrl-C (the summary so far is printed and the bag closed).
 """
 
 # ruff: noqa: T201  (main() is a command-line entry point that prints its report)
@@ -24,15 +29,29 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-from swarm_common.cli import EXIT_SUCCESS, fail
-from swarm_common.errors import SwarmError
-from swarm_sim.departure import place_starts
+from swarm_common.cli import (
+    EXIT_INTERRUPTED,
+    EXIT_SUCCESS,
+    EXIT_UNFINISHED,
+    ToolParser,
+    fail,
+    run_tool,
+)
+from swarm_sim.departure import free_space_capacity, place_starts
 from swarm_sim.engine import EngineConfig
 from swarm_sim.errors import ConfigurationError
 from swarm_sim.physics import require_backend
 from swarm_sim.site_loading import load_site, site_budget_actions
+from swarm_sim.sites import PRESETS, Site, require_rooms
 
-from swarm_experiments.cli_args import add_physics_option, add_render_option, render_config
+from swarm_experiments.cli_args import (
+    SPAWNER_EXIT_CODES,
+    add_physics_option,
+    add_render_option,
+    add_run_options,
+    check_run_outputs,
+    render_config,
+)
 from swarm_experiments.errors import ExperimentError
 from swarm_experiments.mission import (
     VIEWER_TOPICS,
@@ -41,16 +60,21 @@ from swarm_experiments.mission import (
     MissionSpec,
     RecordingSpec,
     RobotNodeSpec,
+    StopReason,
     run_mission,
 )
 from swarm_experiments.node_overrides import parse_overrides
+from swarm_experiments.progress import MissionProgressBar, progress_wanted
 
 __all__ = [
     'ACTION_LENGTH_M',
     'DEFAULT_RECORD_TOPICS',
+    'MAX_ROBOTS',
     'VARIANTS',
     'OABugRun',
     'SpawnSettings',
+    'build_mission',
+    'check_site_limits',
     'main',
     'oabug_parameter_overrides',
     'run',
@@ -59,6 +83,9 @@ __all__ = [
 VARIANTS = ('random', 'minimum', 'sound', 'gas', 'gas_sound')
 ACTION_LENGTH_M = 0.1
 DEFAULT_ACTIONS = 1000
+#: Largest swarm the command runs: every robot is a node in this one process (the paper
+#: reports 2 to 10 robots; oabug_batch runs larger swarms without nodes).
+MAX_ROBOTS = 100
 DEFAULT_RECORD_TOPICS = ('/clock', '/sim/poses', '/sim/coverage', '/sim/site', *VIEWER_TOPICS)
 # OA-Bug node parameters the spawner sets from its own options (see build_mission).
 SPAWNER_PARAMETERS = (
@@ -127,7 +154,8 @@ class SpawnSettings:
             msg = f'speed_mps must be positive, got {self.speed_mps}'
             raise ConfigurationError(msg)
         if self.seed < 0 or self.site_seed < 0:
-            raise ConfigurationError('seeds must be >= 0')
+            msg = f'seeds must be >= 0, got seed {self.seed}, site seed {self.site_seed}'
+            raise ConfigurationError(msg)
 
     @property
     def budget_actions(self) -> int:
@@ -192,9 +220,44 @@ def _oabug_factory() -> Callable[..., object]:
     return OABugNode
 
 
-def build_mission(config: SpawnSettings) -> tuple[MissionSpec, float]:
-    """The mission spec of ``config`` and the heading bias it uses."""
+def check_site_limits(config: SpawnSettings, site: Site, *, max_robots: int | None = None) -> None:
+    """Check the run against its site before anything is placed or started.
+
+    Raises:
+        swarm_sim.sites.SiteValidationError: the site has no rooms (nothing to search).
+        ConfigurationError: no such departure point, more robots than its free space could
+            hold (:func:`swarm_sim.departure.free_space_capacity`, quick for any count), or
+            more than ``max_robots``.
+    """
+    require_rooms(site, None if config.site.lower() in PRESETS else config.site)
+    capacity = free_space_capacity(site, config.departure, body=config.engine.body)
+    if config.robots > capacity.max_robots:
+        msg = (
+            f'{config.robots} robots do not fit around departure point {capacity.departure!r} '
+            f'of site {site.name!r}: its {capacity.area_m2:.0f} m^2 of free space hold at most '
+            f'{capacity.max_robots} robots of radius {config.engine.body.robot_radius_m} m'
+        )
+        raise ConfigurationError(msg)
+    if max_robots is not None and config.robots > max_robots:
+        msg = (
+            f'--robots must be in 1..{max_robots} (one node per robot in this process; '
+            f'oabug_batch runs larger swarms), got {config.robots}'
+        )
+        raise ConfigurationError(msg)
+
+
+def build_mission(
+    config: SpawnSettings, *, max_robots: int | None = None
+) -> tuple[MissionSpec, float]:
+    """The mission spec of ``config`` and the heading bias it uses.
+
+    Raises:
+        ConfigurationError: an unknown site or departure point, or more robots than fit
+            around the departure point (:func:`check_site_limits`) or than ``max_robots``.
+        swarm_sim.sites.SiteError: the site file or layout is invalid or has no rooms.
+    """
     site = load_site(config.site, seed=config.site_seed)
+    check_site_limits(config, site, max_robots=max_robots)
     starts = place_starts(
         site, config.departure, config.robots, seed=config.seed, body=config.engine.body
     )
@@ -231,6 +294,7 @@ def build_mission(config: SpawnSettings) -> tuple[MissionSpec, float]:
         max_sim_time_s=config.budget_s,
         engine_config=engine,
         recording=recording,
+        progress_period_s=min(10.0, max(1.0, config.budget_s / 100.0)),
     )
     return spec, bias
 
@@ -246,6 +310,9 @@ def write_plots(result: MissionResult, out_dir: Path, stem: str) -> tuple[Path, 
         f'{stem}: {100.0 * result.coverage:.1f} % '
         f'({result.rooms_covered}/{result.rooms_total} rooms) in {result.sim_time_s:.0f} s'
     )
+    if result.stop_reason == StopReason.INTERRUPTED:
+        title += ' (interrupted)'
+
     paths = plot_site_paths(
         out_dir / f'{stem}_paths.png',
         walls=np.asarray(site.sealed_walls),
@@ -293,20 +360,28 @@ def run(
     """
     spec, bias = build_mission(config)
     mission = runner(spec, progress=progress)
-    plots: tuple[Path, ...] = ()
+    result = OABugRun(settings=config, mission=mission, heading_bias_rad=bias)
     if config.out_dir is not None:
-        stem = f'oabug_{config.variant}_{config.departure}_{mission.site.name}_seed{config.seed}'
-        plots = write_plots(mission, Path(config.out_dir), stem)
-    return OABugRun(settings=config, mission=mission, heading_bias_rad=bias, plots=plots)
+        result = dataclasses.replace(result, plots=write_run_plots(result, Path(config.out_dir)))
+    return result
+
+
+def write_run_plots(result: OABugRun, out_dir: Path) -> tuple[Path, ...]:
+    """Write the PNGs of a run into ``out_dir`` (see :func:`write_plots`)."""
+    config = result.settings
+    mission = result.mission
+    stem = f'oabug_{config.variant}_{config.departure}_{mission.site.name}_seed{config.seed}'
+    return write_plots(mission, out_dir, stem)
 
 
 def _parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = ToolParser(
         prog='spawn',
         description=(
             'Run an OA-Bug swarm search in the simulator until every room is covered '
             'or the action budget ends; print the coverage summary and write the plots.'
         ),
+        epilog=SPAWNER_EXIT_CODES,
         formatter_class=argparse.ArgumentDefaultsHelpFormatter,
     )
     parser.add_argument(
@@ -330,15 +405,10 @@ def _parser() -> argparse.ArgumentParser:
         help='max actions (0.1 m steps) per robot; default: the preset budget (Small 1000)',
     )
     parser.add_argument('--speed', type=float, default=0.3, help='robot cruise speed [m/s]')
-    parser.add_argument('--record', type=Path, default=None, help='write a rosbag2 bag here')
+    add_run_options(parser, out_default=Path('oabug_results'), plots='the PNGs')
     parser.add_argument(
         '--record-scans', action='store_true', help="also record the robots' lidar scans"
     )
-    parser.add_argument(
-        '--out', type=Path, default=Path('oabug_results'), help='directory for the PNGs'
-    )
-    parser.add_argument('--no-plots', action='store_true', help='do not write PNGs')
-    parser.add_argument('--quiet', action='store_true', help='no progress lines')
     parser.add_argument(
         '--param',
         action='append',
@@ -353,40 +423,34 @@ def _parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Command line entry point; returns the process exit code."""
+    """Command line entry point; returns the process exit code (module docstring)."""
+    return run_tool('spawn', _main, argv)
+
+
+def _main(argv: list[str]) -> int:
     args = _parser().parse_args(argv)
-    try:
-        require_backend(args.physics)
-        config = SpawnSettings(
-            robot_parameters=oabug_parameter_overrides(args.param),
-            site=args.site,
-            site_seed=args.site_seed,
-            variant=args.variant,
-            robots=args.robots,
-            departure=args.departure,
-            seed=args.seed,
-            actions=args.actions,
-            speed_mps=args.speed,
-            record=args.record,
-            record_scans=args.record_scans,
-            out_dir=None if args.no_plots else args.out,
-            engine=EngineConfig(physics=args.physics, render=render_config(args.render)),
-        )
-        site_warnings = load_site(config.site, seed=config.site_seed).warnings
-    except SwarmError as err:
-        return fail('spawn', err)
-    for warning in site_warnings:
+    config = SpawnSettings(
+        robot_parameters=oabug_parameter_overrides(args.param),
+        site=args.site,
+        site_seed=args.site_seed,
+        variant=args.variant,
+        robots=args.robots,
+        departure=args.departure,
+        seed=args.seed,
+        actions=args.actions,
+        speed_mps=args.speed,
+        record=args.record,
+        record_scans=args.record_scans,
+        out_dir=None if args.no_plots else args.out,
+        engine=EngineConfig(physics=args.physics, render=render_config(args.render)),
+    )
+    require_backend(args.physics)
+    check_run_outputs(config.record, config.out_dir)
+    spec, bias = build_mission(config, max_robots=MAX_ROBOTS)
+    for warning in spec.site.warnings:
         print(f'spawn: warning: {warning}', file=sys.stderr, flush=True)
-
-    def show(p: MissionProgress) -> None:
-        print(
-            f'  t = {p.sim_time_s:6.1f} s  coverage {100.0 * p.coverage:5.1f} % '
-            f'({p.rooms_covered}/{p.rooms_total})  wall {p.wall_time_s:5.1f} s',
-            flush=True,
-        )
-
     print(
-        f'OA-Bug {config.variant}: {config.robots} robots, site {config.site}, '
+        f'OA-Bug {config.variant}: {config.robots} robots, site {spec.site.name}, '
         f'{config.departure} departure, budget {config.budget_actions} actions '
         f'= {config.budget_s:.0f} s at {config.speed_mps} m/s',
         flush=True,
@@ -394,19 +458,32 @@ def main(argv: Sequence[str] | None = None) -> int:
     if config.robot_parameters:
         settings = ', '.join(f'{k}={v}' for k, v in sorted(config.robot_parameters.items()))
         print(f'OA-Bug parameters other than the defaults: {settings}', flush=True)
-    try:
-        result = run(config, progress=None if args.quiet else show)
-    except SwarmError as err:
-        return fail('spawn', err)
-    print(format_summary(result))
-    for path in result.plots:
-        print(f'wrote {path}')
-    if result.mission.bag_path is not None:
-        print(f'recorded {result.mission.bag_path}')
+    bar = MissionProgressBar(
+        f'OA-Bug {config.variant}',
+        spec.max_sim_time_s,
+        enabled=progress_wanted(args.quiet),
+        lines=not args.quiet,
+    )
+    with bar:
+        mission = run_mission(spec, progress=bar)
+    result = OABugRun(settings=config, mission=mission, heading_bias_rad=bias)
+    print(format_summary(result), flush=True)
+    if mission.bag_path is not None:
+        print(f'recorded {mission.bag_path}', flush=True)
+    if config.out_dir is not None:
+        for path in write_run_plots(result, Path(config.out_dir)):
+            print(f'wrote {path}')
     frames = config.engine.render.frames_dir
     if config.engine.render.mode == 'frames' and frames is not None:
         print(f'wrote the frames to {frames} and {frames / "run.gif"}')
-    return EXIT_SUCCESS
+    if mission.stop_reason == StopReason.INTERRUPTED:
+        fail(
+            'spawn',
+            f'interrupted at sim time {mission.sim_time_s:.1f} s; the summary covers '
+            'the run so far',
+        )
+        return EXIT_INTERRUPTED
+    return EXIT_SUCCESS if mission.coverage >= 1.0 else EXIT_UNFINISHED
 
 
 if __name__ == '__main__':

@@ -13,6 +13,10 @@ recomputes tau.
 Example: ``spawn_bayes_swarm --case case1 --robots 5 --seed 1 --out runs/case1``;
 ``--param horizon_s=20`` changes any other bayes_swarm node parameter for every robot,
 including those the case sets.
+
+Options and outputs are checked before the run; a progress bar shows on a terminal. Exit
+codes: 0 source found, 1 not found within T_max, 2 bad options or input, 130 Ctrl-C (the
+outcome so far is printed and the bag closed).
 """
 
 # ruff: noqa: T201  (main() is a command-line entry point that prints its report)
@@ -28,8 +32,14 @@ from typing import Any
 
 import numpy as np
 from sim_bridge.signal_extension import SignalExtension
-from swarm_common.cli import EXIT_SUCCESS, fail
-from swarm_common.errors import SwarmError
+from swarm_common.cli import (
+    EXIT_INTERRUPTED,
+    EXIT_SUCCESS,
+    EXIT_UNFINISHED,
+    ToolParser,
+    fail,
+    run_tool,
+)
 from swarm_sim.engine import EngineConfig, SiteGeometry
 from swarm_sim.physics import require_backend
 from swarm_sim.signal_fields import CASE_NAMES, SignalCase, UnknownCaseError, get_case
@@ -37,17 +47,26 @@ from swarm_sim.signal_mission import SignalMissionModel
 
 from swarm_experiments.bayes_batch import MissionSpec as BatchMissionSpec
 from swarm_experiments.bayes_batch import depot_fan
-from swarm_experiments.cli_args import add_physics_option, points_argument
+from swarm_experiments.cli_args import (
+    SPAWNER_EXIT_CODES,
+    add_physics_option,
+    add_run_options,
+    check_finite,
+    check_run_outputs,
+    points_argument,
+)
 from swarm_experiments.errors import ExperimentError
 from swarm_experiments.mission import (
     VIEWER_TOPICS,
     MissionSpec,
     RecordingSpec,
     RobotNodeSpec,
+    StopReason,
     run_mission,
 )
 from swarm_experiments.node_overrides import parse_overrides
 from swarm_experiments.open_field import point_robot_engine_config
+from swarm_experiments.progress import MissionProgressBar, progress_wanted
 
 __all__ = [
     'ALGORITHMS',
@@ -80,6 +99,9 @@ DEFAULT_RECORD_TOPICS = (
     *VIEWER_TOPICS,
 )
 GLOWWORM_RATE_HZ = 100.0
+#: Largest swarm the spawner runs: every robot is a node in this one process. The papers'
+#: largest swarm is 100 (Case 3); bayes_batch runs larger ones without nodes.
+MAX_ROBOTS = 100
 
 
 @dataclass(frozen=True)
@@ -151,19 +173,22 @@ def _check(settings: SpawnSettings) -> SignalCase:
         case = get_case(settings.case)
     except UnknownCaseError as err:
         raise ExperimentError(str(err)) from err
-    if settings.robots is not None and settings.robots < 1:
-        msg = f'--robots must be >= 1, got {settings.robots}'
+    if settings.robots is not None and not 1 <= settings.robots <= MAX_ROBOTS:
+        msg = (
+            f'--robots must be in 1..{MAX_ROBOTS} (one node per robot in this process; '
+            f'bayes_batch runs larger swarms), got {settings.robots}'
+        )
         raise ExperimentError(msg)
-    for name in ('noise_std', 'relative_noise'):
-        if getattr(settings, name) < 0.0:
-            msg = f'{name} must be >= 0, got {getattr(settings, name)}'
-            raise ExperimentError(msg)
-    if not settings.comm_range_m > 0.0:
-        msg = f'comm range must be > 0 m, got {settings.comm_range_m}'
+    if settings.seed < 0:
+        raise ExperimentError(f'--seed must be >= 0, got {settings.seed}')
+    check_finite('--noise', settings.noise_std, minimum=0.0)
+    check_finite('--relative-noise', settings.relative_noise, minimum=0.0)
+    check_finite('--comm-range', settings.comm_range_m, minimum=0.0, above=True, allow_inf=True)
+    if not 0.0 <= settings.loss_probability <= 1.0:
+        msg = f'--loss must be a probability in [0, 1], got {settings.loss_probability}'
         raise ExperimentError(msg)
-    if settings.max_mission_time_s is not None and not settings.max_mission_time_s > 0.0:
-        msg = f'T_max must be > 0 s, got {settings.max_mission_time_s}'
-        raise ExperimentError(msg)
+    if settings.max_mission_time_s is not None:
+        check_finite('--t-max', settings.max_mission_time_s, minimum=0.0, above=True)
     if settings.depots is not None:
         depots = np.asarray(settings.depots, dtype=float).reshape(-1, 2)
         x0, x1, y0, y1 = case.arena_m
@@ -300,6 +325,16 @@ def _initial_yaw(case: SignalCase, fan_index: int, fan_size: int, offset: float)
     return math.radians(theta + offset)
 
 
+def check_settings(settings: SpawnSettings) -> SignalCase:
+    """The case of ``settings`` once every setting is checked (nothing runs).
+
+    Raises:
+        ExperimentError: an unknown algorithm or case, a value out of range, a depot outside
+            the arena.
+    """
+    return _check(settings)
+
+
 def run(settings: SpawnSettings, progress: Any = None) -> BayesSwarmRun:
     """Run one mission; raises a SwarmError on bad settings or a failed run."""
     from bayes_swarm.node import BayesSwarmNode
@@ -373,6 +408,13 @@ def run(settings: SpawnSettings, progress: Any = None) -> BayesSwarmRun:
     return result
 
 
+def _save(fig: Any, path: Path) -> None:
+    from swarm_common.outputs import atomic_output
+
+    with atomic_output(path) as partial:  # no half-written PNG under the final name
+        fig.savefig(partial, dpi=120, bbox_inches='tight')
+
+
 def write_plots(result: BayesSwarmRun, out_dir: Path) -> list[Path]:
     """Signal field with paths, and one robot's GP mean with its waypoints (PNG files)."""
     import matplotlib
@@ -397,13 +439,15 @@ def write_plots(result: BayesSwarmRun, out_dir: Path) -> list[Path]:
     ax.plot(*case.source_m, marker='*', color='red', ms=14, ls='none', label='source')
     ax.plot(case.depots_m[:, 0], case.depots_m[:, 1], 'ks', ms=6, label='depot')
     status = f'tau = {result.tau:.2f}' if result.found else 'not found'
+    if result.mission.stop_reason == StopReason.INTERRUPTED:
+        status += f' (interrupted at {result.mission.sim_time_s:.0f} s)'
     ax.set_title(f'{case.name}, {result.settings.algorithm}, {traj.shape[1]} robots: {status}')
     ax.set_xlabel('x [m]')
     ax.set_ylabel('y [m]')
     ax.set_aspect('equal')
     ax.legend(fontsize=7, loc='lower right')
     path = out_dir / 'field_paths.png'
-    fig.savefig(path, dpi=120, bbox_inches='tight')
+    _save(fig, path)
     plt.close(fig)
     paths.append(path)
 
@@ -424,14 +468,17 @@ def write_plots(result: BayesSwarmRun, out_dir: Path) -> list[Path]:
         ax.set_aspect('equal')
         ax.legend(fontsize=7, loc='lower right')
         path = out_dir / f'r{index}_gp_mean.png'
-        fig.savefig(path, dpi=120, bbox_inches='tight')
+        _save(fig, path)
         plt.close(fig)
         paths.append(path)
     return paths
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
+    """Command-line options of ``spawn_bayes_swarm``."""
+    parser = ToolParser(
+        prog='spawn_bayes_swarm', description=__doc__.split('\n\n')[0], epilog=SPAWNER_EXIT_CODES
+    )
     parser.add_argument('--algorithm', choices=ALGORITHMS, default='bayes_swarm_p')
     parser.add_argument('--case', choices=CASE_NAMES, default='case1')
     parser.add_argument('--robots', type=int, default=None, help='swarm size (paper default)')
@@ -445,9 +492,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument('--relative-noise', type=float, default=0.0, help='noise std / |f|')
     parser.add_argument('--t-max', type=float, default=None, help='T_max [s] (case default)')
     parser.add_argument('--outer-optimizer', choices=('grid', 'cobyla', 'pso'), default='grid')
-    parser.add_argument('--record', type=Path, default=None, help='bag directory to write')
-    parser.add_argument('--out', type=Path, default=Path('bayes_swarm_run'), help='plot dir')
-    parser.add_argument('--no-plots', action='store_true')
+    add_run_options(parser, out_default=Path('bayes_swarm_run'), plots='the PNGs')
     parser.add_argument(
         '--param',
         action='append',
@@ -461,13 +506,14 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point of ``spawn_bayes_swarm``; returns the exit status."""
+    """Entry point of ``spawn_bayes_swarm``; returns the exit status (module docstring)."""
+    return run_tool('spawn_bayes_swarm', _main, argv)
+
+
+def _main(argv: list[str]) -> int:
     args = build_parser().parse_args(argv)
-    try:
-        require_backend(args.physics)
-        extra = node_parameter_overrides(args.param)
-    except SwarmError as err:
-        return fail('spawn_bayes_swarm', err)
+    require_backend(args.physics)
+    extra = node_parameter_overrides(args.param)
     settings = SpawnSettings(
         extra_parameters=extra,
         algorithm=args.algorithm,
@@ -482,23 +528,29 @@ def main(argv: Sequence[str] | None = None) -> int:
         max_mission_time_s=args.t_max,
         outer_optimizer=args.outer_optimizer,
         record=args.record,
-        out_dir=None if args.no_plots else args.out,
         physics=args.physics,
     )
-
-    def progress(report: Any) -> None:
-        print(f'  t = {report.sim_time_s:7.1f} s  (wall {report.wall_time_s:6.1f} s)', flush=True)
-
-    try:
-        result = run(settings, progress=progress)
-    except SwarmError as err:
-        return fail('spawn_bayes_swarm', err)
+    case = check_settings(settings)
+    out_dir = None if args.no_plots else args.out
+    check_run_outputs(settings.record, out_dir)
+    bar = MissionProgressBar(
+        f'{settings.algorithm} {case.name}',
+        case.max_mission_time_s,
+        enabled=progress_wanted(args.quiet),
+        lines=not args.quiet,
+        detail=lambda report: '',
+    )
+    with bar:
+        result = run(settings, progress=bar)
+    mission = result.mission
     times = result.finder_decision_times_s()
     print(f'case {result.case.name}, {result.settings.algorithm}, seed {settings.seed}')
     if result.found:
         print(
             f'found by {result.finder} at t = {result.found_time_s:.2f} s, tau = {result.tau:.3f}'
         )
+    elif mission.stop_reason == StopReason.INTERRUPTED:
+        print(f'not found by t = {mission.sim_time_s:.1f} s (interrupted)')
     else:
         print(f'not found within T_max = {result.case.max_mission_time_s:g} s')
     if times.size:
@@ -508,11 +560,16 @@ def main(argv: Sequence[str] | None = None) -> int:
             f'median {np.median(times) * 1e3:.1f} ms, mean {np.mean(times) * 1e3:.1f} ms, '
             f'max {np.max(times) * 1e3:.1f} ms'
         )
-    for path in result.plots:
-        print(f'wrote {path}')
     if settings.record is not None:
         print(f'recorded {settings.record}')
-    return EXIT_SUCCESS
+    sys.stdout.flush()
+    if out_dir is not None:
+        for path in write_plots(result, Path(out_dir)):
+            print(f'wrote {path}')
+    if mission.stop_reason == StopReason.INTERRUPTED and not result.found:
+        fail('spawn_bayes_swarm', f'interrupted at sim time {mission.sim_time_s:.1f} s')
+        return EXIT_INTERRUPTED
+    return EXIT_SUCCESS if result.found else EXIT_UNFINISHED
 
 
 if __name__ == '__main__':

@@ -14,6 +14,11 @@ which ``swarm_analysis.cct.cct_from_bag`` recomputes the CCT.
 Example: ``spawn_msc_pf --scheme proposed --robots 15 --targets 10 --seed 1 --out runs/p1``;
 ``--param msc.leader_rule=pbest --param phases.unheard_updates=true`` changes any other msc_pf
 node parameter for every robot (names: ``msc_pf/config/msc_pf.yaml``).
+
+Options, target positions (inside the field) and outputs are checked before the run; a
+progress bar shows on a terminal. The capture times are printed before the plots are
+written. Exit codes: 0 every target captured, 1 not all by T_max, 2 bad options or input,
+130 Ctrl-C (the captures so far are printed and the bag closed).
 """
 
 # ruff: noqa: T201  (main() is a command-line entry point that prints its report)
@@ -29,13 +34,26 @@ from typing import Any
 
 import numpy as np
 from sim_bridge.rssi_extension import RssiExtension
-from swarm_common.cli import EXIT_SUCCESS, EXIT_UNFINISHED, fail
-from swarm_common.errors import SwarmError
+from swarm_common.cli import (
+    EXIT_INTERRUPTED,
+    EXIT_SUCCESS,
+    EXIT_UNFINISHED,
+    ToolParser,
+    fail,
+    run_tool,
+)
 from swarm_sim.engine import EngineConfig, SiteGeometry
 from swarm_sim.physics import require_backend
 from swarm_sim.rssi_targets import RssiTargetConfig, RssiTargetField, place_robots
 
-from swarm_experiments.cli_args import add_physics_option, points_argument
+from swarm_experiments.cli_args import (
+    SPAWNER_EXIT_CODES,
+    add_physics_option,
+    add_run_options,
+    check_finite,
+    check_run_outputs,
+    points_argument,
+)
 from swarm_experiments.errors import ExperimentError
 from swarm_experiments.mission import (
     VIEWER_TOPICS,
@@ -43,10 +61,12 @@ from swarm_experiments.mission import (
     MissionSpec,
     RecordingSpec,
     RobotNodeSpec,
+    StopReason,
     run_mission,
 )
 from swarm_experiments.node_overrides import parse_overrides
 from swarm_experiments.open_field import point_robot_engine_config
+from swarm_experiments.progress import MissionProgressBar, progress_wanted
 
 __all__ = ['SCHEMES', 'MscPfRun', 'SpawnSettings', 'controller_parameter_overrides', 'main', 'run']
 
@@ -63,6 +83,9 @@ DEFAULT_RECORD_TOPICS = (
     '/r*/peers/out',
     *VIEWER_TOPICS,
 )
+#: Largest swarm the spawner runs: every robot is a node in this one process (the paper's
+#: sweep goes to 30; msc_pf_batch runs larger swarms without nodes).
+MAX_ROBOTS = 100
 
 
 @dataclass(frozen=True)
@@ -129,21 +152,48 @@ class MscPfRun:
     plots: list[Path]
 
 
-def _check(settings: SpawnSettings) -> None:
+def check_settings(settings: SpawnSettings) -> None:
+    """Check every setting before a run.
+
+    Raises:
+        ExperimentError: an unknown scheme, a count or value out of range, a target position
+            outside the field.
+    """
     if settings.scheme not in SCHEMES:
         msg = f'unknown scheme {settings.scheme!r}; choose one of {", ".join(SCHEMES)}'
         raise ExperimentError(msg)
-    if settings.robots < 1 or settings.targets < 1:
-        msg = f'--robots and --targets must be >= 1, got {settings.robots}, {settings.targets}'
+    if not 1 <= settings.robots <= MAX_ROBOTS:
+        msg = (
+            f'--robots must be in 1..{MAX_ROBOTS} (one node per robot in this process; '
+            f'msc_pf_batch runs larger swarms), got {settings.robots}'
+        )
         raise ExperimentError(msg)
-    for name in ('comm_range_m', 'max_time_s', 'field_size_m', 'physics_rate_hz'):
-        value = getattr(settings, name)
-        if not value > 0.0:
-            msg = f'{name} must be > 0, got {value}'
-            raise ExperimentError(msg)
+    if settings.targets < 1:
+        raise ExperimentError(f'--targets must be >= 1, got {settings.targets}')
+    if settings.seed < 0:
+        raise ExperimentError(f'--seed must be >= 0, got {settings.seed}')
+    for name, value in (
+        ('--comm-range', settings.comm_range_m),
+        ('--t-max', settings.max_time_s),
+        ('field_size_m', settings.field_size_m),
+        ('physics_rate_hz', settings.physics_rate_hz),
+        ('start_radius_m', settings.start_radius_m),
+    ):
+        check_finite(name, value, minimum=0.0, above=True)
     if not 0.0 <= settings.loss_probability <= 1.0:
-        msg = f'loss probability must be in [0, 1], got {settings.loss_probability}'
+        msg = f'--loss must be a probability in [0, 1], got {settings.loss_probability}'
         raise ExperimentError(msg)
+    if settings.target_positions_m is not None:
+        positions = np.asarray(settings.target_positions_m, dtype=float).reshape(-1, 2)
+        size = settings.field_size_m
+        outside = ~np.all((positions >= 0.0) & (positions <= size), axis=1)
+        if np.any(outside):
+            x, y = positions[int(np.argmax(outside))]
+            msg = (
+                f'--target-positions: target {int(np.argmax(outside))} at ({x:g}, {y:g}) m lies '
+                f'outside the {size:g} m x {size:g} m field (0..{size:g} m on both axes)'
+            )
+            raise ExperimentError(msg)
 
 
 def _engine_config(settings: SpawnSettings) -> EngineConfig:
@@ -202,7 +252,7 @@ def run(settings: SpawnSettings, progress: Any = None) -> MscPfRun:
     """Run one mission; raises a SwarmError on bad settings or a failed run."""
     from msc_pf.node import MscPfNode
 
-    _check(settings)
+    check_settings(settings)
     targets, poses = scenario(settings)
     extension = RssiExtension(targets, seed=settings.seed)
     nodes: list[Any] = []
@@ -265,6 +315,13 @@ def run(settings: SpawnSettings, progress: Any = None) -> MscPfRun:
     return result
 
 
+def _save(fig: Any, path: Path) -> None:
+    from swarm_common.outputs import atomic_output
+
+    with atomic_output(path) as partial:  # no half-written PNG under the final name
+        fig.savefig(partial, dpi=120, bbox_inches='tight')
+
+
 def write_plots(result: MscPfRun, out_dir: Path) -> list[Path]:
     """Field with paths and targets coloured by capture time; PF estimate errors over time."""
     import matplotlib
@@ -301,6 +358,8 @@ def write_plots(result: MscPfRun, out_dir: Path) -> list[Path]:
         ax.legend(loc='lower right', fontsize=7)
     fig.colorbar(dots, ax=ax, label='capture time [s]')
     cct = f'CCT {result.cct_s:.0f} s' if not math.isnan(result.cct_s) else 'not all captured'
+    if result.mission.stop_reason == StopReason.INTERRUPTED:
+        cct += f' (interrupted at {end:.0f} s)'
     ax.set_title(f'{settings.scheme}, {traj.shape[1]} robots, {len(times)} targets: {cct}')
     ax.set_xlim(0.0, settings.field_size_m)
     ax.set_ylim(0.0, settings.field_size_m)
@@ -308,7 +367,7 @@ def write_plots(result: MscPfRun, out_dir: Path) -> list[Path]:
     ax.set_ylabel('y [m]')
     ax.set_aspect('equal')
     path = out_dir / 'field_paths.png'
-    fig.savefig(path, dpi=120, bbox_inches='tight')
+    _save(fig, path)
     plt.close(fig)
     paths.append(path)
 
@@ -326,7 +385,7 @@ def write_plots(result: MscPfRun, out_dir: Path) -> list[Path]:
         ax.set_title('PF estimates over time')
         ax.legend(fontsize=6, ncol=2)
         path = out_dir / 'pf_estimates.png'
-        fig.savefig(path, dpi=120, bbox_inches='tight')
+        _save(fig, path)
         plt.close(fig)
         paths.append(path)
     return paths
@@ -334,7 +393,9 @@ def write_plots(result: MscPfRun, out_dir: Path) -> list[Path]:
 
 def build_parser() -> argparse.ArgumentParser:
     """Command-line options of ``spawn_msc_pf``."""
-    parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
+    parser = ToolParser(
+        prog='spawn_msc_pf', description=__doc__.split('\n\n')[0], epilog=SPAWNER_EXIT_CODES
+    )
     parser.add_argument('--scheme', choices=SCHEMES, default='proposed')
     parser.add_argument('--robots', type=int, default=15)
     parser.add_argument('--targets', type=int, default=10)
@@ -348,9 +409,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument('--comm-range', type=float, default=150.0, help='[m]')
     parser.add_argument('--loss', type=float, default=0.0, help='peer message loss probability')
     parser.add_argument('--t-max', type=float, default=30000.0, help='T_max [s]')
-    parser.add_argument('--record', type=Path, default=None, help='bag directory to write')
-    parser.add_argument('--out', type=Path, default=Path('msc_pf_run'), help='plot directory')
-    parser.add_argument('--no-plots', action='store_true')
+    add_run_options(parser, out_default=Path('msc_pf_run'), plots='the PNGs')
     parser.add_argument(
         '--param',
         action='append',
@@ -364,14 +423,15 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point of ``spawn_msc_pf``; returns the exit status."""
+    """Entry point of ``spawn_msc_pf``; returns the exit status (module docstring)."""
+    return run_tool('spawn_msc_pf', _main, argv)
+
+
+def _main(argv: list[str]) -> int:
     args = build_parser().parse_args(argv)
     targets = args.targets if args.target_positions is None else len(args.target_positions)
-    try:
-        require_backend(args.physics)
-        extra = controller_parameter_overrides(args.param)
-    except SwarmError as err:
-        return fail('spawn_msc_pf', err)
+    require_backend(args.physics)
+    extra = controller_parameter_overrides(args.param)
     settings = SpawnSettings(
         extra_parameters=extra,
         scheme=args.scheme,
@@ -383,18 +443,22 @@ def main(argv: Sequence[str] | None = None) -> int:
         max_time_s=args.t_max,
         target_positions_m=args.target_positions,
         record=args.record,
-        out_dir=None if args.no_plots else args.out,
         physics=args.physics,
     )
-
-    def report(p: MissionProgress) -> None:
-        if int(p.sim_time_s) % 500 == 0:
-            print(f'  t = {p.sim_time_s:7.0f} s  (wall {p.wall_time_s:6.1f} s)', flush=True)
-
-    try:
-        result = run(settings, progress=report)
-    except SwarmError as err:
-        return fail('spawn_msc_pf', err)
+    check_settings(settings)
+    out_dir = None if args.no_plots else args.out
+    check_run_outputs(settings.record, out_dir)
+    bar = MissionProgressBar(
+        f'{settings.scheme}, {settings.robots} robots',
+        settings.max_time_s,
+        enabled=progress_wanted(args.quiet),
+        lines=not args.quiet,
+        detail=lambda report: '',
+    )
+    with bar:
+        result = run(settings, progress=bar)
+    mission = result.mission
+    interrupted = mission.stop_reason == StopReason.INTERRUPTED
     print(
         f'scheme {settings.scheme}, {settings.robots} robots, {targets} targets, seed {args.seed}'
     )
@@ -403,14 +467,21 @@ def main(argv: Sequence[str] | None = None) -> int:
     ):
         when = f'{t:8.0f} s' if not math.isnan(t) else 'not captured'
         print(f'  target {target:2d} at ({pos[0]:6.0f}, {pos[1]:6.0f}) m: {when}')
-    if math.isnan(result.cct_s):
-        print(f'CCT: not every target captured by T_max = {settings.max_time_s:.0f} s')
+    if not math.isnan(result.cct_s):
+        print(f'CCT: {result.cct_s:.0f} s  (wall {mission.wall_time_s:.1f} s)')
+    elif interrupted:
+        print(f'CCT: not every target captured by t = {mission.sim_time_s:.0f} s (interrupted)')
     else:
-        print(f'CCT: {result.cct_s:.0f} s  (wall {result.mission.wall_time_s:.1f} s)')
-    for path in result.plots:
-        print(f'wrote {path}')
+        print(f'CCT: not every target captured by T_max = {settings.max_time_s:.0f} s')
     if settings.record is not None:
         print(f'bag: {settings.record}')
+    sys.stdout.flush()
+    if out_dir is not None:
+        for path in write_plots(result, Path(out_dir)):
+            print(f'wrote {path}')
+    if math.isnan(result.cct_s) and interrupted:
+        fail('spawn_msc_pf', f'interrupted at sim time {mission.sim_time_s:.1f} s')
+        return EXIT_INTERRUPTED
     return EXIT_UNFINISHED if math.isnan(result.cct_s) else EXIT_SUCCESS
 
 

@@ -59,7 +59,7 @@ def test_bag_paths_match_the_true_poses_of_the_run(recorded):
 
 def test_report_command_prints_the_summary_and_writes_both_figures(recorded, tmp_path, capsys):
     _, bag = recorded
-    assert main([str(bag), '--out-dir', str(tmp_path)]) == 0
+    assert main([str(bag), '--out', str(tmp_path)]) == 0
     out = capsys.readouterr().out
     assert 'rooms first visited per robot' in out
     assert sorted(p.name for p in tmp_path.iterdir()) == [
@@ -69,5 +69,7 @@ def test_report_command_prints_the_summary_and_writes_both_figures(recorded, tmp
 
 
 def test_a_bag_without_ground_truth_is_reported_not_crashed(tmp_path, capsys):
-    assert main([str(tmp_path / 'missing_bag')]) == 1
-    assert 'oabug_report:' in capsys.readouterr().err
+    assert main([str(tmp_path / 'missing_bag')]) == 2
+    err = capsys.readouterr().err
+    assert err.count('\n') == 1
+    assert err.startswith('oabug_report: ')

@@ -132,7 +132,7 @@ def test_levy_spawn_reports_a_failure_within_a_short_t_max():
 def test_bad_settings_are_rejected_before_the_run(capsys):
     with pytest.raises(ExperimentError, match='unknown case'):
         run(SpawnSettings(case='case9'))
-    with pytest.raises(ExperimentError, match='comm range'):
+    with pytest.raises(ExperimentError, match='--comm-range'):
         run(SpawnSettings(comm_range_m=-1.0))
     with pytest.raises(ExperimentError, match='depots'):
         run(SpawnSettings(depots=np.array([[50.0, 50.0]])))

@@ -96,7 +96,7 @@ def test_ros_path_and_batch_simulator_agree_on_a_simple_scenario(ros_run):
     [
         ({'scheme': 'pso'}, 'unknown scheme'),
         ({'robots': 0}, '--robots'),
-        ({'comm_range_m': 0.0}, 'comm_range_m'),
+        ({'comm_range_m': 0.0}, '--comm-range'),
         ({'loss_probability': 1.5}, 'loss'),
     ],
 )

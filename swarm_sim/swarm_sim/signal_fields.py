@@ -30,6 +30,8 @@ from typing import Protocol
 
 import numpy as np
 
+from swarm_sim.errors import SimulationError
+
 __all__ = [
     'AVALANCHE_DEPTH_M',
     'CASE_NAMES',
@@ -43,7 +45,7 @@ __all__ = [
 ]
 
 
-class UnknownCaseError(ValueError):
+class UnknownCaseError(SimulationError, ValueError):
     """A case name that is not one of :data:`CASE_NAMES`."""
 
 

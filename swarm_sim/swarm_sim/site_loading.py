@@ -20,6 +20,8 @@ def load_site(spec: str, *, seed: int = 0) -> Any:
 
     Raises:
         ConfigurationError: ``spec`` is neither a preset nor an existing file of a known kind.
+        swarm_sim.sites.SiteError: the file is not a valid layout or site file (the message
+            names the file and line).
     """
     from swarm_sim import sites
 
@@ -27,6 +29,14 @@ def load_site(spec: str, *, seed: int = 0) -> Any:
     if key in sites.PRESETS:
         return sites.generate_site(key, seed)
     path = Path(spec)
+    if path.is_dir():
+        msg = f'site {spec!r} is a directory; expected a preset, a .lay layout or a site file'
+        raise ConfigurationError(msg)
+    if path.exists() and not path.is_file():
+        msg = (
+            f'site {spec!r} is not a regular file; expected a preset, a .lay layout or a site file'
+        )
+        raise ConfigurationError(msg)
     if not path.is_file():
         presets = ', '.join(sites.PRESETS)
         msg = f'site {spec!r} is neither a preset ({presets}) nor an existing file'

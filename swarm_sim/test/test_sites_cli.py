@@ -110,7 +110,7 @@ def test_validate_accepts_the_example_files_and_rejects_a_broken_one(
     lines = (CONFIG_DIR / 'office_plan.lay').read_text().splitlines()
     lines[5] = ' ' + lines[5][1:]
     broken.write_text('\n'.join(lines) + '\n')
-    assert main(['validate', str(broken)]) == 1
+    assert main(['validate', str(broken)]) == 2
     assert 'broken.lay:6:1: the enclosure is open' in capsys.readouterr().err
 
 
@@ -123,15 +123,20 @@ def test_render_draws_a_png(tmp_path: Path) -> None:
 def test_unknown_file_types_and_missing_files_fail_cleanly(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    assert main(['validate', str(tmp_path / 'site.txt')]) == 1
+    assert main(['validate', str(tmp_path / 'site.txt')]) == 2
     assert "unknown site file type '.txt'" in capsys.readouterr().err
-    assert main(['validate', str(tmp_path / 'missing.yaml')]) == 1
+    assert main(['validate', str(tmp_path / 'missing.yaml')]) == 2
     assert 'missing.yaml' in capsys.readouterr().err
 
 
-def test_a_bad_departure_argument_is_an_argparse_error(tmp_path: Path) -> None:
-    with pytest.raises(SystemExit):
-        main(['import-lay', 'x.lay', '-o', str(tmp_path / 'x.yaml'), '--departure', 'center'])
+def test_a_bad_departure_argument_is_a_one_line_usage_error(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    argv = ['import-lay', 'x.lay', '-o', str(tmp_path / 'x.yaml'), '--departure', 'center']
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.count('\n') == 1
+    assert 'expected NAME=LINE,COLUMN' in err
 
 
 def test_import_and_validate_log_the_sites_warnings_on_stderr(
@@ -146,8 +151,17 @@ def test_import_and_validate_log_the_sites_warnings_on_stderr(
     captured = capsys.readouterr()
     assert 'found 0 rooms and 0 doors, 1 sealed voids read as solid' in captured.out
     assert f'warning: {plan}:2:7: an enclosed area with no door' in captured.err
-    assert main(['validate', str(plan)]) == 0
-    assert f'warning: {plan}:2:7:' in capsys.readouterr().err
+    assert 'warning: the site has no rooms' in captured.err
+    # Validation prints the warnings, then refuses the site: it has nothing to search.
+    assert main(['validate', str(plan)]) == 2
+    err = capsys.readouterr().err
+    assert f'warning: {plan}:2:7:' in err
+    assert err.endswith(
+        f'site_tool: {plan}: the site has no rooms; a search needs at least one'
+        ' (coverage would be 0/0)\n'
+    )
     # The site file holds the void as solid already: nothing left to warn about.
-    assert main(['validate', str(out)]) == 0
-    assert 'warning' not in capsys.readouterr().err
+    assert main(['validate', str(out)]) == 2
+    err = capsys.readouterr().err
+    assert 'warning' not in err
+    assert err.count('\n') == 1

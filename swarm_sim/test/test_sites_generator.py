@@ -211,7 +211,7 @@ def test_rooms_are_rectangles_spanning_their_wall_lines() -> None:
 def test_any_size_gives_a_valid_site_with_exactly_the_rooms_asked_for_or_a_clear_error(
     width: int, height: int, room_density: float, seed: int
 ) -> None:
-    rooms = round(room_density * width * height / 50)
+    rooms = max(1, round(room_density * width * height / 50))
     config = GeneratorConfig(width, height, rooms=rooms, victims=min(rooms, 3), max_attempts=3)
     try:
         site = generate_site(config, seed)

@@ -5,7 +5,15 @@ from __future__ import annotations
 import math
 
 import pytest
-from swarm_sim.sites import DeparturePoint, Door, Room, Site, SiteValidationError, validate_site
+from swarm_sim.sites import (
+    DeparturePoint,
+    Door,
+    Room,
+    Site,
+    SiteValidationError,
+    require_rooms,
+    validate_site,
+)
 
 OUTER_WALLS = [
     (0.0, 0.0, 1.8, 0.0),
@@ -130,3 +138,14 @@ def test_an_entrance_that_is_not_a_gap_in_the_enclosure_is_rejected() -> None:
         SiteValidationError, match=r'the entrance at \(2\.000, 0\.000\) m is not a gap'
     ):
         validate_site(box_site(walls=walls))
+
+
+def test_a_site_without_rooms_is_valid_but_not_searchable() -> None:
+    empty = box_site(rooms=(), doors=())
+    validate_site(empty)
+    with pytest.raises(SiteValidationError, match="site 'box': the site has no rooms") as info:
+        require_rooms(empty)
+    assert info.value.key_path == ('rooms',)
+    with pytest.raises(SiteValidationError, match=r'^box\.yaml: the site has no rooms'):
+        require_rooms(empty, 'box.yaml')
+    require_rooms(box_site())

@@ -43,6 +43,8 @@ from pathlib import Path
 from types import FrameType
 from typing import Any, TextIO
 
+from swarm_common.cli import EXIT_SUCCESS, EXIT_UNFINISHED, EXIT_USAGE, ToolParser, run_tool
+from swarm_common.errors import SwarmError
 from swarm_runtime.standalone import (
     builtin_runtime_requested,
     rclpy_available,
@@ -69,9 +71,10 @@ __all__ = [
     'run',
 ]
 
-EXIT_STOPPED = 0
-EXIT_CHILD_FAILED = 1
-EXIT_NOT_STARTED = 2
+# The suite's exit codes (swarm_common.cli), read for a robot that runs until stopped.
+EXIT_STOPPED = EXIT_SUCCESS
+EXIT_CHILD_FAILED = EXIT_UNFINISHED
+EXIT_NOT_STARTED = EXIT_USAGE
 
 # executable name -> module, as in setup.py's console_scripts.
 EXECUTABLES = {
@@ -98,7 +101,7 @@ DEVICE_PARAMETERS: dict[str, dict[str, Any]] = {
 }
 
 
-class BringupError(Exception):
+class BringupError(SwarmError):
     """Something the bringup needs is missing or wrong; nothing was started."""
 
 
@@ -566,13 +569,14 @@ def run(
 
 def parse_args(argv: Sequence[str] | None = None) -> tuple[BringupOptions, argparse.Namespace]:
     """Command-line options."""
-    parser = argparse.ArgumentParser(
+    parser = ToolParser(
         prog='robot_bringup',
         description=(__doc__ or '').split('\n\n')[0],
         epilog=(
             'exit status: 0 stopped by SIGINT/SIGTERM/SIGHUP or --dry-run; 1 a child exited'
             ' or could not start (all others stopped); 2 nothing started (bad options,'
-            ' parameter file, missing device or program)'
+            ' parameter file, missing device or program; one line on stderr per problem,'
+            ' --debug adds the traceback of an error)'
         ),
     )
     parser.add_argument('--robot', default='r0', help='robot name = namespace (r0, r1, ...)')
@@ -601,6 +605,13 @@ def parse_args(argv: Sequence[str] | None = None) -> tuple[BringupOptions, argpa
     )
     parser.add_argument('--dry-run', action='store_true', help='print the commands only')
     args = parser.parse_args(argv)
+    if args.robot_count < 1:
+        raise BringupError(f'--robot-count must be >= 1, got {args.robot_count}')
+    if not 0 <= args.robot_index < args.robot_count:
+        msg = f'--robot-index must be in 0..{args.robot_count - 1}, got {args.robot_index}'
+        raise BringupError(msg)
+    if not args.grace >= 0.0:
+        raise BringupError(f'--grace must be >= 0 s, got {args.grace}')
     options = BringupOptions(
         robot=args.robot,
         own_tag_id=args.own_tag,
@@ -617,19 +628,22 @@ def parse_args(argv: Sequence[str] | None = None) -> tuple[BringupOptions, argpa
     return options, args
 
 
-def main(argv: Sequence[str] | None = None) -> None:
-    """Entry point of ``robot_bringup``."""
+def _main(argv: list[str]) -> int:
     options, args = parse_args(argv)
     try:
-        status = run(
+        return run(
             options,
             dry_run=args.dry_run,
             check_devices=not args.skip_device_check,
             grace_s=args.grace,
         )
     except KeyboardInterrupt:  # Ctrl-C before the supervisor took over: nothing runs
-        status = EXIT_STOPPED
-    sys.exit(status)
+        return EXIT_STOPPED
+
+
+def main(argv: Sequence[str] | None = None) -> None:
+    """Entry point of ``robot_bringup``; exits with the status (module docstring)."""
+    sys.exit(run_tool('robot_bringup', _main, argv))
 
 
 if __name__ == '__main__':

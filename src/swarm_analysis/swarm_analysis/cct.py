@@ -14,12 +14,14 @@ import math
 from dataclasses import dataclass
 from pathlib import Path
 
+from swarm_common.errors import SwarmError
+
 __all__ = ['TARGETS_TOPIC', 'CctError', 'CctResult', 'cct_from_bag']
 
 TARGETS_TOPIC = '/sim/targets'
 
 
-class CctError(ValueError):
+class CctError(SwarmError, ValueError):
     """A bag lacks what the CCT needs (no target messages)."""
 
 

@@ -10,7 +10,12 @@ The mission is recognised by the simulator's ground-truth topics in the bag:
 damaged bag (cut short, never closed, garbage in it) as far as it can be read, says how much
 was recovered per topic and where the damage is, then reports from what was recovered.
 
-Exit codes: 0 on success, 2 when the input cannot be read or holds no mission to report on.
+``--out DIR`` chooses where the OA-Bug PNGs go (default: the bag directory); they are
+written under a temporary name and renamed, and ``DIR`` is checked before the bag is read.
+``--out-dir`` is the old spelling of ``--out`` (hidden, deprecated: it prints a warning).
+
+Exit codes: 0 on success, 2 when the input cannot be read or holds no mission to report on,
+or the output cannot be written (one line on stderr; ``--debug`` adds the traceback).
 """
 
 from __future__ import annotations
@@ -23,14 +28,30 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from swarm_analysis.cct import TARGETS_TOPIC, CctError, cct_from_bag
-from swarm_analysis.oabug_report import COVERAGE_TOPIC, ReportError, load_run, write_report
-from swarm_analysis.tau import STATUS_TOPIC, TauError, tau_from_bag
+from swarm_common.cli import EXIT_SUCCESS, EXIT_USAGE, ToolParser, run_tool
+from swarm_common.errors import SwarmError
+from swarm_common.outputs import check_output_directory
 
-__all__ = ['EXIT_BAD_INPUT', 'EXIT_OK', 'main']
+from swarm_analysis.cct import TARGETS_TOPIC, cct_from_bag
+from swarm_analysis.oabug_report import COVERAGE_TOPIC, load_run, write_report
+from swarm_analysis.tau import STATUS_TOPIC, tau_from_bag
 
-EXIT_OK = 0
-EXIT_BAD_INPUT = 2
+__all__ = [
+    'EXIT_BAD_INPUT',
+    'EXIT_OK',
+    'NoMissionError',
+    'add_out_option',
+    'build_parser',
+    'main',
+    'resolve_out_option',
+]
+
+EXIT_OK = EXIT_SUCCESS
+EXIT_BAD_INPUT = EXIT_USAGE
+
+
+class NoMissionError(SwarmError):
+    """The bag holds none of the ground-truth topics a report is made from."""
 
 
 def _count(summary: Any, recovering: bool) -> str:
@@ -100,6 +121,8 @@ def _oabug_report(path: Path, out_dir: Path | None, recover: bool) -> str:
 def _report(args: argparse.Namespace) -> int:
     from swarm_runtime.bag import read_bag_info
 
+    if args.out is not None and not args.info:
+        check_output_directory(args.out, option='--out')
     info = read_bag_info(args.bag, allow_truncated=args.recover)
     if args.info:
         sys.stdout.write(_format_info(info, recovering=args.recover) + '\n')
@@ -108,41 +131,63 @@ def _report(args: argparse.Namespace) -> int:
         sys.stdout.write('\n'.join([f'bag: {info.path}', *_recovery_lines(info)]) + '\n')
     topics = set(info.topics)
     if COVERAGE_TOPIC in topics:
-        text = _oabug_report(args.bag, args.out_dir, args.recover)
+        text = _oabug_report(args.bag, args.out, args.recover)
     elif STATUS_TOPIC in topics:
         text = _tau_report(args.bag, args.recover)
     elif TARGETS_TOPIC in topics:
         text = _cct_report(args.bag, args.recover)
     else:
-        sys.stderr.write(
-            f'swarm_report: {args.bag} has none of {COVERAGE_TOPIC}, {STATUS_TOPIC}, '
-            f'{TARGETS_TOPIC}: not a recorded simulation (try --info)\n'
+        msg = (
+            f'{args.bag} has none of {COVERAGE_TOPIC}, {STATUS_TOPIC}, '
+            f'{TARGETS_TOPIC}: not a recorded simulation (try --info)'
         )
-        return EXIT_BAD_INPUT
+        raise NoMissionError(msg)
     sys.stdout.write(text + '\n')
     return EXIT_OK
 
 
-def _one_line(err: BaseException) -> str:
-    text = ' '.join(str(err).split())
-    return text or type(err).__name__
+def add_out_option(parser: argparse.ArgumentParser, help_text: str) -> None:
+    """``--out DIR`` plus the hidden, deprecated ``--out-dir`` spelling of it."""
+    parser.add_argument('--out', type=Path, default=None, help=help_text)
+    parser.add_argument('--out-dir', type=Path, dest='out_dir', help=argparse.SUPPRESS)
 
 
-def main(argv: Sequence[str] | None = None) -> int:
-    """Print the report of the mission recorded in a bag; returns the exit code."""
-    parser = argparse.ArgumentParser(
+def resolve_out_option(program: str, args: argparse.Namespace) -> None:
+    """Fold ``--out-dir`` into ``--out`` (with a warning on stderr)."""
+    from swarm_common.errors import UsageError
+
+    if args.out_dir is None:
+        return
+    if args.out is not None:
+        raise UsageError('--out-dir is the old name of --out; give only --out')
+    sys.stderr.write(f'{program}: warning: --out-dir is deprecated, use --out\n')
+    args.out = args.out_dir
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """Command-line options of ``swarm_report``."""
+    parser = ToolParser(
         prog='swarm_report',
         description='Outcome of a recorded mission (OA-Bug, Bayes-Swarm or MSC + PF).',
+        epilog=(
+            'exit codes: 0 report printed; 2 the bag cannot be read, holds no mission, or '
+            '--out cannot be written (one line on stderr; --debug adds the traceback)'
+        ),
     )
     parser.add_argument('bag', type=Path, help='rosbag2 directory (or .mcap file)')
-    parser.add_argument('--out-dir', type=Path, default=None, help='PNG directory (OA-Bug)')
+    add_out_option(parser, 'directory for the PNGs (OA-Bug; default: the bag directory)')
     parser.add_argument('--info', action='store_true', help='list topics and counts only')
     parser.add_argument(
         '--recover',
         action='store_true',
         help='read a damaged bag (cut, unfinished) as far as possible and say what was lost',
     )
-    args = parser.parse_args(argv)
+    return parser
+
+
+def _main(argv: list[str]) -> int:
+    args = build_parser().parse_args(argv)
+    resolve_out_option('swarm_report', args)
 
     from swarm_runtime.bag import BagError, TruncatedBagWarning
 
@@ -152,11 +197,15 @@ def main(argv: Sequence[str] | None = None) -> int:
             warnings.simplefilter('ignore', TruncatedBagWarning)
             return _report(args)
     except BagError as err:
-        hint = ' (swarm_report --recover reads what it holds)' if err.recoverable else ''
-        sys.stderr.write(f'swarm_report: {_one_line(err)}{hint}\n')
-    except (CctError, ReportError, TauError) as err:
-        sys.stderr.write(f'swarm_report: {_one_line(err)}\n')
-    return EXIT_BAD_INPUT
+        if err.recoverable and not args.recover:
+            hint = f'{err} (swarm_report --recover reads what it holds)'
+            raise BagError(hint, recoverable=True) from err
+        raise
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Print the report of the mission recorded in a bag; returns the exit code."""
+    return run_tool('swarm_report', _main, argv)
 
 
 if __name__ == '__main__':

@@ -5,12 +5,15 @@ rooms, ``/sim/poses`` for the paths, ``/sim/coverage`` for the first entries, ``
 recorded for the end time) and rebuilds
 what the spawner printed and drew, without rerunning the simulation::
 
-    python -m swarm_analysis.oabug_report path/to/bag --out-dir figures/
+    python -m swarm_analysis.oabug_report path/to/bag --out figures/
+
+Exit codes: 0 report written, 2 the bag cannot be read or lacks a topic, or ``--out`` cannot
+be written (one line on stderr; ``--debug`` adds the traceback). ``--out-dir`` is the old,
+deprecated spelling of ``--out``.
 """
 
 from __future__ import annotations
 
-import argparse
 import sys
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -18,6 +21,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from swarm_common.errors import SwarmError
 from swarm_common.stamps import stamp_to_seconds
 
 from swarm_analysis.coverage import CoverageSummary, RoomFirstVisit
@@ -31,7 +35,7 @@ COVERAGE_TOPIC = '/sim/coverage'
 CLOCK_TOPIC = '/clock'
 
 
-class ReportError(Exception):
+class ReportError(SwarmError):
     """The bag lacks what the report needs."""
 
 
@@ -154,28 +158,40 @@ def write_report(run: RecordedRun, out_dir: Path, stem: str) -> tuple[Path, Path
     return paths, curve
 
 
-def main(argv: Sequence[str] | None = None) -> int:
-    """Command line: print the run's summary and write its figures; returns the exit code."""
-    parser = argparse.ArgumentParser(
+def _main(argv: list[str]) -> int:
+    from swarm_common.cli import ToolParser
+    from swarm_common.outputs import check_output_directory
+
+    from swarm_analysis.cli import add_out_option, resolve_out_option
+
+    parser = ToolParser(
         prog='oabug_report',
         description='Coverage summary and figures of an OA-Bug run, from its bag alone.',
+        epilog=(
+            'exit codes: 0 report written; 2 the bag cannot be read or lacks a topic, or --out '
+            'cannot be written (one line on stderr; --debug adds the traceback)'
+        ),
     )
     parser.add_argument('bag', type=Path, help='rosbag2 directory recorded by the spawner')
-    parser.add_argument('--out-dir', type=Path, default=None, help='PNG directory (default: bag)')
+    add_out_option(parser, 'PNG directory (default: the bag directory)')
     args = parser.parse_args(argv)
-    from swarm_runtime.bag import BagError
-
-    try:
-        run = load_run(args.bag)
-    except (ReportError, BagError) as err:
-        sys.stderr.write(f'oabug_report: {err}\n')
-        return 1
-    out_dir = args.out_dir if args.out_dir is not None else args.bag
+    resolve_out_option('oabug_report', args)
+    out_dir = args.out if args.out is not None else args.bag
+    if args.out is not None:
+        check_output_directory(out_dir, option='--out')
+    run = load_run(args.bag)
     figures = write_report(run, out_dir, f'{args.bag.name}')
     sys.stdout.write(run.coverage.format_report(f'Coverage of {run.site_name}') + '\n')
     for path in figures:
         sys.stdout.write(f'wrote {path}\n')
     return 0
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Command line: print the run's summary and write its figures; returns the exit code."""
+    from swarm_common.cli import run_tool
+
+    return run_tool('oabug_report', _main, argv)
 
 
 if __name__ == '__main__':

@@ -16,6 +16,7 @@ import matplotlib
 import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.patches import Rectangle
+from swarm_common.outputs import atomic_output
 
 __all__ = ['plot_coverage_curves', 'plot_site_paths', 'robot_colours']
 
@@ -93,7 +94,8 @@ def plot_site_paths(
     ax.legend(loc='upper left', bbox_to_anchor=(1.0, 1.0), fontsize='small', frameon=False)
     fig.tight_layout()
     path = Path(path)
-    fig.savefig(path, dpi=120)
+    with atomic_output(path) as partial:  # no half-written PNG under the final name
+        fig.savefig(partial, dpi=120)
     return path
 
 
@@ -118,5 +120,6 @@ def plot_coverage_curves(
         ax.legend()
     fig.tight_layout()
     path = Path(path)
-    fig.savefig(path, dpi=120)
+    with atomic_output(path) as partial:  # no half-written PNG under the final name
+        fig.savefig(partial, dpi=120)
     return path

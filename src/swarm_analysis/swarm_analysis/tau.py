@@ -16,6 +16,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from swarm_common.errors import SwarmError
 from swarm_common.segments import first_entry_fraction
 
 __all__ = [
@@ -31,7 +32,7 @@ STATUS_TOPIC = '/sim/source_search'
 POSES_TOPIC = '/sim/poses'
 
 
-class TauError(ValueError):
+class TauError(SwarmError, ValueError):
     """A bag lacks what tau needs (no status message, unknown robots, ...)."""
 
 

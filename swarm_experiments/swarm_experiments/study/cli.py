@@ -1,8 +1,9 @@
 """``swarm_study``: list, run, report and project studies.
 
-Exit codes: 0 everything asked for is done; 1 some runs failed or were not run (an
-interrupted study, a report of an unfinished one); 2 a usage or input error (one line on
-stderr; ``--debug`` shows the traceback).
+Exit codes: 0 everything asked for is done; 1 some runs failed or were not run (a cluster
+lost, a report of an unfinished study); 2 a usage or input error (one line on stderr;
+``--debug`` shows the traceback); 130 interrupted by Ctrl-C (the finished runs are kept and
+the same command resumes).
 """
 
 from __future__ import annotations
@@ -11,14 +12,15 @@ import argparse
 import logging
 import os
 import sys
-import traceback
 from collections.abc import Sequence
 from pathlib import Path
-from typing import NoReturn
+
+from swarm_common.cli import EXIT_INTERRUPTED, ToolParser, run_tool
+from swarm_common.outputs import check_output_directory
 
 from .definition import StudyRegistry, load_registry
 from .engines import ENGINES, make_engine
-from .errors import EngineError, StudyError, UsageError
+from .errors import UsageError
 from .projection import (
     DASK_DISPATCH_S,
     DASK_OVERHEAD_S,
@@ -33,11 +35,11 @@ from .spec import StudyPlan, make_specs, parse_overrides
 
 PROG = 'swarm_study'
 EXIT_OK, EXIT_INCOMPLETE, EXIT_USAGE = 0, 1, 2
-
-
-class _Parser(argparse.ArgumentParser):
-    def error(self, message: str) -> NoReturn:
-        raise UsageError(message)
+EXIT_CODES = (
+    'exit codes: 0 everything asked for is done; 1 some runs failed or were not run; 2 a usage '
+    'or input error (one line on stderr, --debug adds the traceback); 130 interrupted by '
+    'Ctrl-C: finished runs are kept, the same command resumes'
+)
 
 
 def _add_plan_options(parser: argparse.ArgumentParser) -> None:
@@ -58,8 +60,9 @@ def _add_plan_options(parser: argparse.ArgumentParser) -> None:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = _Parser(prog=PROG, description='Run parameter studies and report their results.')
-    parser.add_argument('--debug', action='store_true', help='show tracebacks of errors')
+    parser = ToolParser(
+        prog=PROG, description='Run parameter studies and report their results.', epilog=EXIT_CODES
+    )
     parser.add_argument(
         '--studies',
         action='append',
@@ -67,7 +70,7 @@ def build_parser() -> argparse.ArgumentParser:
         metavar='MODULE:FUNCTION',
         help='also load the studies FUNCTION() returns (repeatable)',
     )
-    commands = parser.add_subparsers(dest='command', required=True, parser_class=_Parser)
+    commands = parser.add_subparsers(dest='command', required=True)
     commands.add_parser('list', help='list the registered studies')
 
     run = commands.add_parser('run', help='run (or resume) a study')
@@ -151,6 +154,7 @@ def _cmd_run(registry: StudyRegistry, args: argparse.Namespace) -> int:
         raise UsageError(f'--workers must be >= 1, not {args.workers}')
     if args.batch_rows < 1:
         raise UsageError(f'--batch-rows must be >= 1, not {args.batch_rows}')
+    check_output_directory(args.out, option='--out')
     if not args.debug:
         # Worker processes inherit this: no Dask log lines between the progress bar updates.
         os.environ.setdefault('DASK_LOGGING__DISTRIBUTED', 'error')
@@ -164,7 +168,7 @@ def _cmd_run(registry: StudyRegistry, args: argparse.Namespace) -> int:
         )
     except KeyboardInterrupt:
         print(f'{PROG}: interrupted while starting the engine', file=sys.stderr)
-        return EXIT_INCOMPLETE
+        return EXIT_INTERRUPTED
     with engine:
         summary = run_study(
             plan, args.out, engine, progress=not args.quiet, batch_rows=args.batch_rows
@@ -176,6 +180,7 @@ def _cmd_run(registry: StudyRegistry, args: argparse.Namespace) -> int:
     )
     if summary.interrupted:
         print(f'{PROG}: interrupted; run the same command again to resume', file=sys.stderr)
+        return EXIT_INTERRUPTED
     return EXIT_OK if summary.complete else EXIT_INCOMPLETE
 
 
@@ -220,32 +225,23 @@ def _cmd_project(registry: StudyRegistry, args: argparse.Namespace) -> int:
 
 def main(argv: Sequence[str] | None = None, *, registry: StudyRegistry | None = None) -> int:
     """Run the command line; ``registry`` replaces the installed studies (for tests)."""
-    argv = list(sys.argv[1:] if argv is None else argv)
-    debug = '--debug' in argv
-    try:
-        try:
-            args = build_parser().parse_args(argv)
-        except SystemExit as exc:  # --help
-            return int(exc.code or 0)
-        if registry is None:
-            registry = load_registry(args.studies)
+
+    def body(args_list: list[str]) -> int:
+        args = build_parser().parse_args(args_list)
+        studies = registry
+        if studies is None:
+            studies = load_registry(args.studies)
         elif args.studies:
-            registry.extend(load_registry(args.studies, use_entry_points=False))
+            studies.extend(load_registry(args.studies, use_entry_points=False))
         if args.command == 'list':
-            return _cmd_list(registry)
+            return _cmd_list(studies)
         if args.command == 'run':
-            return _cmd_run(registry, args)
+            return _cmd_run(studies, args)
         if args.command == 'report':
-            return _cmd_report(registry, args)
-        return _cmd_project(registry, args)
-    except StudyError as exc:
-        if debug:
-            traceback.print_exc()
-        print(f'{PROG}: error: {exc}', file=sys.stderr)
-        return EXIT_INCOMPLETE if isinstance(exc, EngineError) else EXIT_USAGE
-    except KeyboardInterrupt:
-        print(f'{PROG}: interrupted', file=sys.stderr)
-        return EXIT_INCOMPLETE
+            return _cmd_report(studies, args)
+        return _cmd_project(studies, args)
+
+    return run_tool(PROG, body, argv)
 
 
 if __name__ == '__main__':

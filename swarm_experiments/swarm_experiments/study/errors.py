@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+from swarm_common.cli import EXIT_UNFINISHED
+from swarm_common.errors import SwarmError
+
 __all__ = ['EngineError', 'ResultsError', 'StudyDefinitionError', 'StudyError', 'UsageError']
 
 
-class StudyError(Exception):
+class StudyError(SwarmError):
     """Base class of every error the study machinery raises on purpose."""
 
 
@@ -22,4 +25,6 @@ class ResultsError(StudyError, RuntimeError):
 
 
 class EngineError(StudyError, RuntimeError):
-    """An engine cannot start, reach its cluster, or keep its workers alive."""
+    """An engine cannot start, reach its cluster, or keep its workers alive (exit code 1)."""
+
+    exit_code = EXIT_UNFINISHED

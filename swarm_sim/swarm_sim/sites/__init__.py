@@ -30,7 +30,7 @@ from swarm_sim.sites.layout import Layout, LayoutImport, LayoutMode, import_layo
 from swarm_sim.sites.model import CELL_M, NO_ROOM, DeparturePoint, Door, Room, Site
 from swarm_sim.sites.room_lookup import RoomLookup
 from swarm_sim.sites.site_file import load_site, save_site
-from swarm_sim.sites.validation import validate_site
+from swarm_sim.sites.validation import require_rooms, validate_site
 
 __all__ = [
     'BIG',
@@ -60,6 +60,7 @@ __all__ = [
     'import_layout',
     'layout_to_site',
     'load_site',
+    'require_rooms',
     'save_site',
     'validate_site',
 ]

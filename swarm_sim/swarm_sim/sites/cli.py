@@ -8,9 +8,13 @@ Examples::
     site_tool validate plan.yaml
     site_tool render small7.yaml -o small7.png
 
-Every command exits with 0 on success and 1 on an invalid site or bad input, printing the
-error (file, line and column or key) to stderr. The site's warnings (a sealed void read as
-solid, a departure point inside a room, ...) go to stderr as ``warning: ...`` lines.
+Every command exits with 0 on success and 2 on an invalid site or bad input (``validate``
+also refuses a site without rooms, which ``import-lay`` writes with a warning), printing the
+error as one line (file, line and column or key) on stderr; ``--debug`` adds the traceback.
+Outputs are checked before anything is built and written under a temporary name first, so
+a failed command leaves no partial file.
+The site's warnings (a sealed void read as solid, a departure point inside a room, ...) go
+to stderr as ``warning: ...`` lines.
 """
 
 from __future__ import annotations
@@ -21,12 +25,15 @@ from collections.abc import Sequence
 from dataclasses import replace
 from pathlib import Path
 
+from swarm_common.cli import ToolParser, run_tool
+from swarm_common.outputs import check_output_file
+
 from swarm_sim.sites.errors import SiteError
 from swarm_sim.sites.generator import PRESETS, generate_layout, resolve_config, with_size
 from swarm_sim.sites.layout import LayoutMode, import_layout, layout_to_site, write_layout
 from swarm_sim.sites.model import CELL_M, Site
 from swarm_sim.sites.site_file import load_site, save_site
-from swarm_sim.sites.validation import DEFAULT_ROBOT_RADIUS_M, validate_site
+from swarm_sim.sites.validation import DEFAULT_ROBOT_RADIUS_M, require_rooms, validate_site
 
 __all__ = ['build_parser', 'load_any', 'main']
 
@@ -34,6 +41,9 @@ __all__ = ['build_parser', 'load_any', 'main']
 def load_any(path: str | Path) -> Site:
     """Load a site from a ``.yaml``/``.yml`` site file or a ``.lay`` layout (default import
     options)."""
+    if Path(path).is_dir():
+        msg = f'{path}: is a directory; expected a .yaml site file or a .lay layout'
+        raise SiteError(msg)
     suffix = Path(path).suffix.lower()
     if suffix == '.lay':
         return import_layout(path).site
@@ -66,7 +76,18 @@ def _render(site: Site, path: str) -> None:
     print(f'wrote {path}')
 
 
+def _check_outputs(args: argparse.Namespace, *options: str) -> None:
+    """Every output the command will write can be written (checked before any work)."""
+    for option in options:
+        value = getattr(args, option.lstrip('-').replace('-', '_'), None)
+        if value:
+            check_output_file(value, option=option)
+
+
 def _generate(args: argparse.Namespace) -> int:
+    if args.seed < 0:
+        raise SiteError(f'--seed must be >= 0, got {args.seed}')
+    _check_outputs(args, '--output', '--lay', '--png')
     config = resolve_config(args.config)
     sizes = (args.width_cells, args.height_cells, args.rooms)
     if any(v is not None for v in sizes):
@@ -105,6 +126,7 @@ def _parse_departure(text: str) -> tuple[str, tuple[float, float]]:
 
 
 def _import_lay(args: argparse.Namespace) -> int:
+    _check_outputs(args, '--output', '--png')
     result = import_layout(
         args.layout,
         mode=args.mode,
@@ -120,6 +142,11 @@ def _import_lay(args: argparse.Namespace) -> int:
         f'{result.doors_found} doors{voids}'
     )
     _log_warnings(result.site)
+    if not result.site.rooms:
+        print(
+            'warning: the site has no rooms; the spawners and site_tool validate refuse it',
+            file=sys.stderr,
+        )
     save_site(result.site, args.output)
     print(f'wrote {args.output}: {_summary(result.site)}')
     if args.png:
@@ -128,14 +155,18 @@ def _import_lay(args: argparse.Namespace) -> int:
 
 
 def _validate(args: argparse.Namespace) -> int:
+    if not args.robot_radius_m > 0.0:
+        raise SiteError(f'--robot-radius-m must be > 0, got {args.robot_radius_m}')
     site = load_any(args.site)
     validate_site(site, robot_radius_m=args.robot_radius_m)
     _log_warnings(site)
+    require_rooms(site, str(args.site))
     print(f'{args.site}: valid. {_summary(site)}')
     return 0
 
 
 def _render_command(args: argparse.Namespace) -> int:
+    _check_outputs(args, '--output')
     site = load_any(args.site)
     _log_warnings(site)
     _render(site, args.output)
@@ -144,7 +175,7 @@ def _render_command(args: argparse.Namespace) -> int:
 
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of ``site_tool``."""
-    parser = argparse.ArgumentParser(
+    parser = ToolParser(
         prog='site_tool', description='Generate, import, validate and render search sites.'
     )
     commands = parser.add_subparsers(dest='command', required=True)
@@ -200,13 +231,13 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point of ``site_tool``; returns the exit code."""
+    """Entry point of ``site_tool``; returns the exit code (0 done, 2 bad input)."""
+    return run_tool('site_tool', _run, argv)
+
+
+def _run(argv: list[str]) -> int:
     args = build_parser().parse_args(argv)
-    try:
-        return int(args.run(args))
-    except (SiteError, OSError) as err:
-        print(f'error: {err}', file=sys.stderr)
-        return 1
+    return int(args.run(args))
 
 
 if __name__ == '__main__':

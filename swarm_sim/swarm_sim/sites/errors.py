@@ -29,7 +29,7 @@ __all__ = [
 
 
 class SiteError(SimulationError):
-    """Base class of every error raised by :mod:`swarm_sim.sites`."""
+    """Base class of every error raised by :mod:`swarm_sim.sites` (a bad site: exit code 2)."""
 
 
 @dataclass(frozen=True)

@@ -101,9 +101,10 @@ class GeneratorConfig:
                 f'{self.width_cells} x {self.height_cells}'
             )
             raise GeneratorError(msg)
-        if self.rooms < 0 or not 0 <= self.victims <= self.rooms:
+        if self.rooms < 1 or not 0 <= self.victims <= self.rooms:
             msg = (
-                'need rooms >= 0 and 0 <= victims <= rooms, got '
+                'need rooms >= 1 (a site without rooms has nothing to search) and '
+                '0 <= victims <= rooms, got '
                 f'rooms={self.rooms}, victims={self.victims}'
             )
             raise GeneratorError(msg)

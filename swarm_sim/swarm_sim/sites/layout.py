@@ -57,6 +57,7 @@ from typing import Any, Final
 
 import numpy as np
 from scipy import ndimage
+from swarm_common.outputs import write_text_atomic
 
 from swarm_sim.sites import lattice
 from swarm_sim.sites.door_gaps import closing_masks, find_door_gaps
@@ -224,12 +225,14 @@ def read_layout(path: str | Path) -> Layout:
         line = before.count(b'\n') + 1
         column = err.start - (before.rfind(b'\n') + 1) + 1
         raise LayoutError(str(path), line, column, 'the file is not UTF-8 text') from None
+    except OSError as err:
+        raise LayoutError(str(path), None, None, err.strerror or str(err)) from None
     return parse_layout(text, str(path))
 
 
 def write_layout(layout: Layout, path: str | Path) -> None:
     """Write a layout as a ``.lay`` file."""
-    Path(path).write_text(layout.to_text(), encoding='utf-8')
+    write_text_atomic(path, layout.to_text())
 
 
 def detect_mode(layout: Layout) -> LayoutMode:

@@ -18,6 +18,7 @@ from matplotlib.colors import ListedColormap
 from matplotlib.figure import Figure
 from matplotlib.patches import Patch, Polygon, Rectangle
 from scipy import ndimage
+from swarm_common.outputs import atomic_output
 
 from swarm_sim.sites.model import Site
 from swarm_sim.sites.validation import free_space_raster
@@ -143,7 +144,8 @@ def render_site(
     ax = figure.add_subplot()
     draw_site(ax, site, room_colors=room_colors, show_doors=True)
     ax.set_title(title if title is not None else _default_title(site))
-    figure.savefig(path, dpi=dpi)
+    with atomic_output(path) as partial:  # no half-written PNG under the final name
+        figure.savefig(partial, dpi=dpi)
 
 
 def _shade_unreachable(ax: Axes, site: Site) -> None:

@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import Any, Final
 
 import yaml
+from swarm_common.outputs import write_text_atomic
 
 from swarm_sim.sites.errors import SiteError, SiteFileError, SiteValidationError
 from swarm_sim.sites.model import DeparturePoint, Door, Room, Site
@@ -104,19 +105,31 @@ def dump_site(site: Site) -> str:
 
 
 def save_site(site: Site, path: str | Path) -> None:
-    """Write the site to a YAML file."""
-    Path(path).write_text(dump_site(site), encoding='utf-8')
+    """Write the site to a YAML file (under a temporary name first, then renamed)."""
+    write_text_atomic(path, dump_site(site))
 
 
 def load_site(path: str | Path) -> Site:
     """Read, check and validate a site file.
 
     Raises:
-        SiteFileError: unreadable YAML, a missing/unknown/mistyped key, or an invalid site;
-            the message names the file, line and key path.
+        SiteFileError: a file that cannot be read or is not UTF-8 text, unreadable YAML, a
+            missing/unknown/mistyped key, or an invalid site; the message names the file,
+            line and key path.
     """
     path = Path(path)
-    return parse_site(path.read_text(encoding='utf-8'), source=str(path))
+    try:
+        data = path.read_bytes()
+    except OSError as err:
+        raise SiteFileError(str(path), err.strerror or str(err)) from None
+    try:
+        text = data.decode('utf-8')
+    except UnicodeDecodeError as err:
+        line = data.count(b'\n', 0, err.start) + 1
+        column = err.start - (data.rfind(b'\n', 0, err.start) + 1) + 1
+        msg = f'the file is not UTF-8 text (byte 0x{data[err.start]:02x} at column {column})'
+        raise SiteFileError(str(path), msg, line=line) from None
+    return parse_site(text, source=str(path))
 
 
 def parse_site(text: str, source: str = '<site>') -> Site:

@@ -11,6 +11,10 @@ sites.
 4. Every room is reachable from every departure point through its doors; a room that cannot
    be reached and is named by no door is reported as a room with no door.
 
+A site without rooms holds these invariants (an imported plan whose only enclosures are
+sealed voids, say), but there is nothing to search in it: :func:`require_rooms` is the extra
+check of the tools that run or validate a search (coverage would be 0 of 0).
+
 A departure point inside a room is not an error (robots can leave through its door) but a
 warning, which says whether the room is *nested* (its doors open only into other rooms).
 
@@ -37,6 +41,7 @@ __all__ = [
     'departure_room_warnings',
     'free_space_raster',
     'point_segment_distances',
+    'require_rooms',
     'validate_site',
 ]
 
@@ -115,6 +120,20 @@ def free_space_raster(site: Site, *, sealed: bool = True) -> FreeSpaceRaster:
     resolution = site.grid_m / 4.0 if site.grid_m is not None else _FREE_FORM_RESOLUTION_M
     walls = site.sealed_walls if sealed else site.walls
     return FreeSpaceRaster(walls, site.width_m, site.height_m, resolution)
+
+
+def require_rooms(site: Site, source: str | None = None) -> None:
+    """Raise :class:`SiteValidationError` when the site has no room to search.
+
+    Args:
+        site: the site.
+        source: the file it came from, named in the message instead of the site's name.
+    """
+    if site.rooms:
+        return
+    where = source if source is not None else f'site {site.name!r}'
+    msg = f'{where}: the site has no rooms; a search needs at least one (coverage would be 0/0)'
+    raise SiteValidationError(msg, key_path=('rooms',))
 
 
 def validate_site(

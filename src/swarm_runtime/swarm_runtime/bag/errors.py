@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+from swarm_common.errors import SwarmError
+
 __all__ = ['BagError', 'BagNotFoundError', 'BagTypeError', 'BagWriteError', 'CorruptBagError']
 
 
-class BagError(Exception):
+class BagError(SwarmError):
     """Base class of every bag error; the message (one line) names the file and what is wrong.
 
     ``recoverable`` is True when reading with recovery would get messages out of the bag

@@ -106,6 +106,9 @@ class BagRecorder(Node):
         flush_period_s: How often buffered messages are pushed to disk [s, steady time],
             so a crash loses at most this much.
         use_sim_time: Set the node's ``use_sim_time`` parameter (timestamps in sim time).
+        staging: Record into a hidden sibling of ``output`` and rename it to ``output`` when
+            the node is destroyed (:class:`BagWriter`): a killed recording leaves no bag
+            under the final name that looks complete.
         **node_kwargs: Passed to ``Node`` (namespace, context, parameter_overrides ...).
     """
 
@@ -121,6 +124,7 @@ class BagRecorder(Node):
         discovery_period_s: float = 0.1,
         flush_period_s: float = 5.0,
         use_sim_time: bool | None = None,
+        staging: bool = False,
         **node_kwargs: Any,
     ) -> None:
         if discovery_period_s <= 0.0 or flush_period_s <= 0.0:
@@ -130,7 +134,7 @@ class BagRecorder(Node):
             overrides = list(node_kwargs.pop('parameter_overrides', None) or [])
             overrides.append(Parameter('use_sim_time', value=use_sim_time))
             node_kwargs['parameter_overrides'] = overrides
-        self._writer = BagWriter(output)
+        self._writer = BagWriter(output, staging=staging)
         super().__init__(node_name, **node_kwargs)
         self._patterns = tuple(topics) if topics is not None else None
         self._exclude = tuple(exclude)
@@ -152,7 +156,7 @@ class BagRecorder(Node):
 
     @property
     def path(self) -> Path:
-        """The bag directory being written."""
+        """The bag directory (its final name; see ``staging``)."""
         return self._writer.path
 
     @property

@@ -13,6 +13,7 @@ a chunk is detected instead of decoded.
 
 from __future__ import annotations
 
+import os
 from collections.abc import Sequence
 from functools import partial
 from pathlib import Path
@@ -24,6 +25,7 @@ from mcap.writer import Writer as McapLibraryWriter
 from rosbags.interfaces import Connection, MessageDefinitionFormat, Qos
 from rosbags.rosbag2 import StoragePlugin, Writer, WriterError
 from rosbags.typesys.store import Typestore
+from swarm_common.outputs import staging_path
 
 from .errors import BagWriteError
 
@@ -46,10 +48,16 @@ class _McapStorage:
     """rosbags' storage-writer interface, implemented with the ``mcap`` library (with CRCs)."""
 
     def __init__(
-        self, path: Path, compression: Any, *, chunk_compression: str, chunk_size_bytes: int
+        self,
+        path: Path,
+        compression: Any,
+        *,
+        chunk_compression: str,
+        chunk_size_bytes: int,
+        stem: str | None = None,
     ) -> None:
         del compression  # rosbag2 file/message compression: never enabled by BagWriter
-        self.path = path / f'{path.name}.mcap'
+        self.path = path / f'{stem or path.name}.mcap'
         self._stream = self.path.open('xb')
         self._mcap = McapLibraryWriter(
             self._stream,
@@ -114,6 +122,11 @@ class BagWriter:
     summary and metadata.yaml; it also happens when the ``with`` block exits with an error, so
     whatever was recorded before the error is kept.
 
+    With ``staging`` the bag is written into a hidden sibling, ``.<name>.<pid>.partial``, and
+    renamed to ``path`` when it is closed: a bag under its final name is always complete,
+    while a recording that was killed (never closed) stays under the staging name, where
+    ``read_messages(..., allow_truncated=True)`` still reads it.
+
     Args:
         path: Directory to create; it must not exist.
         typestore: Types whose definitions and RIHS01 hashes are written (default: the
@@ -121,6 +134,7 @@ class BagWriter:
         chunk_compression: 'none' (default: a cut bag then keeps the whole messages of its
             last, partial chunk), 'zstd' or 'lz4'.
         chunk_size_bytes: Uncompressed chunk size at which a chunk is closed.
+        staging: Write into a hidden sibling and rename it to ``path`` on :meth:`close`.
     """
 
     def __init__(
@@ -130,10 +144,16 @@ class BagWriter:
         typestore: Typestore | None = None,
         chunk_compression: str = 'none',
         chunk_size_bytes: int = DEFAULT_CHUNK_SIZE_BYTES,
+        staging: bool = False,
     ) -> None:
         self._path = Path(path)
-        if self._path.exists():
+        if os.path.lexists(self._path):
             msg = f'{self._path} exists already; a bag is never overwritten'
+            raise BagWriteError(msg)
+        # The directory written while the bag is open (the final one unless staging).
+        self._directory = staging_path(self._path) if staging else self._path
+        if os.path.lexists(self._directory):
+            msg = f'{self._directory} exists already; a bag is never overwritten'
             raise BagWriteError(msg)
         if chunk_compression not in CHUNK_COMPRESSIONS:
             msg = f'chunk_compression must be one of {", ".join(CHUNK_COMPRESSIONS)}'
@@ -146,13 +166,16 @@ class BagWriter:
 
             typestore = get_typestore()
         self._typestore = typestore
-        self._writer = Writer(self._path, version=BAG_VERSION, storage_plugin=StoragePlugin.MCAP)
+        self._writer = Writer(
+            self._directory, version=BAG_VERSION, storage_plugin=StoragePlugin.MCAP
+        )
         # An instance attribute shadows rosbags' class-level plugin table for this writer only.
         self._writer.STORAGE_PLUGINS = {  # type: ignore[misc]
             StoragePlugin.MCAP: partial(
                 _McapStorage,
                 chunk_compression=chunk_compression,
                 chunk_size_bytes=int(chunk_size_bytes),
+                stem=self._path.name,  # the final name, also while staging
             )
         }
         self._connections: dict[str, Connection] = {}
@@ -160,13 +183,18 @@ class BagWriter:
 
     @property
     def path(self) -> Path:
-        """The bag directory."""
+        """The bag directory (its final name)."""
         return self._path
+
+    @property
+    def directory(self) -> Path:
+        """The directory being written: the staging one while a staged bag is open."""
+        return self._directory
 
     @property
     def mcap_path(self) -> Path:
         """The MCAP storage file inside the bag directory."""
-        return self._path / f'{self._path.name}.mcap'
+        return self._directory / f'{self._path.name}.mcap'
 
     @property
     def is_open(self) -> bool:
@@ -338,5 +366,15 @@ class BagWriter:
         try:
             self._writer.close()
         except (WriterError, OSError) as err:
-            msg = f'{self._path}: cannot finish the bag: {err}'
+            msg = f'{self._directory}: cannot finish the bag: {err}'
             raise BagWriteError(msg) from err
+        if self._directory != self._path:
+            if os.path.lexists(self._path):
+                msg = f'{self._path} appeared while recording; the bag is kept as {self._directory}'
+                raise BagWriteError(msg)
+            try:
+                os.rename(self._directory, self._path)
+            except OSError as err:
+                msg = f'cannot rename {self._directory} to {self._path}: {err.strerror or err}'
+                raise BagWriteError(msg) from err
+            self._directory = self._path
