@@ -24,6 +24,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+from oabug_robot.profiles import PROFILES
 from swarm_common.cli import EXIT_SUCCESS, fail
 from swarm_common.errors import SwarmError
 from swarm_sim.departure import place_starts
@@ -92,7 +93,10 @@ class SpawnSettings:
         record_scans: also record each robot's lidar scans (``/r<i>/scan``, about 8 kB/s
             per robot; off by default, the viewers' scan displays show them when present).
         out_dir: directory for the PNGs, or None for no plots.
-        robot_parameters: extra OA-Bug node parameters for every robot.
+        profile: the OA-Bug parameter profile (``oabug_robot.profiles``): 'tuned' (the
+            node's defaults) or 'paper' (Table I read literally).
+        robot_parameters: extra OA-Bug node parameters for every robot (on top of the
+            profile's).
         engine: world configuration (its seed is replaced by ``seed``).
     """
 
@@ -108,6 +112,7 @@ class SpawnSettings:
     record_robot_topics: bool = True
     record_scans: bool = False
     out_dir: Path | None = None
+    profile: str = 'tuned'
     robot_parameters: dict[str, object] = field(default_factory=dict)
     engine: EngineConfig = field(default_factory=EngineConfig)
 
@@ -126,6 +131,9 @@ class SpawnSettings:
             raise ConfigurationError(msg)
         if self.seed < 0 or self.site_seed < 0:
             raise ConfigurationError('seeds must be >= 0')
+        if self.profile not in PROFILES:
+            msg = f'unknown profile {self.profile!r}; choose one of {", ".join(PROFILES)}'
+            raise ConfigurationError(msg)
 
     @property
     def budget_actions(self) -> int:
@@ -210,6 +218,7 @@ def build_mission(config: SpawnSettings) -> tuple[MissionSpec, float]:
             'own_tag_id': f'R{i}',
             'seed': int(config.seed * 1000 + i),
         }
+        params.update(PROFILES[config.profile])
         params.update(config.robot_parameters)
         robots.append(RobotNodeSpec(factory, params))
     recording = None
@@ -322,6 +331,13 @@ def _parser() -> argparse.ArgumentParser:
     )
     parser.add_argument('--seed', type=int, default=0, help='seed of the run')
     parser.add_argument(
+        '--profile',
+        choices=tuple(PROFILES),
+        default='tuned',
+        help="OA-Bug parameters: 'paper' (Table I read literally) or 'tuned' (the defaults; "
+        'departures in docs/oabug.md); --param values apply on top',
+    )
+    parser.add_argument(
         '--actions',
         type=int,
         default=None,
@@ -360,6 +376,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             robots=args.robots,
             departure=args.departure,
             seed=args.seed,
+            profile=args.profile,
             actions=args.actions,
             speed_mps=args.speed,
             record=args.record,

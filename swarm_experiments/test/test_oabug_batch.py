@@ -179,3 +179,25 @@ def test_the_spawner_starts_robots_in_free_space_on_a_seeded_fan():
     first, _ = build_mission(SpawnSettings(site='small', robots=10, departure='edge', seed=0))
     second, _ = build_mission(SpawnSettings(site='small', robots=10, departure='edge', seed=1))
     assert not np.allclose(first.initial_poses[:, 2], second.initial_poses[:, 2])
+
+
+def test_the_spawner_profile_sets_the_node_parameters_under_the_explicit_ones():
+    paper, _ = build_mission(
+        SpawnSettings(site=str(FIVE_ROOMS), robots=2, departure='edge', profile='paper')
+    )
+    assert all(r.parameters['gas_sound_wall_side'] == 'every_contact' for r in paper.robots)
+    assert all(r.parameters['robot_hit_repeat_s'] == 0.0 for r in paper.robots)
+    mixed, _ = build_mission(
+        SpawnSettings(
+            site=str(FIVE_ROOMS),
+            robots=2,
+            departure='edge',
+            profile='paper',
+            robot_parameters={'robot_hit_repeat_s': 2.0},
+        )
+    )
+    assert all(r.parameters['robot_hit_repeat_s'] == 2.0 for r in mixed.robots)
+    tuned, _ = build_mission(SpawnSettings(site=str(FIVE_ROOMS), robots=2, departure='edge'))
+    assert 'gas_sound_wall_side' not in tuned.robots[0].parameters
+    with pytest.raises(ConfigurationError, match='profile'):
+        SpawnSettings(profile='fast')
