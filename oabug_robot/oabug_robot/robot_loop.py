@@ -184,6 +184,21 @@ class RobotLoop(Generic[_ScanT]):
             name for name, stamp in required if stamp is None or not 0.0 <= now_s - stamp <= timeout
         ]
 
+    def _fresh(self, now_s: float) -> bool:
+        """``not self.stale_inputs(now_s)``, without building the list (every step asks)."""
+        timeout = self.stale_timeout_s
+        stamp = self._features_time_s
+        if stamp is None or not 0.0 <= now_s - stamp <= timeout:
+            return False
+        stamp = self._imu_time_s
+        if stamp is None or not 0.0 <= now_s - stamp <= timeout:
+            return False
+        if self.needs_gas:
+            stamp = self._gas_time_s
+            if stamp is None or not 0.0 <= now_s - stamp <= timeout:
+                return False
+        return True
+
     def _near_peers(self, now_s: float) -> tuple[np.ndarray, np.ndarray]:
         bearings = self._bearings
         if bearings is None or now_s - bearings.stamp_s > self.config.bearing_timeout_s:
@@ -253,10 +268,9 @@ class RobotLoop(Generic[_ScanT]):
         """One control step at node time ``now_s`` [s], after :meth:`update_features` (or
         :func:`extract_features`): the controller's command, or :data:`STOP` and the stale
         inputs while any input is missing or stale."""
-        stale = self.stale_inputs(now_s)
         features = self._features
-        if stale or features is None:
-            return LoopOutput(STOP, tuple(stale) or ('scan',))
+        if features is None or not self._fresh(now_s):
+            return LoopOutput(STOP, tuple(self.stale_inputs(now_s)) or ('scan',))
         snapshot = SensorSnapshot(
             time_s=now_s,
             yaw_rad=self._yaw_rad,
