@@ -292,9 +292,9 @@ def format_footer(outcomes: Sequence[Outcome], total_s: float, args: argparse.Na
     metres = sum(o.robot_metres for o in outcomes)
     sim_s = sum(o.sim_time_s for o in outcomes)
     workers = max(args.workers, 1)
-    settings = ''
+    settings = f' Profile {getattr(args, "profile", "tuned")}.'
     if args.set:
-        settings = f' OA-Bug parameters other than the defaults: {" ".join(args.set)}.'
+        settings += f' OA-Bug parameters other than the profile: {" ".join(args.set)}.'
     return (
         f'{n} runs ({args.config}, {args.robots} robots, {args.sites} sites, {args.path} path) '
         f'in {total_s:.0f} s wall with {workers} workers: {cpu:.2f} CPU s per run, '
@@ -390,12 +390,20 @@ def main(argv: Sequence[str] | None = None) -> int:
         metavar='NAME=VALUE',
         help='OA-Bug node parameters other than the defaults (e.g. gas_threshold=300)',
     )
+    parser.add_argument(
+        '--profile',
+        choices=('paper', 'tuned'),
+        default='tuned',
+        help="OA-Bug profile: 'paper' (Table I read literally) or 'tuned' (the defaults); "
+        '--set values apply on top',
+    )
     args = parser.parse_args(argv)
+    from oabug_robot.profiles import profile_parameters
     from swarm_experiments.spawn import oabug_parameter_overrides
     from swarm_sim.errors import ConfigurationError
 
     try:
-        parameters = oabug_parameter_overrides(args.set)
+        parameters = {**profile_parameters(args.profile), **oabug_parameter_overrides(args.set)}
     except ConfigurationError as err:
         parser.error(str(err))
     outcomes, total_s = run(
