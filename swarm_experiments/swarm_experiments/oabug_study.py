@@ -251,7 +251,7 @@ def _curve_figure(page: ReportPage, rows: pd.DataFrame, site: str, profile: str)
     robots_present = [r for r in ROBOTS if (rows['config.robots'] == r).any()]
     if not robots_present:
         return
-    figure = Figure(figsize=(3.0 * len(robots_present), 5.6))
+    figure = Figure(figsize=(max(3.0 * len(robots_present), 5.5), 5.6))
     axes = figure.subplots(2, len(robots_present), squeeze=False, sharey=True)
     for row, departure in enumerate(DEPARTURES):
         for col, robots in enumerate(robots_present):
