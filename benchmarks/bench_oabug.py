@@ -299,9 +299,9 @@ def format_footer(outcomes: Sequence[Outcome], total_s: float, args: argparse.Na
     metres = sum(o.robot_metres for o in outcomes)
     sim_s = sum(o.sim_time_s for o in outcomes)
     workers = max(args.workers, 1)
-    settings = ''
+    settings = f' Profile {getattr(args, "profile", "tuned")}.'
     if args.set:
-        settings = f' OA-Bug parameters other than the defaults: {" ".join(args.set)}.'
+        settings += f' OA-Bug parameters other than the profile: {" ".join(args.set)}.'
     return (
         f'{n} runs ({args.config}, {args.robots} robots, {args.sites} sites, {args.path} path, '
         f'{args.physics} physics) '
@@ -429,13 +429,21 @@ def _main(argv: list[str]) -> int:
         default='numpy',
         help='physics and ray-casting backend of every mission (docs/simulation.md)',
     )
+    parser.add_argument(
+        '--profile',
+        choices=('paper', 'tuned'),
+        default='tuned',
+        help="OA-Bug profile: 'paper' (Table I read literally) or 'tuned' (the defaults); "
+        '--set values apply on top',
+    )
     args = parser.parse_args(argv)
+    from oabug_robot.profiles import profile_parameters
     from swarm_experiments.spawn import oabug_parameter_overrides
 
     for name in ('sites', 'robots', 'workers'):
         if getattr(args, name) < 1:
             raise UsageError(f'--{name} must be >= 1, got {getattr(args, name)}')
-    parameters = oabug_parameter_overrides(args.set)
+    parameters = {**profile_parameters(args.profile), **oabug_parameter_overrides(args.set)}
     if args.out is not None:
         check_output_file(args.out, option='--out')
     interrupted = None

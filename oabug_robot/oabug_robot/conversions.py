@@ -26,6 +26,7 @@ __all__ = [
     'command_to_pump',
     'command_to_twist',
     'gas_from_ros',
+    'peer_arrays_from_ros',
     'scan_from_ros',
     'state_to_ros',
     'stop_twist',
@@ -80,6 +81,17 @@ def gas_from_ros(msg: Any) -> int | None:
     return int(msg.raw)
 
 
+def peer_arrays_from_ros(msg: Any, own_tag_id: str) -> tuple[np.ndarray, np.ndarray]:
+    """swarm_interfaces/PeerBearingArray -> the peers' azimuths [rad] and distances [m]
+    without the own tag (``own_tag_id`` case-insensitive; '' keeps every tag)."""
+    own = own_tag_id.strip().upper()
+    peers = [b for b in msg.bearings if not own or b.tag_id.strip().upper() != own]
+    return (
+        np.array([b.azimuth for b in peers], dtype=float),
+        np.array([b.distance for b in peers], dtype=float),
+    )
+
+
 def bearings_from_ros(msg: Any, own_tag_id: str, stamp_s: float, yaw_rad: float) -> PeerBearings:
     """swarm_interfaces/PeerBearingArray -> :class:`PeerBearings` without the own tag.
 
@@ -89,13 +101,9 @@ def bearings_from_ros(msg: Any, own_tag_id: str, stamp_s: float, yaw_rad: float)
         stamp_s: when the array was received [s, node clock].
         yaw_rad: the robot's yaw at that time [rad].
     """
-    own = own_tag_id.strip().upper()
-    peers = [b for b in msg.bearings if not own or b.tag_id.strip().upper() != own]
+    azimuths, distances = peer_arrays_from_ros(msg, own_tag_id)
     return PeerBearings(
-        azimuths_rad=np.array([b.azimuth for b in peers], dtype=float),
-        distances_m=np.array([b.distance for b in peers], dtype=float),
-        stamp_s=stamp_s,
-        yaw_at_stamp_rad=yaw_rad,
+        azimuths_rad=azimuths, distances_m=distances, stamp_s=stamp_s, yaw_at_stamp_rad=yaw_rad
     )
 
 

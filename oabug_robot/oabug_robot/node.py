@@ -6,8 +6,10 @@ Subscribes (relative names, so the robot's namespace applies): ``scan``
 (geometry_msgs/Twist), ``pump`` (std_msgs/Bool) and ``state`` (swarm_interfaces/OABugState)
 at ``control_rate_hz`` (the state at ``state_rate_hz``, and at every event).
 
-The node only translates; every decision is in :class:`oabug_robot.fsm.OABugFsm`. If the scan
-or the IMU (and, for the gas variants, the gas sensor) has not been heard for
+The node only translates: the control loop (sample and hold, staleness, scan features, the
+controller step) is :class:`oabug_robot.robot_loop.RobotLoop`, the same loop the batch
+runner of the sweeps drives, and every decision is in :class:`oabug_robot.fsm.OABugFsm`. If
+the scan or the IMU (and, for the gas variants, the gas sensor) has not been heard for
 ``stale_timeout_s``, it publishes a zero cmd_vel and pump off until the input is back.
 
 Run: ``ros2 run oabug_robot oabug --ros-args -r __ns:=/r0 -p variant:=gas_sound
@@ -20,7 +22,6 @@ import math
 from collections.abc import Sequence
 from typing import Any
 
-import numpy as np
 from swarm_common.cli import fail
 from swarm_runtime.parameters import ParameterFileError, check_parameter_arguments, declare_config
 from swarm_runtime.ros import (
@@ -32,20 +33,19 @@ from swarm_runtime.ros import (
 )
 
 from oabug_robot.conversions import (
-    bearings_from_ros,
     command_to_pump,
     command_to_twist,
     gas_from_ros,
+    peer_arrays_from_ros,
     scan_from_ros,
     state_to_ros,
     stop_twist,
     yaw_from_imu,
 )
 from oabug_robot.errors import ConfigError, ScanError
-from oabug_robot.fsm import Event, OABugFsm, SensorSnapshot
+from oabug_robot.fsm import Event, OABugFsm
 from oabug_robot.node_settings import NODE_NAME, OABUG_PARAMETERS, OABugNodeConfig
-from oabug_robot.scan_features import ScanFeatureExtractor, ScanFeatures
-from oabug_robot.sound import PeerBearings
+from oabug_robot.robot_loop import RobotLoop
 
 __all__ = ['OABugNode', 'main']
 
@@ -63,30 +63,19 @@ class OABugNode(Node):
 
     def __init__(self, node_name: str = NODE_NAME, **kwargs: Any) -> None:
         super().__init__(node_name, **kwargs)
+        self._loop: RobotLoop[Any] | None = None
         try:
             self._declared = declare_config(self, OABUG_PARAMETERS, on_change=self._configure)
         except ConfigError as err:
             self.get_logger().fatal(f'invalid configuration: {err}')
             raise
         settings = self._declared.config
-        self._config = settings.controller_config()
+        self._loop = RobotLoop(settings, decode_scan=scan_from_ros)
+        self._config = self._loop.config
         self._configure(settings)
-        self._fsm = OABugFsm(self._config)
-        self._extractor = ScanFeatureExtractor(self._config.perception)
-
-        self._scan_msg: Any = None
-        self._scan_time_s: float | None = None
-        self._features: ScanFeatures | None = None
-        self._features_time_s: float | None = None
-        self._yaw_rad = math.nan
-        self._imu_time_s: float | None = None
-        self._gas_raw: int | None = None
-        self._gas_time_s: float | None = None
-        self._bearings: PeerBearings | None = None
         self._last_warning_s: dict[str, float] = {}
         self._last_state_s = -math.inf
         self._last_state_stale: bool | None = None
-        self._heard: set[str] = set()
 
         self._cmd_pub = self.create_publisher(geometry_msgs.Twist, 'cmd_vel', 10)
         self._pump_pub = self.create_publisher(std_msgs.Bool, 'pump', 10)
@@ -98,11 +87,11 @@ class OABugNode(Node):
         self.create_subscription(
             swarm_interfaces.PeerBearingArray, 'bearings', self._on_bearings, sensor_qos
         )
-        self._timer = self.create_timer(1.0 / settings.control_rate_hz, self._on_control)
+        self._timer = self.create_timer(self._loop.control_period_s, self._on_control)
         self.get_logger().info(
             f'OA-Bug {self._config.variant.value}: robot {self._config.robot_index} of '
             f'{self._config.robot_count}, {self._config.departure.value} departure, '
-            f'preferred direction {math.degrees(self._fsm.memory.preferred_direction_rad):.1f} deg'
+            f'preferred direction {math.degrees(self.fsm.memory.preferred_direction_rad):.1f} deg'
         )
 
     def _configure(self, settings: OABugNodeConfig) -> None:
@@ -110,11 +99,19 @@ class OABugNode(Node):
         self._stale_timeout_s = settings.stale_timeout_s
         self._state_period_s = 1.0 / settings.state_rate_hz
         self._own_tag_id = settings.own_tag_id
+        if self._loop is not None:
+            self._loop.configure(settings)
+
+    @property
+    def loop(self) -> RobotLoop[Any]:
+        """The robot's control loop (held readings, staleness, controller)."""
+        assert self._loop is not None
+        return self._loop
 
     @property
     def fsm(self) -> OABugFsm:
         """The controller (for inspection in tests and tools)."""
-        return self._fsm
+        return self.loop.fsm
 
     def _now_s(self) -> float:
         return self.get_clock().now().nanoseconds * 1e-9
@@ -130,89 +127,40 @@ class OABugNode(Node):
             else:
                 self.get_logger().info(text)
 
-    # Sensor callbacks: store the latest value and when it arrived (node clock).
+    # Sensor callbacks: hand the reading to the loop with the time it arrived (node clock).
 
     def _on_scan(self, msg: Any) -> None:
-        self._scan_msg = msg
-        self._scan_time_s = self._now_s()
+        self.loop.hold_scan(msg, self._now_s())
 
     def _on_imu(self, msg: Any) -> None:
         try:
-            self._yaw_rad = yaw_from_imu(msg)
+            yaw = yaw_from_imu(msg)
         except ValueError as err:
             self._log_once_per_period('imu', f'ignoring IMU message: {err}')
             return
-        self._imu_time_s = self._now_s()
-        self._heard.add('imu')
+        self.loop.hold_yaw(yaw, self._now_s())
 
     def _on_gas(self, msg: Any) -> None:
-        self._gas_raw = gas_from_ros(msg)
-        self._gas_time_s = self._now_s()
-        self._heard.add('gas')
+        self.loop.hold_gas(gas_from_ros(msg), self._now_s())
 
     def _on_bearings(self, msg: Any) -> None:
-        yaw = self._yaw_rad if math.isfinite(self._yaw_rad) else 0.0
-        self._bearings = bearings_from_ros(msg, self._own_tag_id, self._now_s(), yaw)
+        azimuths, distances = peer_arrays_from_ros(msg, self._own_tag_id)
+        self.loop.hold_bearings(azimuths, distances, self._now_s())
 
     # Control loop.
 
-    def _stale_inputs(self, now_s: float) -> list[str]:
-        required: list[tuple[str, float | None]] = [
-            ('scan', self._features_time_s),
-            ('imu', self._imu_time_s),
-        ]
-        if self._config.variant.uses_scent:
-            required.append(('gas', self._gas_time_s))
-        return [
-            name
-            for name, stamp in required
-            if stamp is None or not 0.0 <= now_s - stamp <= self._stale_timeout_s
-        ]
-
-    def _near_peers(self, now_s: float) -> tuple[np.ndarray, np.ndarray]:
-        """Fresh bearings [rad] (robot frame now) and distances [m] of peers that may be near."""
-        bearings = self._bearings
-        if bearings is None or now_s - bearings.stamp_s > self._config.bearing_timeout_s:
-            return np.zeros(0), np.zeros(0)
-        return bearings.near_peers_now(
-            self._yaw_rad, self._config.perception.peer_bearing_max_distance_m
-        )
-
-    def _update_features(self, now_s: float) -> None:
-        if self._scan_msg is None:
-            return
-        scan_time, msg = self._scan_time_s, self._scan_msg
-        self._scan_msg = None
-        try:
-            # Only the wall being followed matters for the next step (a wall taken up in
-            # that step is first turned to, which needs no side wall).
-            side = self._fsm.memory.wall_side
-            self._features = self._extractor.extract(
-                scan_from_ros(msg), *self._near_peers(now_s), sides=(side,) if side else ()
-            )
-        except ScanError as err:
-            self._log_once_per_period('scan', f'ignoring laser scan: {err}')
-            return
-        self._features_time_s = scan_time
-        self._heard.add('scan')
-
     def _on_control(self) -> None:
         now_s = self._now_s()
-        if math.isfinite(self._yaw_rad):
-            self._update_features(now_s)
-        stale = self._stale_inputs(now_s)
-        features = self._features
-        if stale or features is None:
-            self._hold_stopped(now_s, stale or ['scan'])
+        loop = self.loop
+        try:
+            loop.update_features(now_s)
+        except ScanError as err:
+            self._log_once_per_period('scan', f'ignoring laser scan: {err}')
+        output = loop.step(now_s)
+        if output.stale:
+            self._hold_stopped(now_s, output.stale)
             return
-        snapshot = SensorSnapshot(
-            time_s=now_s,
-            yaw_rad=self._yaw_rad,
-            scan=features,
-            gas_raw=self._gas_raw,
-            bearings=self._bearings,
-        )
-        command = self._fsm.step(snapshot)
+        command = output.command
         self._cmd_pub.publish(command_to_twist(command))
         self._pump_pub.publish(command_to_pump(command.pump_on))
         self._publish_state(now_s, pump_on=command.pump_on, stale=False)
@@ -222,7 +170,7 @@ class OABugNode(Node):
         self._cmd_pub.publish(stop_twist())
         self._pump_pub.publish(command_to_pump(False))
         self._publish_state(now_s, pump_on=False, stale=True)
-        never = [name for name in stale if name not in self._heard]
+        never = [name for name in stale if name not in self.loop.heard]
         if never:
             self._log_once_per_period(
                 'waiting', f'waiting for the first {", ".join(never)} message', warn=False
@@ -237,20 +185,21 @@ class OABugNode(Node):
         """Publish the state at ``state_rate_hz``, and at once on an event or a stale change."""
         due = not 0.0 <= now_s - self._last_state_s < self._state_period_s
         changed = stale != self._last_state_stale
-        event = not stale and self._fsm.memory.event is not Event.NONE
+        event = not stale and self.fsm.memory.event is not Event.NONE
         if not (due or changed or event):
             return
         self._last_state_s = now_s
         self._last_state_stale = stale
+        loop = self.loop
         self._state_pub.publish(
             state_to_ros(
-                self._fsm.memory,
+                self.fsm.memory,
                 self._config,
                 stamp=self.get_clock().now().to_msg(),
-                heading_rad=self._yaw_rad,
+                heading_rad=loop.yaw_rad,
                 pump_on=pump_on,
-                gas_raw=self._gas_raw,
-                scent_detected=self._fsm.scent_detected(now_s),
+                gas_raw=loop.gas_raw,
+                scent_detected=self.fsm.scent_detected(now_s),
                 inputs_stale=stale,
             )
         )

@@ -4,10 +4,10 @@
 numba is optional: the simulation install compiles these loops, a robot install (no numba)
 runs the same Python loops uncompiled, with the same results; the robots themselves run the
 numpy extractor, which stays the reference. The batch sweep path
-(:mod:`swarm_experiments.oabug_batch`) hands every scan of a physics step to :func:`extract_many`
-instead of calling the extractor once per robot. The features are bit-identical
-(``test_scan_features_kernel.py`` compares them on random scans with NaN and +-inf ranges,
-empty scans and peers with NaN bearings and distances):
+(:func:`oabug_robot.robot_loop.extract_features`) hands every scan of a control step to
+:func:`extract_many_flat` instead of calling the extractor once per robot. The features are
+bit-identical (``test_scan_features_kernel.py`` compares them on random scans with NaN and
++-inf ranges, empty scans and peers with NaN bearings and distances):
 
 * the transcendental functions stay in numpy (``arctan2``, ``sin``, ``cos``), computed for
   all robots at once: numpy's vectorised ``arctan2`` differs from the C library's in the last

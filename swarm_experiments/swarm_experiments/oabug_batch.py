@@ -2,10 +2,10 @@
 
 The ROS path (:func:`swarm_experiments.mission.run_mission`) runs the sim bridge node and one
 :class:`oabug_robot.node.OABugNode` per robot on the built-in runtime, and every reading
-travels as a message. This module drives the very same parts directly: the
-:class:`swarm_sim.engine.SimEngine` and, per robot, the node's own controller
-(:class:`oabug_robot.fsm.OABugFsm`) and scan feature extractor, built from the same node
-parameters by :data:`oabug_robot.node_settings.OABUG_PARAMETERS`. It reproduces what the
+travels as a message. This module steps the world (:class:`swarm_sim.engine.SimEngine`)
+and drives, per robot, the node's own control loop (:class:`oabug_robot.robot_loop.RobotLoop`:
+sample and hold, staleness, scan features, controller step), built from the same node
+parameters by :data:`oabug_robot.node_settings.OABUG_PARAMETERS`. What it adds is what the
 messages and the executor do to the data, so a batch run's trajectories and first room
 entries equal the ROS path's (tested):
 
@@ -36,19 +36,16 @@ import dataclasses
 import math
 import time
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from oabug_robot.errors import ScanError
-from oabug_robot.fsm import Command, OABugFsm, SensorSnapshot
+from oabug_robot.fsm import Command
 from oabug_robot.node_settings import OABUG_PARAMETERS
-from oabug_robot.scan_features import LaserScanData, ScanFeatureExtractor, ScanFeatures
-from oabug_robot.scan_features_kernel import extract_many_flat
-from oabug_robot.sound import PeerBearings
+from oabug_robot.robot_loop import ControlTimer, RobotLoop, extract_features
+from oabug_robot.scan_features import LaserScanData
 from swarm_common.angles import yaw_from_quaternion, yaw_to_quaternion
 from swarm_common.params import ParameterError
-from swarm_common.stamps import NS_PER_S, seconds_to_ns
+from swarm_common.stamps import seconds_to_ns
 from swarm_runtime.builtin._messages import cdr_roundtrip_enabled
 from swarm_sim.engine import EngineConfig, SimEngine, SiteGeometry
 from swarm_sim.errors import ConfigurationError
@@ -63,19 +60,14 @@ from swarm_experiments.spawn import OABugRun, SpawnSettings, run
 
 __all__ = ['BatchRobot', 'run_oabug_batch', 'run_spawn_batch']
 
-_STOP = Command(linear_mps=0.0, angular_radps=0.0, pump_on=False)
-
-
-@dataclass
-class _Held:
-    """The newest reading of one sensor and the node-clock time it arrived [s]."""
-
-    value: Any = None
-    time_s: float | None = None
-
 
 class BatchRobot:
-    """One OA-Bug robot as its node runs it, fed with readings instead of messages."""
+    """One OA-Bug robot as its node runs it, fed with readings instead of messages.
+
+    The control loop is the node's own (:class:`oabug_robot.robot_loop.RobotLoop`); this
+    class only does to the readings what the messages do (float32 fields, the IMU
+    quaternion, the own tag dropped) and keeps the node's control timer.
+    """
 
     def __init__(
         self, parameters: Mapping[str, Any], lidar: LidarConfig, *, float32_fields: bool = False
@@ -99,17 +91,13 @@ class BatchRobot:
             if err.unknown:
                 raise ConfigurationError(str(err)) from err
             raise
-        self.config = settings.controller_config()
-        rate_hz = settings.control_rate_hz
+        self.loop: RobotLoop[LaserScanData] = RobotLoop(settings)
+        self.config = self.loop.config
+        self.fsm = self.loop.fsm
         self.stale_timeout_s = settings.stale_timeout_s
-        # The node's timer: period in whole nanoseconds, first deadline one period in.
-        self.control_period_ns = int(1.0 / rate_hz * NS_PER_S)
-        self.next_control_ns = self.control_period_ns
+        # The node's timer on sim time.
+        self.timer = ControlTimer(self.loop.control_period_s)
         self.own_tag = settings.own_tag_id.strip().upper()
-        self.fsm = OABugFsm(self.config)
-        # Robots of one group have equal perception settings (set by the batch runner).
-        self.perception_group = 0
-        self._extractor = ScanFeatureExtractor(self.config.perception)
         # Fields of the messages: float32 after serialization, else the Python float.
         self._field_type = np.float32 if float32_fields else np.float64
         field = self._field_type
@@ -117,30 +105,21 @@ class BatchRobot:
             float(field(v))
             for v in (-math.pi, lidar.angle_increment_rad, lidar.range_min_m, lidar.range_max_m)
         )
-        self._needs_gas = self.config.variant.uses_scent
-        self._scan = _Held()
-        self._features: ScanFeatures | None = None
-        self._features_time_s: float | None = None
-        self._yaw = _Held(math.nan)
-        self._gas = _Held()
-        self._bearings: PeerBearings | None = None
 
     @property
     def needs_gas(self) -> bool:
         """The robot's variant reads the gas sensor (it lays scent)."""
-        return self._needs_gas
+        return self.loop.needs_gas
 
     # Readings, in the order the bridge publishes them within a step.
 
     def receive_scan(self, ranges_m: np.ndarray, now_s: float) -> None:
         """A lidar revolution arrives: ranges [m] (REP 117) as the message's float32 hold."""
-        self._scan.value = LaserScanData(ranges_m, *self._scan_frame)
-        self._scan.time_s = now_s
+        self.loop.hold_scan(LaserScanData(ranges_m, *self._scan_frame), now_s)
 
     def receive_gas(self, raw: int, now_s: float) -> None:
         """A gas reading on the 10-bit scale arrives."""
-        self._gas.value = int(raw)
-        self._gas.time_s = now_s
+        self.loop.hold_gas(int(raw), now_s)
 
     def receive_bearings(self, report: BearingReport, tag_ids: Sequence[str], now_s: float) -> None:
         """A locator cycle arrives; stamped with the yaw held now (the previous IMU).
@@ -153,7 +132,7 @@ class BatchRobot:
         azimuths = np.asarray(report.azimuth_rad, dtype=self._field_type)
         distances = np.asarray(report.distance_m, dtype=self._field_type)
         keep = report.tags != self.own_tag_index(tag_ids)
-        self.hold_bearings(azimuths[keep].astype(float), distances[keep].astype(float), now_s)
+        self.loop.hold_bearings(azimuths[keep].astype(float), distances[keep].astype(float), now_s)
 
     def own_tag_index(self, tag_ids: Sequence[str]) -> int:
         """Index of the robot's own tag in ``tag_ids``, -1 when it is not there. The node
@@ -165,110 +144,13 @@ class BatchRobot:
         """The type of the messages' float32 fields as received: np.float32 or np.float64."""
         return self._field_type
 
-    def hold_bearings(
-        self, azimuths_rad: np.ndarray, distances_m: np.ndarray, now_s: float
-    ) -> None:
-        """Hold a locator cycle already converted as the message carries it (the own tag
-        dropped, float32 fields rounded, then widened); stamped with the yaw held now."""
-        yaw = self._yaw.value if math.isfinite(self._yaw.value) else 0.0
-        self._bearings = PeerBearings(
-            azimuths_rad=azimuths_rad, distances_m=distances_m, stamp_s=now_s, yaw_at_stamp_rad=yaw
-        )
-
     def receive_imu(self, yaw_rad: float, now_s: float) -> None:
         """An IMU reading arrives; its yaw goes through the message's quaternion."""
-        self.hold_yaw(yaw_from_quaternion(*yaw_to_quaternion(yaw_rad)), now_s)
-
-    def hold_yaw(self, yaw_rad: float, now_s: float) -> None:
-        """Hold an IMU yaw already read back from the message's quaternion
-        (:func:`swarm_sim.sensors_kernel.imu_message_yaw_kernel`)."""
-        self._yaw.value = yaw_rad
-        self._yaw.time_s = now_s
-
-    # The control step.
-
-    def _near_peers(self, now_s: float) -> tuple[np.ndarray, np.ndarray]:
-        bearings = self._bearings
-        if bearings is None or now_s - bearings.stamp_s > self.config.bearing_timeout_s:
-            return np.zeros(0), np.zeros(0)
-        return bearings.near_peers_now(
-            self._yaw.value, self.config.perception.peer_bearing_max_distance_m
-        )
-
-    def pending_scan(self, now_s: float) -> tuple[LaserScanData, int] | None:
-        """The held scan that this control step turns into features and the side whose wall
-        is wanted; None when there is nothing to do."""
-        scan = self._scan.value
-        if scan is None or not math.isfinite(self._yaw.value):
-            return None
-        return scan, self.fsm.memory.wall_side
-
-    def peer_bearings(self, now_s: float) -> tuple[np.ndarray, np.ndarray, float] | None:
-        """The bearings the control step at ``now_s`` reads, before the near-peer selection:
-        the held azimuths [rad] and distances [m] and the rotation since they were heard
-        (``yaw_at_stamp - yaw`` [rad], added to the azimuths as
-        :meth:`~oabug_robot.sound.PeerBearings.near_peers_now` does); None when none are
-        held or they are older than the bearing timeout."""
-        bearings = self._bearings
-        if bearings is None or now_s - bearings.stamp_s > self.config.bearing_timeout_s:
-            return None
-        return (
-            bearings.azimuths_rad,
-            bearings.distances_m,
-            bearings.yaw_at_stamp_rad - self._yaw.value,
-        )
-
-    def take_features(self, features: ScanFeatures) -> None:
-        """Hold the features of the pending scan (computed for many robots at once)."""
-        self._features = features
-        self._features_time_s = self._scan.time_s
-        self._scan.value = None
-
-    @property
-    def extractor(self) -> ScanFeatureExtractor:
-        """The robot's scan feature extractor."""
-        return self._extractor
-
-    def _update_features(self, now_s: float) -> None:
-        scan, scan_time = self._scan.value, self._scan.time_s
-        if scan is None:
-            return
-        self._scan.value = None
-        side = self.fsm.memory.wall_side
-        try:
-            self._features = self._extractor.extract(
-                scan, *self._near_peers(now_s), sides=(side,) if side else ()
-            )
-        except ScanError:
-            return
-        self._features_time_s = scan_time
+        self.loop.hold_yaw(yaw_from_quaternion(*yaw_to_quaternion(yaw_rad)), now_s)
 
     def control(self, now_s: float) -> Command:
         """One control step at node time ``now_s``: the command the node would publish."""
-        held_yaw = self._yaw
-        if math.isfinite(held_yaw.value) and self._scan.value is not None:
-            self._update_features(now_s)
-        # Every reading the step reads must be fresh: stamped at most the stale timeout ago.
-        timeout = self.stale_timeout_s
-        features_s, yaw_s = self._features_time_s, held_yaw.time_s
-        if features_s is None or not 0.0 <= now_s - features_s <= timeout:
-            return _STOP
-        if yaw_s is None or not 0.0 <= now_s - yaw_s <= timeout:
-            return _STOP
-        if self._needs_gas:
-            gas_s = self._gas.time_s
-            if gas_s is None or not 0.0 <= now_s - gas_s <= timeout:
-                return _STOP
-        if self._features is None:
-            return _STOP
-        snapshot = SensorSnapshot(
-            time_s=now_s,
-            yaw_rad=held_yaw.value,
-            scan=self._features,
-            gas_raw=self._gas.value,
-            bearings=self._bearings,
-        )
-        return self.fsm.step(snapshot)
+        return self.loop.control(now_s).command
 
 
 def _check_spec(spec: MissionSpec) -> None:
@@ -317,7 +199,7 @@ def run_oabug_batch(
     # Robots with equal perception settings share one compiled feature call per step.
     perception_groups: dict[Any, int] = {}
     for robot in robots:
-        robot.perception_group = perception_groups.setdefault(
+        robot.loop.perception_group = perception_groups.setdefault(
             robot.config.perception, len(perception_groups)
         )
     unused = {'odometry'}
@@ -412,20 +294,11 @@ def _deliver(engine: SimEngine, out: Any, robots: list[BatchRobot], own_tags: np
             if math.isnan(held):
                 robot.receive_imu(yaw, now_s)  # no orientation: raises as the node does
             else:
-                robot.hold_yaw(held, now_s)
-    due = []
-    for i, robot in enumerate(robots):
-        if now_ns < robot.next_control_ns:
-            continue
-        period = robot.control_period_ns
-        robot.next_control_ns += period
-        if robot.next_control_ns < now_ns:
-            behind = now_ns - robot.next_control_ns
-            robot.next_control_ns += (1 + (behind - 1) // period) * period
-        due.append(i)
+                robot.loop.hold_yaw(held, now_s)
+    due = [i for i, robot in enumerate(robots) if robot.timer.due(now_ns)]
     # A robot's control step reads only its own readings and controller, so the scan
     # features of every robot due can be computed first, all at once.
-    _extract_features([robots[i] for i in due], now_s)
+    extract_features([robots[i].loop for i in due], now_s)
     velocities: list[tuple[float, float]] = []
     pumps: list[bool] = []
     for i in due:
@@ -451,62 +324,7 @@ def _deliver_bearings(
         bounds = np.concatenate(([0], np.cumsum(keep)))[bounds].tolist()
         azimuths, distances = azimuths[keep], distances[keep]
     for robot, lo, hi in zip(robots, bounds[:-1], bounds[1:], strict=True):
-        robot.hold_bearings(azimuths[lo:hi], distances[lo:hi], now_s)
-
-
-def _extract_features(robots: list[BatchRobot], now_s: float) -> None:
-    """Turn the held scans of ``robots`` into features, the robots of one perception
-    configuration in one compiled call (:func:`oabug_robot.scan_features_kernel.extract_many`,
-    equal to each robot's extractor). A robot whose scan the batch cannot take (a
-    :class:`ScanError`) is left to its own extractor in its control step."""
-    groups: dict[int, list[tuple[BatchRobot, LaserScanData, int]]] = {}
-    for robot in robots:
-        pending = robot.pending_scan(now_s)
-        if pending is not None:
-            groups.setdefault(robot.perception_group, []).append((robot, *pending))
-    for members in groups.values():
-        extractor = members[0][0].extractor
-        scans = [scan for _, scan, _ in members]
-        sides = [side for _, _, side in members]
-        bearing_start, azimuths, distances = _near_peers(
-            [robot.peer_bearings(now_s) for robot, _, _ in members],
-            extractor.config.peer_bearing_max_distance_m,
-        )
-        try:
-            features = extract_many_flat(
-                extractor, scans, bearing_start, azimuths, distances, sides
-            )
-        except ScanError:
-            continue
-        for (robot, _, _), robot_features in zip(members, features, strict=True):
-            robot.take_features(robot_features)
-
-
-def _near_peers(
-    held: list[tuple[np.ndarray, np.ndarray, float] | None], max_distance_m: float
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """:meth:`oabug_robot.sound.PeerBearings.near_peers_now` of several robots at once (the
-    same element-wise operations): the slice bounds of each robot's near peers, their
-    bearings at the robots' current yaws [rad] and their distances [m].
-
-    Args:
-        held: per robot, what :meth:`BatchRobot.peer_bearings` returns.
-        max_distance_m: peers farther than this (by their known distance) are left out.
-    """
-    counts = [0 if h is None else len(h[0]) for h in held]
-    bounds = np.zeros(len(held) + 1, dtype=np.int64)
-    np.cumsum(counts, out=bounds[1:])
-    if not bounds[-1]:
-        return bounds, np.zeros(0), np.zeros(0)
-    present = [h for h in held if h is not None]
-    rotation = np.repeat([h[2] for h in present], [len(h[0]) for h in present])
-    azimuths = np.concatenate([h[0] for h in present]) + rotation
-    distances = np.concatenate([h[1] for h in present])
-    near = ~(distances > max_distance_m)  # NaN (unknown) distances are kept
-    if not near.all():
-        bounds = np.concatenate(([0], np.cumsum(near)))[bounds]
-        azimuths, distances = azimuths[near], distances[near]
-    return bounds, azimuths, distances
+        robot.loop.hold_bearings(azimuths[lo:hi], distances[lo:hi], now_s)
 
 
 def run_spawn_batch(

@@ -29,6 +29,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+from oabug_robot.profiles import PROFILES
 from swarm_common.cli import (
     EXIT_INTERRUPTED,
     EXIT_SUCCESS,
@@ -121,7 +122,10 @@ class SpawnSettings:
         record_scans: also record each robot's lidar scans (``/r<i>/scan``, about 8 kB/s
             per robot; off by default, the viewers' scan displays show them when present).
         out_dir: directory for the PNGs, or None for no plots.
-        robot_parameters: extra OA-Bug node parameters for every robot.
+        profile: the OA-Bug parameter profile (``oabug_robot.profiles``): 'tuned' (the
+            node's defaults) or 'paper' (Table I read literally).
+        robot_parameters: extra OA-Bug node parameters for every robot (on top of the
+            profile's).
         engine: world configuration (its seed is replaced by ``seed``).
     """
 
@@ -137,6 +141,7 @@ class SpawnSettings:
     record_robot_topics: bool = True
     record_scans: bool = False
     out_dir: Path | None = None
+    profile: str = 'tuned'
     robot_parameters: dict[str, object] = field(default_factory=dict)
     engine: EngineConfig = field(default_factory=EngineConfig)
 
@@ -155,6 +160,9 @@ class SpawnSettings:
             raise ConfigurationError(msg)
         if self.seed < 0 or self.site_seed < 0:
             msg = f'seeds must be >= 0, got seed {self.seed}, site seed {self.site_seed}'
+            raise ConfigurationError(msg)
+        if self.profile not in PROFILES:
+            msg = f'unknown profile {self.profile!r}; choose one of {", ".join(PROFILES)}'
             raise ConfigurationError(msg)
 
     @property
@@ -275,6 +283,7 @@ def build_mission(
             'own_tag_id': f'R{i}',
             'seed': int(config.seed * 1000 + i),
         }
+        params.update(PROFILES[config.profile])
         params.update(config.robot_parameters)
         robots.append(RobotNodeSpec(factory, params))
     recording = None
@@ -399,6 +408,13 @@ def _parser() -> argparse.ArgumentParser:
     )
     parser.add_argument('--seed', type=int, default=0, help='seed of the run')
     parser.add_argument(
+        '--profile',
+        choices=tuple(PROFILES),
+        default='tuned',
+        help="OA-Bug parameters: 'paper' (Table I read literally) or 'tuned' (the defaults; "
+        'departures in docs/oabug.md); --param values apply on top',
+    )
+    parser.add_argument(
         '--actions',
         type=int,
         default=None,
@@ -437,6 +453,7 @@ def _main(argv: list[str]) -> int:
         robots=args.robots,
         departure=args.departure,
         seed=args.seed,
+        profile=args.profile,
         actions=args.actions,
         speed_mps=args.speed,
         record=args.record,

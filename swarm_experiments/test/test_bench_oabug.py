@@ -83,3 +83,18 @@ def test_table_puts_the_matching_authors_figure_beside_each_row(bench):
     bare = bench.format_table(outcomes, None)
     assert '| 85.0 +- 5.0 | n/a |' in bare
     assert "No authors' figures" in bare
+
+
+def test_the_profile_goes_under_the_set_parameters(bench, monkeypatch):
+    pytest.importorskip('oabug_robot.node')
+    seen = {}
+
+    def fake_run(**kwargs):
+        seen.update(kwargs)
+        raise RuntimeError('stop here')
+
+    monkeypatch.setattr(bench, 'run', fake_run)
+    with pytest.raises(RuntimeError, match='stop here'):
+        bench.main(['--profile', 'paper', '--set', 'robot_hit_repeat_s=2'])
+    assert seen['parameters']['gas_sound_wall_side'] == 'every_contact'
+    assert seen['parameters']['robot_hit_repeat_s'] == 2.0

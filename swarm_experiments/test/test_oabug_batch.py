@@ -6,12 +6,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 from oabug_robot.fsm import Command
+from oabug_robot.robot_loop import near_peers
 from oabug_robot.sound import PeerBearings
 from swarm_experiments.mission import RecordingSpec, StopReason, run_mission
 from swarm_experiments.oabug_batch import (
     BatchRobot,
     _deliver_bearings,
-    _near_peers,
     run_oabug_batch,
     run_spawn_batch,
 )
@@ -125,7 +125,7 @@ def test_near_peers_of_many_robots_equal_each_robots_own_selection():
             bearings = PeerBearings(azimuths, distances, 0.0, float(stamp_yaw))
             held.append((azimuths, distances, float(stamp_yaw) - float(yaw)))
             expected.append(bearings.near_peers_now(float(yaw), 2.0))
-        bounds, azimuths, distances = _near_peers(held, 2.0)
+        bounds, azimuths, distances = near_peers(held, 2.0)
         for i, (want_azimuths, want_distances) in enumerate(expected):
             lo, hi = bounds[i], bounds[i + 1]
             assert azimuths[lo:hi].tobytes() == want_azimuths.tobytes()
@@ -158,7 +158,7 @@ def test_a_bearing_cycle_is_held_as_each_robots_report_would_be(float32_fields):
         for robot, report in zip(single, cycle.reports(), strict=True):
             robot.receive_bearings(report, tag_ids, 1.5)
         for got, want in zip(batch, single, strict=True):
-            a, b = got.peer_bearings(1.5), want.peer_bearings(1.5)
+            a, b = got.loop.peer_bearings(1.5), want.loop.peer_bearings(1.5)
             assert a[0].tobytes() == b[0].tobytes()
             assert a[1].tobytes() == b[1].tobytes()
 
@@ -179,3 +179,25 @@ def test_the_spawner_starts_robots_in_free_space_on_a_seeded_fan():
     first, _ = build_mission(SpawnSettings(site='small', robots=10, departure='edge', seed=0))
     second, _ = build_mission(SpawnSettings(site='small', robots=10, departure='edge', seed=1))
     assert not np.allclose(first.initial_poses[:, 2], second.initial_poses[:, 2])
+
+
+def test_the_spawner_profile_sets_the_node_parameters_under_the_explicit_ones():
+    paper, _ = build_mission(
+        SpawnSettings(site=str(FIVE_ROOMS), robots=2, departure='edge', profile='paper')
+    )
+    assert all(r.parameters['gas_sound_wall_side'] == 'every_contact' for r in paper.robots)
+    assert all(r.parameters['robot_hit_repeat_s'] == 0.0 for r in paper.robots)
+    mixed, _ = build_mission(
+        SpawnSettings(
+            site=str(FIVE_ROOMS),
+            robots=2,
+            departure='edge',
+            profile='paper',
+            robot_parameters={'robot_hit_repeat_s': 2.0},
+        )
+    )
+    assert all(r.parameters['robot_hit_repeat_s'] == 2.0 for r in mixed.robots)
+    tuned, _ = build_mission(SpawnSettings(site=str(FIVE_ROOMS), robots=2, departure='edge'))
+    assert 'gas_sound_wall_side' not in tuned.robots[0].parameters
+    with pytest.raises(ConfigurationError, match='profile'):
+        SpawnSettings(profile='fast')

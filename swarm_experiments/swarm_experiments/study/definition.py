@@ -12,7 +12,11 @@ A study is declared once, by the package that owns the algorithm, as a :class:`S
   metrics (scalars) and time series (1-D sequences); it must be deterministic from the spec;
 * ``smoke``: a small variant of the study for ``--smoke`` (fewer axes values, seeds, steps);
 * ``report``: an optional hook ``report(page: ReportPage) -> None`` adding the study's own
-  tables, plots and paper reference numbers to the generic report.
+  tables, plots and paper reference numbers to the generic report;
+* ``check``: an optional hook ``check(config: Mapping) -> None`` called with every
+  configuration's parameters before anything runs; it raises
+  :class:`~swarm_experiments.study.errors.UsageError` for a value the run would reject, so
+  a bad ``--set`` is a one-line error instead of failed rows.
 
 Packages make their studies known through the ``swarm_experiments.studies`` entry point
 group: each entry point loads a callable returning an iterable of :class:`Study`. A module of
@@ -66,6 +70,7 @@ class Study:
     description: str = ''
     smoke: Smoke = field(default_factory=Smoke)
     report: Callable[[ReportPage], None] | None = None
+    check: Callable[[Mapping[str, Any]], None] | None = None
 
     def __post_init__(self) -> None:
         if not _NAME.match(self.name):

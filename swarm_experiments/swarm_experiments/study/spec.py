@@ -212,6 +212,8 @@ def make_specs(
     specs = []
     for values in itertools.product(*(axes[name] for name in names)):
         config = {**copy.deepcopy(params), **dict(zip(names, values, strict=True))}
+        if study.check is not None:
+            study.check(config)
         for seed in seeds:
             specs.append(
                 RunSpec(

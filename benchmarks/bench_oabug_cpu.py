@@ -1,0 +1,122 @@
+"""CPU per OA-Bug run: this suite's batch path against the authors' grid simulator, interleaved.
+
+For each site index the two simulators run the same configuration one after the other in
+this one process (grid, then ours), so both see the same machine load; each run's CPU time
+is ``time.process_time`` around it. The authors' simulator is imported from a checkout the
+user provides (``--simulator DIR``, needs pygame), as in ``reference_oabug_grid.py``. Our
+runs are :func:`swarm_experiments.oabug_batch.run_spawn_batch` missions with the site index
+as site seed and run seed (the Fig. 4 study's runs). Example (one Small run of 10 robots at
+the full budget, 10 sites)::
+
+    python benchmarks/bench_oabug_cpu.py --simulator ../SwarmSearchSimulation --sites 10
+
+``--ours-only`` skips the grid (no checkout needed) and ``--profile FILE`` writes a cProfile
+of our runs to FILE.
+"""
+
+from __future__ import annotations
+
+import argparse
+import cProfile
+import gc
+import statistics
+import sys
+import time
+from collections.abc import Sequence
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+
+def _ours(site: int, config: str, variant: str, departure: str, robots: int, profile: str):
+    from swarm_experiments.oabug_batch import run_spawn_batch
+    from swarm_experiments.spawn import SpawnSettings
+
+    settings = SpawnSettings(
+        site=config,
+        site_seed=site,
+        variant=variant,
+        robots=robots,
+        departure=departure,
+        seed=site,
+        profile=profile,
+    )
+    return run_spawn_batch(settings)
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
+    parser.add_argument('--simulator', type=Path, help="the authors' simulator checkout")
+    parser.add_argument('--ours-only', action='store_true', help='skip the grid simulator')
+    parser.add_argument('--config', choices=('small', 'medium', 'big'), default='small')
+    parser.add_argument('--variant', default='gas_sound')
+    parser.add_argument('--departure', choices=('center', 'edge'), default='center')
+    parser.add_argument('--robots', type=int, default=10)
+    parser.add_argument('--sites', type=int, default=10)
+    parser.add_argument('--first-site', type=int, default=0)
+    parser.add_argument('--oabug-profile', choices=('paper', 'tuned'), default='paper')
+    parser.add_argument('--profile', type=Path, help='write a cProfile of our runs here')
+    args = parser.parse_args(argv)
+    if not args.ours_only and args.simulator is None:
+        parser.error('give --simulator DIR or --ours-only')
+    grid = None
+    if not args.ours_only:
+        from reference_oabug_grid import CONFIGS, GridSimulator
+
+        grid = GridSimulator(args.simulator.resolve(), CONFIGS[args.config], 'right')
+    # Warm-up: imports, numba compilation, caches.
+    _ours(0, args.config, args.variant, args.departure, 2, args.oabug_profile)
+    if grid is not None:
+        grid.run(args.first_site, args.variant, args.departure, 2)
+    gc.collect()
+    profiler = cProfile.Profile() if args.profile else None
+    ours_cpu: list[float] = []
+    grid_cpu: list[float] = []
+    ours_cov: list[float] = []
+    grid_cov: list[float] = []
+    for site in range(args.first_site, args.first_site + args.sites):
+        if grid is not None:
+            start = time.process_time()
+            run = grid.run(site, args.variant, args.departure, args.robots)
+            grid_cpu.append(time.process_time() - start)
+            grid_cov.append(run.coverage_pct)
+        start = time.process_time()
+        if profiler is not None:
+            profiler.enable()
+        result = _ours(
+            site, args.config, args.variant, args.departure, args.robots, args.oabug_profile
+        )
+        if profiler is not None:
+            profiler.disable()
+        ours_cpu.append(time.process_time() - start)
+        ours_cov.append(100.0 * result.coverage)
+        line = f'site {site}: ours {ours_cpu[-1]:.3f} CPU s ({ours_cov[-1]:.1f} %)'
+        if grid is not None:
+            line += f', grid {grid_cpu[-1]:.3f} CPU s ({grid_cov[-1]:.1f} %)'
+        print(line, flush=True)
+    what = (
+        f'{args.config}, {args.variant}, {args.robots} robots from the {args.departure}, '
+        f'{args.sites} sites from {args.first_site}, profile {args.oabug_profile}'
+    )
+    print(f'\n{what}')
+    print(
+        f'ours: {statistics.mean(ours_cpu):.3f} CPU s per run (median '
+        f'{statistics.median(ours_cpu):.3f}), coverage {statistics.mean(ours_cov):.1f} %'
+    )
+    if grid is not None:
+        print(
+            f'grid: {statistics.mean(grid_cpu):.3f} CPU s per run (median '
+            f'{statistics.median(grid_cpu):.3f}), coverage {statistics.mean(grid_cov):.1f} %'
+        )
+        print(
+            f'ratio ours / grid: {sum(ours_cpu) / sum(grid_cpu):.2f} (sum of CPU), '
+            f'{statistics.median(ours_cpu) / statistics.median(grid_cpu):.2f} (medians)'
+        )
+    if profiler is not None:
+        profiler.dump_stats(str(args.profile))
+        print(f'wrote {args.profile}')
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())
