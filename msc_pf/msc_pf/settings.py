@@ -309,6 +309,13 @@ class SwarmConfig:
     peer_timeout_s: float = parameter(
         2.5, 'a peer not heard for longer is out of range.', unit='s', gt=0.0
     )
+    search_alone: bool = parameter(
+        False,
+        'beyond the paper: robots search alone and gather into swarms of at most max_size '
+        'only on a target they heard (no swarms at the start, no merging of searching '
+        'swarms; a swarm whose leader searches again dissolves). False: the paper\'s '
+        'swarms search together.',
+    )
 
     def __post_init__(self) -> None:
         _require_finite(self)
