@@ -19,6 +19,7 @@ from swarm_experiments.msc_pf_studies import (
 )
 from swarm_experiments.study import (
     RunSpec,
+    StudyRegistry,
     load_registry,
     make_engine,
     make_specs,
@@ -128,7 +129,10 @@ def test_the_reports_compare_with_the_paper_and_the_best_msc(tmp_path: Path):
         plan = make_specs(by_name[name], runs=2, overrides={**overrides, 'variant': variants})
         with make_engine('serial') as engine:
             run_study(plan, tmp_path, engine, code_version='v')
-    pages = {path.parent.name: path.read_text() for path in write_reports(tmp_path)}
+    pages = {
+        path.parent.name: path.read_text()
+        for path in write_reports(tmp_path, StudyRegistry(studies()))
+    }
     fig4 = pages['msc_pf-fig4']
     assert 'prints no CCT values' in fig4
     assert "The paper's order, in the means" in fig4
