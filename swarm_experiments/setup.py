@@ -48,6 +48,9 @@ setup(
             'spawn_msc_pf = swarm_experiments.spawn_msc_pf:main',
             'swarm_study = swarm_experiments.study.cli:main',
         ],
-        'swarm_experiments.studies': ['oabug = swarm_experiments.oabug_study:studies'],
+        'swarm_experiments.studies': [
+            'oabug = swarm_experiments.oabug_study:studies',
+            'msc_pf = swarm_experiments.msc_pf_studies:studies',
+        ],
     },
 )

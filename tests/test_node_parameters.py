@@ -90,10 +90,10 @@ def test_oabug_takes_a_new_stale_timeout_and_refuses_a_bad_one(ros) -> None:
 
 def test_msc_pf_steers_with_a_new_heading_gain(ros) -> None:
     node, _ = _msc()
-    assert node._heading_gain == 2.0
+    assert node.loop.steering.heading_gain == 2.0
     [result] = node.set_parameters([Parameter('heading_gain', value=4.0)])
     assert result.successful
-    assert node._heading_gain == 4.0
+    assert node.loop.steering.heading_gain == 4.0
     node.destroy_node()
 
 

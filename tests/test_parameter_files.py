@@ -23,7 +23,11 @@ from swarm_runtime.parameters import check_parameter_arguments
 REPO = Path(__file__).resolve().parents[1]
 BEFORE = Path(__file__).with_name('data') / 'node_parameter_defaults_before_specs.json'
 # Parameters added since the recording (name -> default).
-ADDED = {'oabug': {'min_turn_rate_radps': 0.3}, 'sim_bridge': {'physics': 'numpy'}}
+ADDED = {
+    'oabug': {'min_turn_rate_radps': 0.3},
+    'sim_bridge': {'physics': 'numpy'},
+    'msc_pf': {'swarm.search_alone': False, 'msc.turn_margin_db': 2.0},
+}
 
 
 def _regenerate():

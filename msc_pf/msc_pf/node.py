@@ -9,11 +9,12 @@ Topics (relative to the robot's namespace, e.g. /r3):
 * ``cmd_vel`` (geometry_msgs/Twist): wheel commands, at ``drive_rate_hz``;
 * ``state`` (swarm_interfaces/MscPfState): phase, role, swarm, target, estimates.
 
-Every ``period_s`` the node hands the latest pose, the RSSI samples since the last period
-and the peer messages received to :class:`msc_pf.robot.RobotController`, publishes its
-broadcast and state, and steers toward the displacement it returned until the next period.
-It stops the robot when odometry is older than ``odom_timeout_s`` or the controller has not
-run for two periods. Bad input (unknown or non-finite RSSI, out-of-order stamps, malformed
+The node only translates messages: every input goes to :class:`msc_pf.loop.RobotLoop`
+(sample and hold, staleness, timing, steering around :class:`msc_pf.robot.RobotController`,
+the loop the batch runner runs too). Every ``period_s`` the loop steps the controller and
+the node publishes its broadcast and state; at ``drive_rate_hz`` it publishes the loop's
+wheel command (a stop when odometry is older than ``odom_timeout_s`` or the controller has
+not run for two periods). Bad input (unknown or non-finite RSSI, out-of-order stamps, malformed
 peer messages) is ignored and logged; invalid parameters stop the node at start.
 
 Run on a robot: ``ros2 run msc_pf msc_pf_node --ros-args -r __ns:=/r3 -p scheme:=proposed``
@@ -22,10 +23,8 @@ Run on a robot: ``ros2 run msc_pf msc_pf_node --ros-args -r __ns:=/r3 -p scheme:
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
-import numpy as np
 from swarm_common.cli import fail
 from swarm_runtime.parameters import ParameterFileError, check_parameter_arguments, declare_config
 from swarm_runtime.ros import (
@@ -37,10 +36,9 @@ from swarm_runtime.ros import (
 )
 
 from msc_pf import conversions
-from msc_pf.drive import unicycle_command
-from msc_pf.errors import ConfigError, ObservationError
+from msc_pf.errors import ConfigError
+from msc_pf.loop import ControlStatus, RobotLoop, Steering
 from msc_pf.parameters import MSC_PF_PARAMETERS, NODE_NAME, MscPfNodeConfig
-from msc_pf.peers import PeerInfo
 from msc_pf.robot import RobotController, StepOutput
 
 __all__ = ['MscPfNode', 'main']
@@ -63,7 +61,6 @@ class MscPfNode(Node):
             self.get_logger().fatal(f'invalid parameters: {err}')
             raise
         settings = self._declared.config
-        self._configure(settings)
         self.config = settings.controller
         robot_id = settings.robot_id
         self.robot_name = self.get_namespace().strip('/') or self.get_name()
@@ -73,18 +70,10 @@ class MscPfNode(Node):
             except ValueError as err:
                 raise ConfigError(f'robot_id not set and {err}') from err
         self._accepted = settings.accepted_targets
-        self.controller = RobotController(robot_id, self.config, settings.seed)
-
-        self._pose: tuple[float, float, float] | None = None
-        self._pose_time_s = -math.inf
-        self._readings: dict[int, float] = {}
-        self._rssi_stamp_s = -math.inf
-        self._inbox: list[PeerInfo] = []
-        self._captured: list[int] = []
-        self._waypoint: tuple[float, float] | None = None
-        self._deadline_s = -math.inf
-        self._last_step_s = -math.inf
-        self.last_output: StepOutput | None = None
+        self.loop = RobotLoop(
+            RobotController(robot_id, self.config, settings.seed), self._steering(settings)
+        )
+        self.controller = self.loop.controller
 
         sensor = qos_profile_sensor_data
         self.create_subscription(_nav.Odometry, 'odom', self._on_odom, sensor)
@@ -101,75 +90,69 @@ class MscPfNode(Node):
             f'period {self.config.period_s:g} s'
         )
 
+    @staticmethod
+    def _steering(settings: MscPfNodeConfig) -> Steering:
+        return Steering(
+            odom_timeout_s=settings.odom_timeout_s,
+            max_yaw_rate_rad_s=settings.max_yaw_rate_rad_s,
+            heading_gain=settings.heading_gain,
+        )
+
     def _configure(self, settings: MscPfNodeConfig) -> None:
-        """Take the steering settings (at start and after an accepted parameter change)."""
-        self._odom_timeout_s = settings.odom_timeout_s
-        self._max_yaw_rate_rad_s = settings.max_yaw_rate_rad_s
-        self._heading_gain = settings.heading_gain
+        """Take the steering settings after an accepted parameter change."""
+        loop = getattr(self, 'loop', None)
+        if loop is not None:
+            loop.steering = self._steering(settings)
+
+    @property
+    def last_output(self) -> StepOutput | None:
+        """The controller's output of the last control step (None before the first)."""
+        return self.loop.last_output
 
     def _now_s(self) -> float:
         return self.get_clock().now().nanoseconds * 1e-9
 
     # ------------------------------------------------------------------ inputs
     def _on_odom(self, msg: Any) -> None:
-        pose = conversions.pose_from_odometry(msg)
-        if not all(math.isfinite(v) for v in pose):
+        if not self.loop.receive_pose(conversions.pose_from_odometry(msg), self._now_s()):
             self.get_logger().warning('non-finite odometry ignored', throttle_duration_sec=5.0)
-            return
-        self._pose = pose
-        self._pose_time_s = self._now_s()
 
     def _on_rssi(self, msg: Any) -> None:
         stamp = conversions.stamp_from_ros(msg.header.stamp)
-        if stamp < self._rssi_stamp_s:
+        readings, ignored = conversions.readings_from_ros(msg, self._accepted)
+        previous = self.loop.last_rssi_stamp_s
+        if not self.loop.receive_rssi(stamp, readings):
             self.get_logger().warning(
-                f'RSSI stamped {stamp:.3f} s arrived after {self._rssi_stamp_s:.3f} s: ignored',
+                f'RSSI stamped {stamp:.3f} s arrived after {previous:.3f} s: ignored',
                 throttle_duration_sec=5.0,
             )
             return
-        self._rssi_stamp_s = stamp
-        readings, ignored = conversions.readings_from_ros(msg, self._accepted)
         if ignored:
             self.get_logger().debug(f'{ignored} RSSI readings ignored (unknown or not finite)')
-        self._readings.update(readings)
 
     def _on_captured(self, msg: Any) -> None:
-        self._captured.extend(conversions.captured_from_ros(msg))
+        self.loop.receive_captured(conversions.captured_from_ros(msg))
 
     def _on_peer(self, msg: Any) -> None:
         try:
-            self._inbox.append(conversions.peer_from_ros(msg))
+            self.loop.receive_peer(conversions.peer_from_ros(msg))
         except ValueError as err:
             self.get_logger().warning(f'peer message ignored: {err}', throttle_duration_sec=5.0)
 
     # ------------------------------------------------------------------ control
     def _on_control(self) -> None:
-        now = self._now_s()
-        if self._pose is None or now - self._pose_time_s > self._odom_timeout_s:
-            self._waypoint = None
+        result = self.loop.control(self._now_s())
+        if result.status is ControlStatus.NO_POSE:
             self.get_logger().warning('no fresh odometry: holding still', throttle_duration_sec=5.0)
             return
-        readings, self._readings = self._readings, {}
-        inbox, self._inbox = self._inbox, []
-        captured, self._captured = self._captured, []
-        position = np.array(self._pose[:2])
-        try:
-            out = self.controller.step(now, position, readings, inbox, captured)
-        except ObservationError as err:
-            self.get_logger().error(f'control step skipped: {err}')
-            self._waypoint = None
+        if result.status is ControlStatus.REJECTED or result.output is None:
+            self.get_logger().error(f'control step skipped: {result.error}')
             return
+        out = result.output
         for event in out.events:
             self.get_logger().info(event)
         for change in out.swarm_changes:
             self.get_logger().debug(change)
-        self.last_output = out
-        self._last_step_s = now
-        self._waypoint = (
-            float(position[0] + out.displacement_m[0]),
-            float(position[1] + out.displacement_m[1]),
-        )
-        self._deadline_s = now + self.config.period_s
         self._peer_pub.publish(
             conversions.peer_to_ros(out.broadcast, self.robot_name, _swarm, _builtin)
         )
@@ -181,20 +164,7 @@ class MscPfNode(Node):
         self._on_drive()
 
     def _on_drive(self) -> None:
-        now = self._now_s()
-        stale = self._pose is None or now - self._pose_time_s > self._odom_timeout_s
-        late = now - self._last_step_s > 2.0 * self.config.period_s
-        if stale or late or self._waypoint is None:
-            self._cmd_pub.publish(conversions.twist_to_ros(0.0, 0.0, _geometry))
-            return
-        speed, yaw_rate = unicycle_command(
-            self._pose,
-            self._waypoint,
-            self._deadline_s - now,
-            max_speed_m_s=self.config.max_speed_m_s,
-            max_yaw_rate_rad_s=self._max_yaw_rate_rad_s,
-            heading_gain=self._heading_gain,
-        )
+        speed, yaw_rate = self.loop.command(self._now_s())
         self._cmd_pub.publish(conversions.twist_to_ros(speed, yaw_rate, _geometry))
 
 

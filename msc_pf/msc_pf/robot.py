@@ -40,7 +40,7 @@ from msc_pf.mobility import (
 )
 from msc_pf.particle_filter import ParticleFilterBank, TargetEstimate
 from msc_pf.peers import NO_TARGET, PeerInfo, Phase, Role
-from msc_pf.search import HistorySearch
+from msc_pf.search import HistorySearch, unit
 from msc_pf.settings import MscPfConfig
 from msc_pf.swarm import SwarmMembership
 from msc_pf.targeting import Candidate, select_retarget
@@ -132,6 +132,8 @@ class RobotController:
         self._last_sampled_s: dict[int, float] = {}
         self._pbest: deque[tuple[np.ndarray, float]] = deque(maxlen=config.msc.pbest_window)
         self._pbest_target = NO_TARGET
+        self._leg: list[tuple[np.ndarray, float]] = []
+        self._leg_heading = np.zeros(2)
         self._velocity = np.zeros(2)
         self.phase = Phase.FORMING
         self.target_id = NO_TARGET
@@ -633,11 +635,48 @@ class RobotController:
         self, now_s: float, position: np.ndarray, avoidance: np.ndarray
     ) -> np.ndarray:
         msc = self.config.msc
+        if msc.leader_rule == 'pbest_turn':
+            return self._pbest_turn_vector(now_s, position, avoidance)
         if msc.leader_rule == 'gradient':
             gradient = self._gradient(self.target_id)
             return msc_gradient_leader_vector(self._velocity, gradient, avoidance, msc, self._rng)
         pbest = self._personal_best(now_s, position)
         return msc_leader_vector(self._velocity, position, pbest, avoidance, msc, self._rng)
+
+    def _pbest_turn_vector(
+        self, now_s: float, position: np.ndarray, avoidance: np.ndarray
+    ) -> np.ndarray:
+        """Leader rule 'pbest_turn': straight legs, each ended at its best point.
+
+        The leg records (position, smoothed RSSI) since it started. While the RSSI is within
+        ``turn_margin_db`` of the leg's best the heading stays; below it the leader turns
+        90 degrees (random side) from the direction back to the best point, or reverses when
+        the leg's first point was its best, and a new leg starts.
+        """
+        if self._pbest_target != self.target_id:
+            self._leg.clear()
+            self._pbest_target = self.target_id
+        heading = unit(self._leg_heading)
+        if not heading.any():
+            heading = unit(self._velocity)
+        if not heading.any():
+            theta = self._rng.uniform(0.0, 2.0 * np.pi)
+            heading = np.array([np.cos(theta), np.sin(theta)])
+        mean = self.smoothed_rssi(self.target_id, now_s)
+        if mean is not None:
+            self._leg.append((position.copy(), mean))
+            best_index = max(range(len(self._leg)), key=lambda i: self._leg[i][1])
+            best_position, best_value = self._leg[best_index]
+            if best_value - mean > self.config.msc.turn_margin_db:
+                back = unit(best_position - position)
+                if best_index == 0 or not back.any():
+                    heading = -heading
+                else:
+                    side = 1.0 if self._rng.random() < 0.5 else -1.0
+                    heading = np.array([-side * back[1], side * back[0]])
+                self._leg.clear()
+        self._leg_heading = heading
+        return heading + self.config.msc.avoidance_degree * avoidance
 
     def _follower_vector(
         self, now_s: float, position: np.ndarray, leader: PeerInfo, avoidance: np.ndarray

@@ -28,7 +28,7 @@ __all__ = [
 ]
 
 AVOIDANCE_FORMS = ('linear', 'inverse_square')
-LEADER_RULES = ('gradient', 'pbest')
+LEADER_RULES = ('gradient', 'pbest', 'pbest_turn')
 INITIAL_PRIORS = ('detection_square', 'field')
 FUSION_MODES = ('joint', 'sequential')
 RESAMPLING_SCHEMES = ('systematic', 'multinomial')
@@ -309,6 +309,13 @@ class SwarmConfig:
     peer_timeout_s: float = parameter(
         2.5, 'a peer not heard for longer is out of range.', unit='s', gt=0.0
     )
+    search_alone: bool = parameter(
+        False,
+        'beyond the paper: robots search alone and gather into swarms of at most max_size '
+        'only on a target they heard (no swarms at the start, no merging of searching '
+        "swarms; a swarm whose leader searches again dissolves). False: the paper's "
+        'swarms search together.',
+    )
 
     def __post_init__(self) -> None:
         _require_finite(self)
@@ -344,9 +351,18 @@ class MscConfig:
             'how the leader finds "where larger RSSI is likely": \'gradient\' follows the '
             "least-squares RSSI slope over the swarm's samples of the last ``pbest_window`` "
             "steps; 'pbest' pulls toward the best of its own last ``pbest_window`` "
-            'positions.'
+            "positions; 'pbest_turn' (beyond the paper) keeps its heading while its own "
+            'smoothed RSSI improves and, once it has fallen ``turn_margin_db`` below the best '
+            'of the current straight leg, turns 90 degrees to a random side at that best '
+            'point (or back, when the leg only fell from its start).'
         ),
         choices=LEADER_RULES,
+    )
+    turn_margin_db: float = parameter(
+        2.0,
+        "pbest_turn: drop of the smoothed RSSI below the leg's best that ends a leg.",
+        unit='dB',
+        gt=0.0,
     )
     full_pso: bool = parameter(
         False, 'every robot uses both cognitive and social terms (optional variant).'

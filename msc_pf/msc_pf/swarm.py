@@ -12,6 +12,10 @@ Every rule uses only robot IDs and what peers broadcast (:class:`msc_pf.peers.Pe
 4. join: a leader hearing a lower-ID leader heading to the same target (or both searching)
    follows it when the merged swarm has at most L_th robots;
 5. a working robot (phase WORK) is never a follower.
+
+With ``search_alone`` (beyond the paper) rule 1 makes every robot lead itself, rule 4 merges
+only swarms heading to the same target, and a follower whose leader searches without a
+target leads itself again: robots search apart and gather only on a target they heard.
 """
 
 from __future__ import annotations
@@ -93,7 +97,8 @@ class SwarmMembership:
         """Rule 1 on this robot and the peers it hears now."""
         ids = [self.robot_id, *sorted(peers)]
         positions = np.array([position_m, *(peers[r].position_m for r in sorted(peers))])
-        leader_of = form_initial_swarms(ids, positions, self._cfg.max_size, self._cfg.comm_range_m)
+        size = 1 if self._cfg.search_alone else self._cfg.max_size
+        leader_of = form_initial_swarms(ids, positions, size, self._cfg.comm_range_m)
         self.leader_id = leader_of[self.robot_id]
         self.members = tuple(sorted(r for r, lead in leader_of.items() if lead == self.robot_id))
         self.members = tuple(r for r in self.members if r != self.robot_id)
@@ -148,6 +153,9 @@ class SwarmMembership:
                 self._lead_alone()
                 return f'not accepted by leader {leader.robot_id}: leads itself'
         target = leader.target_id
+        if self._cfg.search_alone and target == NO_TARGET and leader.phase == Phase.SEARCH:
+            self._lead_alone()
+            return f'leader {leader.robot_id} searches again: searches alone'
         if own_target != NO_TARGET and target != NO_TARGET and own_target != target:
             return self._split(peers, own_target)
         return None
@@ -186,6 +194,8 @@ class SwarmMembership:
             if peer.role is not Role.LEADER:
                 continue
             if not heading_to_same(own_target, own_phase, peer.target_id, peer.phase):
+                continue
+            if self._cfg.search_alone and own_target == NO_TARGET:
                 continue
             if peer.swarm_size + size <= self._cfg.max_size:
                 self._follow(robot)

@@ -343,3 +343,35 @@ def test_converged_estimate_not_heard_within_range_is_dropped_before_reaching_it
     assert not robot.filters.is_tracked(2)
     assert out.status.phase is Phase.SEARCH
     assert any('not heard where its filter put it' in e for e in out.events)
+
+
+def climb(rule: str, seed: int, steps: int = 1500) -> tuple[float, bool]:
+    """A lone MSC robot 150 m from a noisy target: its closest distance within ``steps``,
+    and whether it stopped to work (gamma3 = -48 dBm is about 5 m from the target)."""
+    from dataclasses import replace
+
+    config = MscPfConfig(scheme='msc')
+    config = replace(config, msc=replace(config.msc, leader_rule=rule))
+    robot = RobotController(0, config, seed=seed)
+    rng = np.random.default_rng(seed)
+    target = HOME + 150.0 * np.array([math.cos(seed), math.sin(seed)])
+    position = HOME.copy()
+    closest = math.inf
+    for t in range(1, steps):
+        distance = float(np.hypot(*(target - position)))
+        closest = min(closest, distance)
+        rssi = float(RADIO.mean_rssi_dbm(distance) + rng.normal(0.0, 1.0))
+        out = robot.step(float(t), position, {3: rssi})
+        if out.status.phase is Phase.WORK:
+            return closest, True
+        position = position + out.displacement_m
+    return closest, False
+
+
+@pytest.mark.parametrize('seed', [0, 1, 2])
+def test_the_turning_pbest_rule_climbs_to_a_target_through_the_noise(seed):
+    closest, worked = climb('pbest_turn', seed)
+    assert worked
+    assert closest < 6.0
+    # The specification's pbest rule dithers in the noise and gets nowhere near.
+    assert climb('pbest', seed)[0] > 50.0

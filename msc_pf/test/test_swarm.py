@@ -143,3 +143,34 @@ def test_working_robot_is_never_a_follower():
     membership = follower_of(leader=1)
     membership.update(peers(peer(1, members=(5,))), 7, Phase.WORK)
     assert membership.role is Role.LEADER
+
+
+def test_searching_alone_robots_start_apart_and_merge_only_on_a_heard_target():
+    config = SwarmConfig(search_alone=True)
+    me = SwarmMembership(4, config)
+    near = peers(peer(1, x=1.0), peer(2, x=2.0))
+    me.form(np.zeros(2), near)
+    assert me.leader_id == 4
+    # Searching without a target, a lower-ID searching leader does not absorb it...
+    assert me.update(near, NO_TARGET, Phase.SEARCH) is None
+    assert me.role is Role.LEADER
+    # ...but one heading to the target this robot heard does.
+    heading = peers(peer(1, target=7, phase=Phase.MSC_APPROACH, x=1.0))
+    assert me.update(heading, 7, Phase.MSC_APPROACH) == 'joins swarm of 1'
+    assert me.leader_id == 1
+
+
+def test_searching_alone_a_swarm_dissolves_when_its_leader_searches_again():
+    config = SwarmConfig(search_alone=True)
+    me = SwarmMembership(5, config)
+    me.formed = True
+    me.leader_id = 1
+    leader = peers(peer(1, members=(5,), target=NO_TARGET, phase=Phase.SEARCH))
+    assert 'searches alone' in me.update(leader, NO_TARGET, Phase.SEARCH)
+    assert me.role is Role.LEADER
+    # The paper's swarms keep searching together.
+    paper = SwarmMembership(5, SwarmConfig())
+    paper.formed = True
+    paper.leader_id = 1
+    assert paper.update(leader, NO_TARGET, Phase.SEARCH) is None
+    assert paper.leader_id == 1

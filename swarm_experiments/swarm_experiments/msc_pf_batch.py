@@ -1,20 +1,28 @@
-"""Fast ROS-free simulator of the MSC + PF mission for benchmarks (spec 0.2).
+"""MSC + PF missions without the runtime: the path of studies and benchmarks.
 
-It runs the very controllers the ROS node runs (:class:`msc_pf.robot.RobotController`) on
-the world model of :mod:`swarm_sim.rssi_targets`, with the paper's discrete setting:
+The ROS path (:func:`swarm_experiments.spawn_msc_pf.run`) runs the sim bridge with the RSSI
+extension and the peer relay, and one :class:`msc_pf.node.MscPfNode` per robot on the
+built-in runtime. This module drives the same parts directly, and only steps the world:
 
-* time advances in steps of Delta t = 1 s; each step every robot takes one RSSI sample per
-  detectable target, receives the peer messages its neighbours sent in the previous step
-  (senders within the communication range, optional random loss), and moves by the
-  displacement its controller returns, clipped to the field;
-* robots standing still within D_th of a target work on it; the robots working on a target
-  when it is captured learn its ID, and the others learn it from their peers;
-* the run ends when every target is captured (the capture completion time, CCT) or at
-  ``max_time_s``; a scenario without targets searches until ``max_time_s``
-  (:func:`search_coverage` times that search).
+* the :class:`swarm_sim.engine.SimEngine` of point robots (unicycle bases, odometry at the
+  physics rate), the :class:`swarm_sim.rssi_targets.RssiTargetField` (work, captures, one
+  RSSI sample per robot and detectable target every second) and the
+  :class:`swarm_sim.peer_relay.RelayModel` (range, loss), seeded as the bridge seeds them;
+* per robot the node's own loop, :class:`msc_pf.loop.RobotLoop` (sample and hold,
+  staleness, timing, steering around :class:`msc_pf.robot.RobotController`).
 
-Positions are holonomic, as in the paper's simulation; the ROS path drives the bridge's
-robots through cmd_vel instead, which is what the agreement test checks.
+Per physics step it reproduces what the bridge and the executor do: the engine steps; every
+robot receives its odometry pose (through the message's quaternion), its capture notices and,
+when due, its RSSI samples (float32 as in ``RssiArray`` when the runtime round-trips CDR);
+then the nodes' timers run robot by robot in creation order: the control step, whose
+broadcast the relay hands at once to the robots in range (so robot j's step sees the
+broadcasts robots i < j sent in this period), then the drive command. Seeded runs therefore
+equal the ROS path's: capture times and positions (tested for all three schemes, with
+swarms and a lossy relay).
+
+A run ends when every target is captured (the capture completion time, CCT) or at
+``max_time_s``; a scenario without targets searches until ``max_time_s``
+(:func:`search_coverage` times that search). It records no bags and publishes no state.
 """
 
 from __future__ import annotations
@@ -26,11 +34,19 @@ from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
 import numpy as np
+from msc_pf.loop import RobotLoop, Steering
 from msc_pf.peers import PeerInfo
 from msc_pf.robot import RobotController, StepOutput
 from msc_pf.schemes import Scheme
 from msc_pf.settings import MscPfConfig
+from swarm_common.angles import yaw_from_unit_quaternion, yaw_to_quaternion
+from swarm_common.stamps import ns_to_sec_nanosec, seconds_to_ns
+from swarm_runtime.builtin._messages import cdr_roundtrip_enabled
+from swarm_sim.engine import SimEngine, SiteGeometry
+from swarm_sim.peer_relay import RelayConfig, RelayModel
 from swarm_sim.rssi_targets import RssiTargetConfig, RssiTargetField, place_robots
+
+from swarm_experiments.open_field import point_robot_engine_config
 
 __all__ = ['BatchResult', 'BatchScenario', 'SearchCoverage', 'run_batch', 'search_coverage']
 
@@ -49,6 +65,10 @@ class BatchScenario:
         comm_loss: probability that one peer message is lost.
         controller: controller configuration (its scheme is replaced by ``scheme``).
         target_positions_m: (n_targets, 2) fixed target positions; None places them randomly.
+        steering: the node's steering settings (odom_timeout_s, yaw-rate limit, gain).
+        physics_rate_hz: the bridge's physics (and odometry) rate [Hz].
+        drive_rate_hz: the node's drive_rate_hz [Hz].
+        max_linear_speed_m_s: the simulated base's speed limit [m/s].
     """
 
     scheme: Scheme = Scheme.PROPOSED
@@ -60,6 +80,10 @@ class BatchScenario:
     comm_loss: float = 0.0
     controller: MscPfConfig = field(default_factory=MscPfConfig)
     target_positions_m: np.ndarray | None = None
+    steering: Steering = field(default_factory=Steering)
+    physics_rate_hz: float = 10.0
+    drive_rate_hz: float = 10.0
+    max_linear_speed_m_s: float = 1.05
 
 
 @dataclass
@@ -93,24 +117,16 @@ class BatchResult:
     phases: np.ndarray | None = None
 
 
-def _deliver(
-    outputs: list[StepOutput],
-    positions: np.ndarray,
-    comm_range_m: float,
-    loss: float,
-    rng: np.random.Generator,
-) -> list[list[PeerInfo]]:
-    """Peer messages each robot receives: senders within range, minus random losses."""
-    n = len(outputs)
-    diff = positions[:, None, :] - positions[None, :, :]
-    in_range = np.hypot(diff[..., 0], diff[..., 1]) <= comm_range_m
-    if loss > 0.0:
-        in_range &= rng.random((n, n)) >= loss
-    np.fill_diagonal(in_range, False)
-    messages = [out.broadcast for out in outputs]
-    return [
-        [m for m, heard in zip(messages, row, strict=True) if heard] for row in in_range.tolist()
-    ]
+def _message_seconds(time_s: float) -> float:
+    """A time as a receiver reads it from a message stamp (rounded to the nanosecond)."""
+    sec, nanosec = ns_to_sec_nanosec(seconds_to_ns(time_s))
+    return float(sec) + 1e-9 * float(nanosec)
+
+
+def _as_received(info: PeerInfo) -> PeerInfo:
+    """A broadcast as a receiver's node decodes it (``msc_pf.conversions.peer_from_ros``)."""
+    movement = info.movement if all(math.isfinite(v) for v in info.movement) else (0.0, 0.0)
+    return replace(info, stamp_s=_message_seconds(info.stamp_s), movement=movement)
 
 
 def _nearest_hearer_m(
@@ -122,79 +138,153 @@ def _nearest_hearer_m(
     return np.where(np.isnan(samples), np.inf, distance).min(axis=0)
 
 
+def scenario_start(
+    n_targets: int,
+    seed: int,
+    *,
+    field_size_m: float,
+    start_radius_m: float,
+    n_robots: int,
+    target_positions_m: np.ndarray | None = None,
+    task_area_m: float = 5.0,
+) -> tuple[RssiTargetField, np.ndarray]:
+    """Targets and (n_robots, 3) start poses of a seeded run, as the spawner draws them."""
+    rng = np.random.default_rng([seed, 0])
+    config = RssiTargetConfig(
+        n_targets=n_targets, field_size_m=field_size_m, task_area_m=task_area_m
+    )
+    if target_positions_m is None:
+        targets = RssiTargetField.random(config, rng)
+    else:
+        targets = RssiTargetField(config, target_positions_m)
+    centre = (field_size_m / 2.0, field_size_m / 2.0)
+    xy = place_robots(n_robots, centre, start_radius_m, rng)
+    yaw = rng.uniform(-math.pi, math.pi, n_robots)
+    return targets, np.column_stack([xy, yaw])
+
+
 def run_batch(
     scenario: BatchScenario,
     *,
     record: bool = False,
     on_step: Callable[[float, np.ndarray, list[StepOutput]], bool | None] | None = None,
+    float32_fields: bool | None = None,
 ) -> BatchResult:
     """Simulate ``scenario`` and return its CCT and per-target capture times.
 
     Args:
         scenario: the run.
-        record: keep every robot position and phase (for plots).
-        on_step: called after every step with (time, positions, controller outputs); a
-            true return ends the run there.
+        record: keep every robot position and phase, once per control period (for plots).
+        on_step: called after every control period with (time, positions, controller
+            outputs); a true return ends the run there.
+        float32_fields: round the RSSI samples to float32 as ``RssiArray`` serialization
+            does; None follows the built-in runtime's CDR round-trip setting, so the run
+            equals the ROS path's in the same process.
     """
     start_wall = time.perf_counter()
     config = replace(scenario.controller, scheme=Scheme(scenario.scheme))
-    world_rng = np.random.default_rng([scenario.seed, 0])
-    target_config = RssiTargetConfig(
-        n_targets=scenario.n_targets,
+    if float32_fields is None:
+        float32_fields = cdr_roundtrip_enabled()
+    targets, poses = scenario_start(
+        scenario.n_targets,
+        scenario.seed,
         field_size_m=config.field_size_m,
+        start_radius_m=scenario.start_radius_m,
+        n_robots=scenario.n_robots,
+        target_positions_m=scenario.target_positions_m,
         task_area_m=config.phases.task_area_m,
     )
-    if scenario.target_positions_m is None:
-        targets = RssiTargetField.random(target_config, world_rng)
-    else:
-        targets = RssiTargetField(target_config, scenario.target_positions_m)
-    center = (config.field_size_m / 2.0, config.field_size_m / 2.0)
-    positions = place_robots(scenario.n_robots, center, scenario.start_radius_m, world_rng)
-    controllers = [RobotController(i, config, scenario.seed) for i in range(scenario.n_robots)]
-    dt = config.period_s
-    inbox: list[list[PeerInfo]] = [[] for _ in controllers]
-    notices: list[list[int]] = [[] for _ in controllers]
-    paths = [positions.copy()] if record else None
+    engine = SimEngine(
+        SiteGeometry(
+            walls=np.zeros((0, 2, 2)),
+            room_rects=(np.array([[0.0, 0.0, config.field_size_m, config.field_size_m]]),),
+            name='msc_pf field',
+        ),
+        poses,
+        point_robot_engine_config(
+            physics_rate_hz=scenario.physics_rate_hz,
+            seed=scenario.seed,
+            max_linear_speed_mps=scenario.max_linear_speed_m_s,
+        ),
+    )
+    noise_rng = np.random.default_rng([scenario.seed, 1])
+    relay = RelayModel(
+        RelayConfig(
+            msg_type='swarm_interfaces/msg/MscPeer',
+            comm_range_m=config.swarm.comm_range_m,
+            loss_probability=scenario.comm_loss,
+        ),
+        np.random.default_rng(np.random.SeedSequence([scenario.seed, 7])),
+    )
+    steering = scenario.steering
+    loops = [
+        RobotLoop(RobotController(i, config, scenario.seed), steering)
+        for i in range(scenario.n_robots)
+    ]
+    n = len(loops)
+    control_every = max(1, round(config.period_s * scenario.physics_rate_hz))
+    drive_every = max(1, round(scenario.physics_rate_hz / scenario.drive_rate_hz))
+    sample_every = max(1, round(scenario.physics_rate_hz))  # the extension samples at 1 Hz
+    paths = [poses[:, :2].copy()] if record else None
     phases: list[list[int]] | None = [] if record else None
-
-    now = 0.0
     first_heard = np.full(scenario.n_targets, np.nan)
     first_heard_range = np.full(scenario.n_targets, np.nan)
     search_only = scenario.n_targets == 0
-    while (search_only or not targets.all_captured) and now < scenario.max_time_s:
-        now += dt
-        samples = targets.sample_rssi(positions, world_rng)
-        heard_now = ~np.isnan(samples).all(axis=0)
-        first_time = heard_now & np.isnan(first_heard)
-        if first_time.any():
-            first_heard[first_time] = now
-            first_heard_range[first_time] = _nearest_hearer_m(
-                positions, targets.positions_m[first_time], samples[:, first_time]
-            )
-        outputs = []
-        for i, (controller, row) in enumerate(zip(controllers, samples.tolist(), strict=True)):
-            heard = {t: value for t, value in enumerate(row) if value == value}  # not NaN
-            outputs.append(
-                controller.step(
-                    now, positions[i], heard, inbox[i], notices[i], with_estimates=False
+    last: list[StepOutput | None] = [None] * n
+    now = 0.0
+    while (search_only or not targets.all_captured) and now + 1e-9 < scenario.max_time_s:
+        # The bridge's tick: physics, odometry, work and captures, RSSI samples.
+        out = engine.step()
+        step = engine.step_index
+        now_ns = seconds_to_ns(out.time_s)
+        now = now_ns * 1e-9  # the nodes' clock: the /clock stamp
+        if out.odometry is not None:
+            for loop, pose in zip(loops, out.odometry[0].tolist(), strict=True):
+                _, _, qz, qw = yaw_to_quaternion(pose[2])
+                loop.receive_pose(
+                    (pose[0], pose[1], yaw_from_unit_quaternion(0.0, 0.0, qz, qw)), now
                 )
-            )
-        broadcast_positions = positions.copy()
-        steps = np.array([out.displacement_m for out in outputs])
-        positions = np.clip(positions + steps, 0.0, config.field_size_m)
-        speeds = np.hypot(steps[:, 0], steps[:, 1]) / dt
-        notices = [[] for _ in controllers]
-        for capture in targets.work(positions, speeds, dt, now):
+        positions = out.poses[:, :2]
+        speeds = np.abs(engine.world.velocities[:, 0])
+        for capture in targets.work(positions, speeds, engine.config.physics_period_s, out.time_s):
             for robot in capture.robot_indices:
-                notices[robot].append(capture.target_id)
-        inbox = _deliver(
-            outputs, broadcast_positions, config.swarm.comm_range_m, scenario.comm_loss, world_rng
-        )
-        if paths is not None and phases is not None:
-            paths.append(positions.copy())
-            phases.append([int(out.status.phase) for out in outputs])
-        if on_step is not None and on_step(now, positions, outputs):
-            break
+                loops[robot].receive_captured([capture.target_id])
+        if step % sample_every == 0:
+            samples = targets.sample_rssi(positions, noise_rng)
+            if float32_fields:
+                samples = samples.astype(np.float32).astype(np.float64)
+            stamp = _message_seconds(out.time_s)
+            for loop, row in zip(loops, samples.tolist(), strict=True):
+                loop.receive_rssi(stamp, {t: v for t, v in enumerate(row) if v == v})
+            heard_now = ~np.isnan(samples).all(axis=0)
+            first_time = heard_now & np.isnan(first_heard)
+            if first_time.any():
+                first_heard[first_time] = now
+                first_heard_range[first_time] = _nearest_hearer_m(
+                    positions, targets.positions_m[first_time], samples[:, first_time]
+                )
+        # The nodes' timers, in creation order: robot by robot its control step (whose
+        # broadcast the relay hands on at once), then its drive command.
+        control_due = step % control_every == 0
+        drive_due = control_due or step % drive_every == 0
+        if not drive_due:
+            continue
+        for i, loop in enumerate(loops):
+            if control_due:
+                result = loop.control(now, with_estimates=False)
+                if result.output is not None:
+                    last[i] = result.output
+                    message = _as_received(result.output.broadcast)
+                    for receiver in relay.receivers(i, engine.world.poses).tolist():
+                        loops[receiver].receive_peer(message)
+            engine.set_velocity_command(i, *loop.command(now))
+        if control_due:
+            outputs = [o for o in last if o is not None]
+            if paths is not None and phases is not None:
+                paths.append(engine.world.poses[:, :2].copy())
+                phases.append([int(o.status.phase) if o else 0 for o in last])
+            if on_step is not None and on_step(now, engine.world.poses[:, :2], outputs):
+                break
 
     captured = targets.capture_time_s
     cct = float(np.max(captured)) if targets.all_captured and captured.size else math.nan
@@ -204,7 +294,7 @@ def run_batch(
         first_heard_s=first_heard,
         first_heard_range_m=first_heard_range,
         target_positions_m=targets.positions_m.copy(),
-        duration_s=now,
+        duration_s=engine.step_index / scenario.physics_rate_hz,
         wall_time_s=time.perf_counter() - start_wall,
         paths_m=np.array(paths) if paths is not None else None,
         phases=np.array(phases) if phases is not None else None,

@@ -43,6 +43,7 @@ from swarm_common.cli import (
     run_tool,
 )
 from swarm_sim.engine import EngineConfig, SiteGeometry
+from swarm_sim.errors import ConfigurationError
 from swarm_sim.physics import require_backend
 from swarm_sim.rssi_targets import RssiTargetConfig, RssiTargetField, place_robots
 
@@ -64,6 +65,7 @@ from swarm_experiments.mission import (
     StopReason,
     run_mission,
 )
+from swarm_experiments.msc_pf_batch import scenario_start
 from swarm_experiments.node_overrides import parse_overrides
 from swarm_experiments.open_field import point_robot_engine_config
 from swarm_experiments.progress import MissionProgressBar, progress_wanted
@@ -235,17 +237,16 @@ def node_parameters(settings: SpawnSettings, index: int) -> dict[str, Any]:
 
 
 def scenario(settings: SpawnSettings) -> tuple[RssiTargetField, np.ndarray]:
-    """Targets and (robots, 3) start poses of a run; the same seed gives the same scenario."""
-    rng = np.random.default_rng([settings.seed, 0])
-    config = RssiTargetConfig(n_targets=settings.targets, field_size_m=settings.field_size_m)
-    if settings.target_positions_m is None:
-        targets = RssiTargetField.random(config, rng)
-    else:
-        targets = RssiTargetField(config, settings.target_positions_m)
-    centre = (settings.field_size_m / 2.0, settings.field_size_m / 2.0)
-    xy = place_robots(settings.robots, centre, settings.start_radius_m, rng)
-    yaw = rng.uniform(-math.pi, math.pi, settings.robots)
-    return targets, np.column_stack([xy, yaw])
+    """Targets and (robots, 3) start poses of a run; the same seed gives the same scenario
+    (the batch runner's :func:`~swarm_experiments.msc_pf_batch.scenario_start`)."""
+    return scenario_start(
+        settings.targets,
+        settings.seed,
+        field_size_m=settings.field_size_m,
+        start_radius_m=settings.start_radius_m,
+        n_robots=settings.robots,
+        target_positions_m=settings.target_positions_m,
+    )
 
 
 def run(settings: SpawnSettings, progress: Any = None) -> MscPfRun:

@@ -1,0 +1,144 @@
+"""The MSC + PF studies: registration, one run's row against the batch runner, the reports."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+from msc_pf.parameters import MSC_PF_PARAMETERS
+from msc_pf.schemes import Scheme
+from swarm_experiments.msc_pf_batch import BatchScenario, run_batch
+from swarm_experiments.msc_pf_studies import (
+    VARIANTS,
+    controller_settings,
+    run_msc_pf,
+    studies,
+)
+from swarm_experiments.study import (
+    RunSpec,
+    StudyRegistry,
+    load_registry,
+    make_engine,
+    make_specs,
+    run_study,
+    write_reports,
+)
+
+NAMES = ('msc_pf-fig4', 'msc_pf-baseline-bracket', 'msc_pf-gather', 'msc_pf-gather-robots')
+
+
+def test_the_studies_are_registered_through_the_entry_point():
+    registry = load_registry()
+    for name in NAMES:
+        assert name in registry
+    fig4 = registry.get('msc_pf-fig4')
+    plan = make_specs(fig4)
+    assert len(plan.specs) == 3 * 3 * 40
+    assert {s.config['variant'] for s in plan.specs} == {'proposed', 'msc_pf', 'msc'}
+    assert {s.config['targets'] for s in plan.specs} == {10, 15, 20}
+    smoke = make_specs(fig4, smoke=True)
+    assert len(smoke.specs) == 3 * 2
+    assert {s.config['t_max_s'] for s in smoke.specs} == {3000.0}
+
+
+def test_variant_settings_and_changed_parameters_reach_the_controller():
+    assert controller_settings('msc-solo', {}) == {'swarm.max_size': 1}
+    given = {'swarm': {'max_size': 3, 'comm_range_m': 100.0}, 'msc': {'leader_rule': 'gradient'}}
+    # Only values other than the defaults count; the variant's own come first.
+    assert controller_settings('msc-gather', given) == {
+        'swarm.search_alone': True,
+        'swarm.comm_range_m': 100.0,
+    }
+    with pytest.raises(ValueError, match='unknown variant'):
+        controller_settings('pso', {})
+    for scheme, settings in VARIANTS.values():
+        Scheme(scheme)
+        MSC_PF_PARAMETERS.build(dict(settings))  # every variant is a valid configuration
+
+
+def test_a_studys_parameters_accept_set_with_the_node_names():
+    fig4 = next(s for s in studies() if s.name == 'msc_pf-fig4')
+    plan = make_specs(fig4, overrides={'controller.msc.leader_rule': 'pbest', 'targets': '10'})
+    assert {s.config['controller']['msc']['leader_rule'] for s in plan.specs} == {'pbest'}
+    assert controller_settings('msc', plan.specs[0].config['controller']) == {
+        'msc.leader_rule': 'pbest'
+    }
+
+
+def small_spec(variant: str, seed: int = 2, t_max_s: float = 1500.0) -> RunSpec:
+    fig4 = next(s for s in studies() if s.name == 'msc_pf-fig4')
+    config = dict(make_specs(fig4).specs[0].config)
+    config.update(variant=variant, targets=2, robots=4, t_max_s=t_max_s)
+    return RunSpec(study='msc_pf-fig4', config=config, seed=seed, run_id='x')
+
+
+@pytest.mark.slow
+def test_a_run_reports_the_batch_runners_cct_and_its_breakdown():
+    row = run_msc_pf(small_spec('proposed'))
+    batch = run_batch(
+        BatchScenario(scheme=Scheme.PROPOSED, n_robots=4, n_targets=2, seed=2, max_time_s=1500.0)
+    )
+    captured = np.sort(batch.capture_times_s[np.isfinite(batch.capture_times_s)])
+    assert row['captured'] == len(captured)
+    assert row['capture_times_s'] == captured.tolist()
+    if row['finished']:
+        assert row['cct_s'] == batch.cct_s == captured[-1]
+        assert row['last_heard_s'] <= row['cct_s']
+        assert row['after_heard_s'] == pytest.approx(row['cct_s'] - row['last_heard_s'])
+    else:
+        assert row['cct_s'] == 1500.0
+    assert row['first_heard_s'] == sorted(row['first_heard_s'])
+
+
+@pytest.mark.slow
+def test_the_gather_variant_runs_the_search_alone_setting():
+    spec = small_spec('proposed-gather', t_max_s=200.0)
+    row = run_msc_pf(spec)
+    config = replace(
+        MSC_PF_PARAMETERS.build({'swarm.search_alone': True}).controller, scheme=Scheme.PROPOSED
+    )
+    batch = run_batch(
+        BatchScenario(
+            scheme=Scheme.PROPOSED,
+            n_robots=4,
+            n_targets=2,
+            seed=2,
+            max_time_s=200.0,
+            controller=config,
+        )
+    )
+    assert row['capture_times_s'] == sorted(
+        batch.capture_times_s[np.isfinite(batch.capture_times_s)].tolist()
+    )
+    assert row['first_heard_s'] == sorted(
+        batch.first_heard_s[np.isfinite(batch.first_heard_s)].tolist()
+    )
+
+
+@pytest.mark.slow
+def test_the_reports_compare_with_the_paper_and_the_best_msc(tmp_path: Path):
+    by_name = {s.name: s for s in studies()}
+    overrides = {'targets': '1', 'robots': '3', 't_max_s': '600'}
+    for name, variants in (
+        ('msc_pf-fig4', 'proposed,msc_pf,msc'),
+        ('msc_pf-gather', 'proposed,msc,msc-solo,proposed-gather'),
+    ):
+        plan = make_specs(by_name[name], runs=2, overrides={**overrides, 'variant': variants})
+        with make_engine('serial') as engine:
+            run_study(plan, tmp_path, engine, code_version='v')
+    pages = {
+        path.parent.name: path.read_text()
+        for path in write_reports(tmp_path, StudyRegistry(studies()))
+    }
+    fig4 = pages['msc_pf-fig4']
+    assert 'prints no CCT values' in fig4
+    assert "The paper's order, in the means" in fig4
+    assert 'CCT minus MSC, paired by seed' in fig4
+    beyond = pages['msc_pf-gather']
+    assert 'Against the best MSC configuration' in beyond
+    table = beyond.split('Against the best MSC configuration', 1)[1]
+    assert 'proposed-gather' in table
+    assert not math.isnan(float(table.split('proposed-gather |', 1)[1].split('|')[2]))
