@@ -40,8 +40,9 @@ def test_the_robots_decide_from_their_samples_never_from_the_true_source(case1_s
     run = run_mission(case1_spec, 'bayes_swarm_p', 5, seed=3)
     assert run.found
     # The decoy mission runs a little longer than the original one, then stops.
-    planner = replace(case1_spec.planner, max_mission_time_s=run.found_time_s + 1.0)
-    decoy_spec = replace(case1_spec, source_m=np.array([2.3, 0.1]), planner=planner)
+    decoy_spec = replace(
+        case1_spec, source_m=np.array([2.3, 0.1]), stop_time_s=run.found_time_s + 1.0
+    )
     decoy = run_mission(decoy_spec, 'bayes_swarm_p', 5, seed=3)
     assert not decoy.found
     # Every decision taken before the original run ended is taken identically.
@@ -53,7 +54,7 @@ def test_moving_the_field_changes_every_decision_after_the_first(case1_spec):
     """The first decision is a fixed fan; the later ones follow the sampled field."""
     offset = np.array([0.15, -0.1])
     # Both missions stop after the second decisions (at t = 10 s, end of the first legs).
-    spec = replace(case1_spec, planner=replace(case1_spec.planner, max_mission_time_s=12.0))
+    spec = replace(case1_spec, stop_time_s=12.0)
     moved_spec = replace(
         spec,
         field=lambda p: spec.field(np.asarray(p, dtype=float).reshape(-1, 2) - offset),
