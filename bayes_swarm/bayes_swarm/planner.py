@@ -531,6 +531,19 @@ class _OuterProblem:
         values[~cfg.arena.contains(pts)] = -np.inf
         return pts, values
 
+    def _project(self, x: np.ndarray) -> np.ndarray:
+        """``x`` moved onto the reachable disc (Eq. 2) and into the arena.
+
+        COBYLA returns points on the constraint boundary that violate it by its tolerance
+        (about 1e-8 m); rejecting them would leave the robot where it is and trigger
+        Algorithm 1's random jump, so they are pulled back instead.
+        """
+        offset = np.asarray(x, dtype=float) - self.position
+        distance = float(np.hypot(*offset))
+        if distance > self.cfg.max_leg_m:
+            offset = offset * (self.cfg.max_leg_m / distance)
+        return self.cfg.arena.clip(self.position + offset)
+
     def _feasible(self, x: np.ndarray) -> bool:
         return bool(
             np.hypot(*(x - self.position)) <= self.cfg.max_leg_m + 1e-9
@@ -622,6 +635,8 @@ class _OuterProblem:
         elif cfg.outer_optimizer == 'cobyla':
             best = cfg.arena.clip(self.position)
             candidate = self._cobyla(best, rhobeg=min(1.0, cfg.max_leg_m))
+            if np.all(np.isfinite(candidate)):
+                candidate = self._project(candidate)
         else:
             pts, values = self.grid()
             best = pts[int(np.argmax(values))]

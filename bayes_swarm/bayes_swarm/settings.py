@@ -179,11 +179,17 @@ class BayesSwarmConfig:
     dimensionless_acquisition: bool = parameter(
         False, 'Omega in leg lengths and Sigma over prior std x leg (not in the paper)'
     )
-    outer_optimizer: OuterOptimizer = parameter('grid', 'solver of Eq. 1')
-    inner_optimizer: Literal['newton', 'lbfgsb'] = 'newton'
+    outer_optimizer: OuterOptimizer = parameter(
+        'cobyla', 'solver of Eq. 1 (paper: cobyla)', choices=OUTER_OPTIMIZERS
+    )
+    inner_optimizer: Literal['newton', 'lbfgsb'] = parameter(
+        'lbfgsb', 'solver of Eq. 5 (paper: lbfgsb)', choices=INNER_OPTIMIZERS
+    )
     n_candidate_headings: int = 24
     n_inner_starts: int = 2
-    cobyla_max_iterations: int = 60
+    cobyla_max_iterations: int = parameter(
+        1000, 'iteration limit of COBYLA (scipy default, as the authors)', ge=1
+    )
     pso_particles: int = 40
     pso_iterations: int = 40
     max_peer_path_points: int = 400
