@@ -25,7 +25,11 @@ BEFORE = Path(__file__).with_name('data') / 'node_parameter_defaults_before_spec
 # Parameters added since the recording (name -> default).
 ADDED = {
     'oabug': {'min_turn_rate_radps': 0.3},
-    'bayes_swarm': {'inner_optimizer': 'lbfgsb', 'cobyla_max_iterations': 1000},
+    'bayes_swarm': {
+        'inner_optimizer': 'lbfgsb',
+        'cobyla_max_iterations': 1000,
+        'penalty_estimate': False,
+    },
 }
 # Defaults changed on purpose since the recording (name -> new default): the Bayes-Swarm
 # planner defaults to the paper's solvers; the project's grid solver is the 'grid' profile.

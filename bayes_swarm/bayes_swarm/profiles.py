@@ -10,6 +10,9 @@ profiles are this project's departures, each listed in docs/bayes_swarm.md.
 * ``grid``: the project's polar-grid solver of Eq. 1 with a pattern search, and a multi-start
   trust-region Newton ascent for Eq. 5. Both are deterministic, so on a noise-free field a
   run does not depend on the seed at all (only the random jumps of Algorithm 1 would).
+* ``estimated-penalty``: the paper's solvers, but the penalty's M and L estimated from the
+  robot's belief at every decision as in Gonzalez et al.'s local penalization (M the largest
+  observation, L the largest gradient norm of the GP mean), instead of the fixed values.
 """
 
 from __future__ import annotations
@@ -40,6 +43,11 @@ PROFILES: dict[str, Profile] = {
             'grid',
             "polar-grid Eq. 1 and Newton Eq. 5 (project's departure; seed-independent)",
             {'outer_optimizer': 'grid', 'inner_optimizer': 'newton'},
+        ),
+        Profile(
+            'estimated-penalty',
+            "the paper's solvers; L and M estimated from the belief GP (local penalization)",
+            {'penalty_estimate': True},
         ),
     )
 }

@@ -5,7 +5,7 @@ record that exists is a valid one; invalid values raise :class:`~bayes_swarm.err
 with the offending field named.
 
 Defaults follow the Bayes-Swarm-P paper (Case 1 settings, Table 3 caption and Sec. 3.1) and, for
-the baselines, ALGORITHM_SPECS.md (Tables 11 and 12 of the paper). The authors' code departs
+the baselines, the paper's Tables 11 and 12. The authors' code departs
 from the paper in a few places; those departures are available as switches, all off by default
 (see docs/bayes_swarm.md):
 
@@ -164,6 +164,9 @@ class BayesSwarmConfig:
         2.0, 'L, the Lipschitz constant of the penalty', unit='signal/m', gt=0.0
     )
     penalty_enabled: bool = True
+    penalty_estimate: bool = parameter(
+        False, 'L and M of the penalty estimated from the belief GP each decision (not in paper)'
+    )
     robot_size_m: float = parameter(0.1, 'l_robot of Algorithm 2', unit='m', gt=0.0)
     n_max: int = parameter(1000, 'N_max: observations kept for the GP after downsampling', ge=1)
     alpha_time_scale: float = parameter(
@@ -255,7 +258,7 @@ class BayesSwarmConfig:
 
 @dataclass(frozen=True)
 class GlowwormConfig:
-    """Glowworm swarm optimisation (ALGORITHM_SPECS.md §2; paper Table 11).
+    """Glowworm swarm optimisation (paper Table 11).
 
     ``step_m`` is the GSO step s; per decision a robot moves min(step_m, V / decision_rate_hz).
     """
@@ -283,7 +286,7 @@ class GlowwormConfig:
 
 @dataclass(frozen=True)
 class LevyConfig:
-    """Levy walk (ALGORITHM_SPECS.md §3; paper Table 12).
+    """Levy walk (paper Table 12).
 
     Steps follow a Pareto law with exponent ``mu`` and minimum ``min_step_m``, truncated at
     ``max_step_m`` (None: the arena diagonal). With ``taxis`` the heading is wrapped-Cauchy
@@ -307,7 +310,7 @@ class LevyConfig:
 
 @dataclass(frozen=True)
 class ExhaustiveConfig:
-    """Partitioned boustrophedon sweep (ALGORITHM_SPECS.md §4).
+    """Partitioned boustrophedon sweep (the paper's exhaustive baseline).
 
     ``lane_spacing_m`` None means :meth:`spacing_m` of the detection radius: 2 eps, less a
     hair (0.1 %) so that a source exactly midway between two lanes is still detected.

@@ -1,4 +1,4 @@
-"""Comparison methods of the Bayes-Swarm-P study (ALGORITHM_SPECS.md §2-§4)."""
+"""Comparison methods of the Bayes-Swarm-P study."""
 
 from bayes_swarm.baselines.exhaustive import sweep_paths
 from bayes_swarm.baselines.glowworm import GlowwormSwarm, glowworm_step

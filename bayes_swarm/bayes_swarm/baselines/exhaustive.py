@@ -1,4 +1,4 @@
-"""Exhaustive partitioned boustrophedon sweep (ALGORITHM_SPECS.md §4).
+"""Exhaustive partitioned boustrophedon sweep (the paper's exhaustive baseline).
 
 The arena is cut into equal vertical strips, one per robot ('strips'), or into quadrants
 that are shared out among the robots and then cut into strips ('quadrants', the paper's

@@ -1,4 +1,4 @@
-"""Glowworm swarm optimisation for source search (ALGORITHM_SPECS.md §2, paper Table 11).
+"""Glowworm swarm optimisation for source search (paper Table 11).
 
 One synchronous iteration, for every agent i:
 

@@ -1,4 +1,4 @@
-"""Levy walk search (ALGORITHM_SPECS.md §3, paper Table 12).
+"""Levy walk search (paper Table 12).
 
 Each leg draws a step from a Pareto law ``l = l0 u^(-1 / (mu - 1))`` (re-drawn above the
 truncation) and a heading, uniform for the plain walk or wrapped-Cauchy around the direction
