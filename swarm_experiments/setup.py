@@ -48,5 +48,8 @@ setup(
             'spawn_msc_pf = swarm_experiments.spawn_msc_pf:main',
             'swarm_study = swarm_experiments.study.cli:main',
         ],
+        'swarm_experiments.studies': [
+            'bayes_swarm = swarm_experiments.bayes_studies:studies',
+        ],
     },
 )

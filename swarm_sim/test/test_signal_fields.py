@@ -132,4 +132,4 @@ def test_the_default_avalanche_beacon_registers_above_the_papers_noise_across_th
     ring = case.source_m + 27.0 * np.column_stack([np.cos(angles), np.sin(angles)])
     assert np.all(case.field(ring) > noise)
     shallow = avalanche_case(2.0)
-    assert shallow.field(case.source_m + [[12.0, 0.0]])[0] < noise
+    assert shallow.field((case.source_m + np.array([12.0, 0.0]))[None])[0] < noise
