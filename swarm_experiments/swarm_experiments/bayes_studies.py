@@ -15,7 +15,8 @@ fixed parameters of its study; :func:`run_bayes` understands these names:
   ``alpha_t_max_s`` (the T_max of the alpha schedule only, Table 7), ``t_max_s`` (mission
   T_max, 0: the case's), ``baseline_t_max_factor`` (T_max factor for Levy walk and the
   exhaustive sweep, which rarely finish within the paper's T_max), ``depth_m`` (avalanche
-  burial depth, 0: the default);
+  burial depth, 0: the default), ``seed_offset`` (added to the run's seed, e.g. 101 for the
+  held-out seeds 101-...);
 * any other name of a :class:`bayes_swarm.settings.BayesSwarmConfig` field is a planner
   option.
 
@@ -67,6 +68,7 @@ _RUN_KEYS = {
     't_max_s',
     'baseline_t_max_factor',
     'depth_m',
+    'seed_offset',
 }
 
 #: The paper's published tau (mean, std) per study and configuration key.
@@ -155,6 +157,7 @@ def _random_source_offset(case: SignalCase, seed: int) -> np.ndarray:
 def run_bayes(spec: RunSpec) -> dict[str, Any]:
     """One seeded mission of a Bayes-Swarm study (parameter names: module docstring)."""
     config = dict(spec.config)
+    seed = spec.seed + int(config.get('seed_offset', 0) or 0)
     case = _case(config)
     name = str(config.get('case', 'case1'))
     algorithm = str(config.get('algorithm', 'bayes_swarm_p'))
@@ -181,7 +184,7 @@ def run_bayes(spec: RunSpec) -> dict[str, Any]:
         t_max *= factor
     case = replace(case, max_mission_time_s=t_max)
     if config.get('source', 'paper') == 'random':
-        case = case.with_source_moved(_random_source_offset(case, spec.seed))
+        case = case.with_source_moved(_random_source_offset(case, seed))
     level = int(config.get('comm_level', 0) or 0)
     comm = COMM_RANGES_M[name][level - 1] if level > 0 else None
     noise = float(config.get('noise_std', 0.0) or 0.0)
@@ -199,7 +202,7 @@ def run_bayes(spec: RunSpec) -> dict[str, Any]:
         mission = replace(mission, relative_noise=fraction, planner=replace(mission.planner, gp=gp))
     robots = int(config.get('robots', 0) or 0) or PAPER_ROBOTS[name]
     start = time.process_time()
-    result = run_mission(mission, algorithm, robots, spec.seed)
+    result = run_mission(mission, algorithm, robots, seed)
     cpu = time.process_time() - start
     ideal_s = float(np.hypot(*(case.source_m - case.depots_m[0]))) / case.velocity_mps
     decisions = result.decisions[result.finder] if result.found else []
@@ -226,9 +229,19 @@ def _median_ms(values: list[float]) -> float:
 
 
 # ---------------------------------------------------------------------------- reports
+_VARIED = ('param.profile', 'param.seed_offset')
+
+
+def _with_varied(rows: Any, by: list[str]) -> list[str]:
+    """``by`` plus the fixed parameters that differ between the stored runs (``--set``)."""
+    extra = [c for c in _VARIED if c in rows.columns and rows[c].nunique(dropna=False) > 1]
+    return [*extra, *by]
+
+
 def _mean_std(rows: Any, by: list[str]) -> Any:
     import pandas as pd
 
+    by = _with_varied(rows, by)
     found = rows[rows['metric.found'].astype(bool)]
     table = (
         rows.groupby(by, sort=False)
@@ -247,6 +260,8 @@ def _reference_section(page: ReportPage, key: str, by: list[str]) -> None:
     rows = page.rows
     if rows.empty:
         return
+    if len(_with_varied(rows, [])) > 0:
+        rows = rows[rows['param.profile'] == 'paper'] if 'param.profile' in rows else rows
     found = rows[rows['metric.found'].astype(bool)]
     reference = {k: v[0] for k, v in PAPER[key].items()}
     if len(by) == 1:
@@ -257,9 +272,11 @@ def _reference_section(page: ReportPage, key: str, by: list[str]) -> None:
         for r in table[by].itertuples(index=False)
     ]
     page.add_table(
-        _mean_std(rows, by), title='tau over the successful runs, and how many succeeded'
+        _mean_std(page.rows, by), title='tau over the successful runs, and how many succeeded'
     )
-    page.add_table(table, title="tau beside the paper's published figures (successful runs)")
+    page.add_table(
+        table, title="tau beside the paper's published figures (paper profile, successful runs)"
+    )
 
 
 def _paired_section(
@@ -269,7 +286,11 @@ def _paired_section(
     if rows.empty or by not in rows.columns or rows[by].nunique() < 2:
         return
     table = paired_differences(
-        rows, 'metric.tau_censored', by=by, baseline=baseline, group_by=group_by
+        rows,
+        'metric.tau_censored',
+        by=by,
+        baseline=baseline,
+        group_by=_with_varied(rows, group_by),
     )
     page.add_table(table, title=title)
     page.add_text(
@@ -386,9 +407,6 @@ def _report_scaling(page: ReportPage) -> None:
 
 
 # ---------------------------------------------------------------------------- studies
-_SMOKE_T_MAX = {'t_max_s': 0.0}
-
-
 def studies() -> list[Study]:
     """The Bayes-Swarm-P paper's studies, 55 seeds per configuration by default."""
     common = {'profile': 'paper'}
@@ -434,7 +452,7 @@ def studies() -> list[Study]:
             name='bayes-table4-case3',
             run=run_bayes,
             axes={'robots': (48, 100)},
-            params={**common, 'case': 'case3'},
+            params={**common, 'case': 'case3', 't_max_s': 0.0},
             runs=55,
             description='Table 4: Case 3 with 48 and 100 robots from the four corners.',
             smoke=Smoke(runs=1, axes={'robots': (48,)}, params={'t_max_s': 120.0}),
