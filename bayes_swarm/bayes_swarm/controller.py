@@ -77,7 +77,8 @@ class RobotController:
     def __init__(self, settings: NodeSettings, robot_name: str) -> None:
         self.robot_name = robot_name
         self.settings = settings
-        self._follower = WaypointFollower(settings.follower)
+        self.follower_config = settings.follower
+        self._follower = WaypointFollower(self.follower_config)
         self._pose: tuple[float, float, float] | None = None
         self._pose_time_s = -math.inf
         self._waypoint: np.ndarray | None = None
@@ -111,7 +112,8 @@ class RobotController:
     def configure(self, settings: NodeSettings) -> None:
         """Take changed settings while running (only the follower's take effect)."""
         self.settings = settings
-        self._follower = WaypointFollower(settings.follower)
+        self.follower_config = settings.follower
+        self._follower = WaypointFollower(self.follower_config)
 
     @property
     def planner(self) -> BayesSwarmPlanner | None:
@@ -235,7 +237,7 @@ class RobotController:
         if self._glow is None or self._pose is None or self._waypoint is None:
             return None
         position = np.array(self._pose[:2])
-        follower = self.settings.follower
+        follower = self.follower_config
         if self._n_decisions == 1 and np.hypot(*(self._waypoint - position)) > (
             follower.arrival_tolerance_m
         ):
