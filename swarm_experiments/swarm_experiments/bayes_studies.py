@@ -409,7 +409,7 @@ def _report_scaling(page: ReportPage) -> None:
 # ---------------------------------------------------------------------------- studies
 def studies() -> list[Study]:
     """The Bayes-Swarm-P paper's studies, 55 seeds per configuration by default."""
-    common = {'profile': 'paper'}
+    common = {'profile': 'paper', 'seed_offset': 0}
     return [
         Study(
             name='bayes-table1-2-optimizers',

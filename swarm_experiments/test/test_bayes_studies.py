@@ -24,7 +24,8 @@ def test_every_paper_study_is_registered_through_the_entry_point_with_55_seeds()
     for study in studies():
         assert study.runs == 55
         assert study.smoke.runs <= 2
-        assert study.params.get('profile', 'paper') == 'paper'
+        assert study.params['profile'] == 'paper'
+        assert study.params['seed_offset'] == 0
 
 
 def _spec(config, seed=3):
