@@ -51,6 +51,7 @@ setup(
         'swarm_experiments.studies': [
             'oabug = swarm_experiments.oabug_study:studies',
             'msc_pf = swarm_experiments.msc_pf_studies:studies',
+            'bayes_swarm = swarm_experiments.bayes_studies:studies',
         ],
     },
 )

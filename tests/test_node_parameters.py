@@ -101,8 +101,8 @@ def test_bayes_swarm_rebuilds_its_follower_after_a_change(ros) -> None:
     node, _ = _bayes()
     [result] = node.set_parameters([Parameter('arrival_tolerance_m', value=0.05)])
     assert result.successful
-    assert node._follower_config.arrival_tolerance_m == 0.05
-    assert node._follower_config.speed_mps == node.settings.planner.velocity_mps
+    assert node.controller.follower_config.arrival_tolerance_m == 0.05
+    assert node.controller.follower_config.speed_mps == node.settings.planner.velocity_mps
     node.destroy_node()
 
 

@@ -277,8 +277,22 @@ class BayesSwarmPlanner:
             keep = downsample_indices(pts.shape[0], cfg.n_max)
         return pts[keep], vals[keep]
 
+    def _estimated_penalty_constants(self, values: np.ndarray) -> tuple[float, float]:
+        """M and L of the penalty from the belief (local penalization, Gonzalez et al. 2016).
+
+        M is the largest observed value; L the largest norm of the GP mean's gradient over
+        the arena grid and the data points (the configured L if that is below 1e-7).
+        """
+        points = np.vstack([self._mean_grid, self._gp.training_inputs])
+        _, grad, _ = self._gp.mean_derivatives(points)
+        lipschitz = float(np.max(np.hypot(grad[:, 0], grad[:, 1])))
+        if not (math.isfinite(lipschitz) and lipschitz > 1e-7):
+            lipschitz = self._cfg.lipschitz
+        return float(np.max(values)), lipschitz
+
     def _bayes_decision(self, position: np.ndarray, time_s: float) -> Decision:
         cfg = self._cfg
+        lipschitz = cfg.lipschitz
         pts, vals = self._training_data()
         self._gp.fit(pts, vals)
         expected = self._expected_source()
@@ -312,6 +326,8 @@ class BayesSwarmPlanner:
                 max_signal = -float(self._gp.predict_mean(expected.reshape(1, 2))[0])
             else:
                 max_signal = cfg.max_signal
+            if cfg.penalty_estimate:
+                max_signal, lipschitz = self._estimated_penalty_constants(vals)
         else:
             peer_waypoints = np.zeros((0, 2))
             peer_mean = peer_std = np.zeros(0)
@@ -326,6 +342,7 @@ class BayesSwarmPlanner:
             peer_mean,
             peer_std,
             max_signal,
+            lipschitz,
         )
         waypoint = problem.solve(self._rng)
         kind = DecisionKind.ACQUISITION
@@ -456,8 +473,10 @@ class _OuterProblem:
         peer_mean: np.ndarray,
         peer_std: np.ndarray,
         max_signal: float,
+        lipschitz: float,
     ) -> None:
         self.cfg = cfg
+        self.lipschitz = lipschitz
         self.position = position
         self.expected = expected
         self.alpha = alpha
@@ -487,7 +506,7 @@ class _OuterProblem:
             self.peer_mean,
             self.peer_std,
             max_signal=self.max_signal,
-            lipschitz=self.cfg.lipschitz,
+            lipschitz=self.lipschitz,
             std_floor=self.cfg.penalty_std_floor,
         )
 
@@ -530,6 +549,19 @@ class _OuterProblem:
         )
         values[~cfg.arena.contains(pts)] = -np.inf
         return pts, values
+
+    def _project(self, x: np.ndarray) -> np.ndarray:
+        """``x`` moved onto the reachable disc (Eq. 2) and into the arena.
+
+        COBYLA returns points on the constraint boundary that violate it by its tolerance
+        (about 1e-8 m); rejecting them would leave the robot where it is and trigger
+        Algorithm 1's random jump, so they are pulled back instead.
+        """
+        offset = np.asarray(x, dtype=float) - self.position
+        distance = float(np.hypot(*offset))
+        if distance > self.cfg.max_leg_m:
+            offset = offset * (self.cfg.max_leg_m / distance)
+        return self.cfg.arena.clip(self.position + offset)
 
     def _feasible(self, x: np.ndarray) -> bool:
         return bool(
@@ -622,6 +654,8 @@ class _OuterProblem:
         elif cfg.outer_optimizer == 'cobyla':
             best = cfg.arena.clip(self.position)
             candidate = self._cobyla(best, rhobeg=min(1.0, cfg.max_leg_m))
+            if np.all(np.isfinite(candidate)):
+                candidate = self._project(candidate)
         else:
             pts, values = self.grid()
             best = pts[int(np.argmax(values))]

@@ -164,6 +164,9 @@ class BayesSwarmConfig:
         2.0, 'L, the Lipschitz constant of the penalty', unit='signal/m', gt=0.0
     )
     penalty_enabled: bool = True
+    penalty_estimate: bool = parameter(
+        False, 'L and M of the penalty estimated from the belief GP each decision (not in paper)'
+    )
     robot_size_m: float = parameter(0.1, 'l_robot of Algorithm 2', unit='m', gt=0.0)
     n_max: int = parameter(1000, 'N_max: observations kept for the GP after downsampling', ge=1)
     alpha_time_scale: float = parameter(
@@ -179,11 +182,17 @@ class BayesSwarmConfig:
     dimensionless_acquisition: bool = parameter(
         False, 'Omega in leg lengths and Sigma over prior std x leg (not in the paper)'
     )
-    outer_optimizer: OuterOptimizer = parameter('grid', 'solver of Eq. 1')
-    inner_optimizer: Literal['newton', 'lbfgsb'] = 'newton'
+    outer_optimizer: OuterOptimizer = parameter(
+        'cobyla', 'solver of Eq. 1 (paper: cobyla)', choices=OUTER_OPTIMIZERS
+    )
+    inner_optimizer: Literal['newton', 'lbfgsb'] = parameter(
+        'lbfgsb', 'solver of Eq. 5 (paper: lbfgsb)', choices=INNER_OPTIMIZERS
+    )
     n_candidate_headings: int = 24
     n_inner_starts: int = 2
-    cobyla_max_iterations: int = 60
+    cobyla_max_iterations: int = parameter(
+        1000, 'iteration limit of COBYLA (scipy default, as the authors)', ge=1
+    )
     pso_particles: int = 40
     pso_iterations: int = 40
     max_peer_path_points: int = 400

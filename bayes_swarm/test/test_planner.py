@@ -214,3 +214,32 @@ def test_dimensionless_acquisition_makes_the_decision_independent_of_the_signal_
     # In the paper's units a 100 times stronger field lets the exploration term dominate.
     paper = _decision_on_scaled_field(1.0, False)
     assert np.hypot(*(_decision_on_scaled_field(100.0, False) - paper)) > 0.5
+
+
+def _with_data(cfg, peer_waypoint):
+    planner = BayesSwarmPlanner(cfg, 'r0', seed=4)
+    planner.decide([0, 0], 0.0)
+    for end in ([0.26, 0.97], [0.5, 0.87], [0.71, 0.71]):
+        leg(planner, [0, 0], end)
+    planner.receive(PeerUpdate('r1', 1, np.array([0.5, 0.87]), np.asarray(peer_waypoint)))
+    return planner
+
+
+def test_a_penalty_ball_over_the_whole_arena_stalls_cobyla_and_the_estimate_frees_it():
+    """With M far above the field (47 on a field of 1) and L = 2, the exclusion ball around
+    the peer's waypoint is ~23 m wide: Gamma is 0 on the whole arena, the acquisition is flat
+    and COBYLA ends one rhobeg from the start. The belief-estimated M and L keep it local."""
+    fixed = BayesSwarmConfig(max_signal=47.0, lipschitz=2.0)
+    decision = _with_data(fixed, [1.2, 1.2]).decide([0.71, 0.71], 50.0)
+    assert np.hypot(*(decision.waypoint_m - [0.71, 0.71])) == pytest.approx(1.0, abs=1e-6)
+    assert decision.waypoint_m[1] == pytest.approx(0.71, abs=1e-6)  # the first COBYLA step
+    estimating = _with_data(replace(fixed, penalty_estimate=True), [1.2, 1.2])
+    free = estimating.decide([0.71, 0.71], 50.0)
+    assert free.kind is DecisionKind.ACQUISITION
+    assert abs(free.waypoint_m[1] - 0.71) > 0.05
+    values = np.array([0.2, 0.9, 0.4])
+    m, lipschitz = estimating._estimated_penalty_constants(values)
+    assert m == 0.9
+    _, grad, _ = estimating.gp.mean_derivatives(estimating.gp.training_inputs)
+    assert lipschitz >= float(np.max(np.hypot(grad[:, 0], grad[:, 1]))) - 1e-12
+    assert lipschitz < 2.0

@@ -1,10 +1,12 @@
 """Batch runner of Bayes-Swarm missions and their baselines, without the runtime.
 
-It steps the same planner objects the ROS node uses in the paper's motion model
-(:class:`swarm_sim.point_robots.PointRobotField`): robots fly straight legs at V, sample the
-field at every tick of the observation clock (t = k / f_Hz, all robots), decide on arrival at
-their waypoint (so decisions are asynchronous) and broadcast a
-:class:`~bayes_swarm.messages.PeerUpdate`, delivered at once to every robot within
+Only the world lives here. The robots are the ROS node's own per-robot loop,
+:class:`bayes_swarm.controller.RobotController` (sample and hold, staleness, decision timing,
+the planner), with the settings a spawned node gets. The world is the paper's motion model
+(:class:`swarm_sim.point_robots.PointRobotField`): robots fly straight legs at V, every robot
+gets its pose and a sample at every tick of the observation clock (t = k / f_Hz), a robot that
+reaches its waypoint gets a control tick, which decides (so decisions are asynchronous), and
+its :class:`~bayes_swarm.messages.PeerUpdate` is delivered at once to every robot within
 ``comm_range_m`` unless dropped with probability ``loss_probability``. Detection is
 continuous: a mission succeeds at the first instant any robot comes within eps of the source
 along its straight leg. Glowworm runs after the first dispersal leg as a synchronous
@@ -16,16 +18,16 @@ Decisions take no simulated time; their wall-clock duration is recorded per robo
 from __future__ import annotations
 
 import math
-from abc import ABC, abstractmethod
+from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
-from typing import Literal
+from typing import Literal, Protocol
 
 import numpy as np
-from bayes_swarm.baselines.exhaustive import sweep_paths
 from bayes_swarm.baselines.glowworm import GlowwormSwarm
-from bayes_swarm.baselines.levy import LevyWalk
+from bayes_swarm.controller import ControlOutput, RobotController, robot_seed
 from bayes_swarm.errors import ConfigError
 from bayes_swarm.messages import Decision, DecisionKind, PeerUpdate
+from bayes_swarm.node_settings import NodeSettings
 from bayes_swarm.planner import BayesSwarmPlanner, first_waypoint
 from bayes_swarm.settings import (
     Arena,
@@ -38,10 +40,15 @@ from swarm_sim.point_robots import FieldFunction, PointRobotField
 
 __all__ = [
     'ALGORITHMS',
+    'ControllerLink',
     'MissionResult',
     'MissionSpec',
+    'RobotLink',
     'depot_fan',
+    'robot_settings',
     'robot_start_and_fan',
+    'ros_time_s',
+    'run_events',
     'run_mission',
 ]
 
@@ -64,6 +71,8 @@ class MissionSpec:
         relative_noise: std of measurement noise as a fraction of |f| (Table 7's |A| / k).
         comm_range_m: peer-message range [m]; None is unlimited.
         loss_probability: probability that one peer message to one receiver is lost.
+        stop_time_s: when the world stops the run [s] (None: the planners' T_max, which is
+            also what their alpha schedule uses).
     """
 
     field: FieldFunction
@@ -75,6 +84,7 @@ class MissionSpec:
     relative_noise: float = 0.0
     comm_range_m: float | None = None
     loss_probability: float = 0.0
+    stop_time_s: float | None = None
     glowworm: GlowwormConfig = field(default_factory=GlowwormConfig)
     levy: LevyConfig = field(default_factory=LevyConfig)
     exhaustive: ExhaustiveConfig = field(default_factory=ExhaustiveConfig)
@@ -174,126 +184,110 @@ def _tau(spec: MissionSpec, world: PointRobotField) -> float:
 def run_mission(
     spec: MissionSpec, algorithm: str, n_robots: int, seed: int, *, keep_planners: bool = False
 ) -> MissionResult:
-    """Simulate one mission of ``n_robots`` running ``algorithm`` (one of ALGORITHMS)."""
+    """Simulate one mission of ``n_robots`` running ``algorithm`` (one of ALGORITHMS).
+
+    Every robot except Glowworm's is a :class:`~bayes_swarm.controller.RobotController` with
+    the settings a spawned node gets (:func:`robot_settings`).
+    """
     if algorithm not in ALGORITHMS:
         msg = f'unknown algorithm {algorithm!r}; choose one of {", ".join(ALGORITHMS)}'
         raise ConfigError(msg)
     if n_robots < 1:
         msg = f'n_robots must be >= 1, got {n_robots}'
         raise ConfigError(msg)
-    seeds = np.random.SeedSequence(seed).spawn(n_robots + 1)
-    world_rng = np.random.default_rng(seeds[0])
-    world = _world(spec, n_robots, world_rng)
     if algorithm == 'glowworm':
+        seeds = np.random.SeedSequence(seed).spawn(n_robots + 1)
+        world = _world(spec, n_robots, np.random.default_rng(seeds[0]))
         return _run_glowworm(spec, world, n_robots, seeds)
-    agents = _make_agents(spec, algorithm, n_robots, seeds, world)
-    return _run_events(spec, world, agents, keep_planners)
+    controllers = [
+        RobotController(robot_settings(spec, algorithm, n_robots, i, seed), f'r{i}')
+        for i in range(n_robots)
+    ]
+    result = run_events(spec, n_robots, seed, [ControllerLink(c) for c in controllers])
+    if keep_planners:
+        result.planners = [c.planner for c in controllers if c.planner is not None]
+    return result
 
 
-# --------------------------------------------------------------------------- agents
-class _Agent(ABC):
-    """What the event loop needs from a robot's decision maker."""
+# --------------------------------------------------------------------------- robots
+class RobotLink(Protocol):
+    """How the world loop talks to one robot: the calls of a RobotController.
 
-    planner: BayesSwarmPlanner | None = None
+    The batch runner links :class:`~bayes_swarm.controller.RobotController` objects directly
+    (:class:`ControllerLink`); a test links ROS nodes through their messages instead, to show
+    that both paths take the same decisions.
+    """
 
-    def observe(self, point: np.ndarray, value: float) -> None:
-        return None
+    def pose(self, position_m: np.ndarray, yaw_rad: float, time_s: float) -> None:
+        """The robot's pose at ``time_s``."""
 
-    @abstractmethod
-    def decide(self, position: np.ndarray, time_s: float) -> Decision:
-        """Next waypoint on arrival at ``position``."""
+    def signal(self, value: float, time_s: float) -> None:
+        """One field sample at the latest pose."""
 
-    def broadcast(self, position: np.ndarray) -> PeerUpdate | None:
-        return None
+    def peer(self, update: PeerUpdate, time_s: float) -> None:
+        """A peer's broadcast."""
 
-    def receive(self, update: PeerUpdate) -> None:
-        return None
-
-
-class _BayesAgent(_Agent):
-    def __init__(self, planner: BayesSwarmPlanner) -> None:
-        self.planner = planner
-
-    def observe(self, point: np.ndarray, value: float) -> None:
-        self.planner.add_observations(point.reshape(1, 2), np.array([value]))
-
-    def decide(self, position: np.ndarray, time_s: float) -> Decision:
-        return self.planner.decide(position, time_s)
-
-    def broadcast(self, position: np.ndarray) -> PeerUpdate | None:
-        return self.planner.broadcast(position)
-
-    def receive(self, update: PeerUpdate) -> None:
-        self.planner.receive(update)
+    def control(self, time_s: float) -> ControlOutput:
+        """One control tick."""
 
 
-class _LevyAgent(_Agent):
-    def __init__(self, walk: LevyWalk) -> None:
-        self._walk = walk
-        self._k = 0
-        self._last_signal: float | None = None
+class ControllerLink:
+    """A RobotController driven directly."""
 
-    def observe(self, point: np.ndarray, value: float) -> None:
-        self._last_signal = value
+    def __init__(self, controller: RobotController) -> None:
+        self.controller = controller
 
-    def decide(self, position: np.ndarray, time_s: float) -> Decision:
-        waypoint = self._walk.next_waypoint(position, self._last_signal)
-        self._k += 1
-        return Decision(waypoint, self._k - 1, DecisionKind.RANDOM_JUMP)
+    def pose(self, position_m: np.ndarray, yaw_rad: float, time_s: float) -> None:
+        self.controller.on_pose((float(position_m[0]), float(position_m[1]), yaw_rad), time_s)
 
+    def signal(self, value: float, time_s: float) -> None:
+        self.controller.on_signal(value)
 
-class _SweepAgent(_Agent):
-    def __init__(self, waypoints: np.ndarray) -> None:
-        self._waypoints = waypoints
-        self._k = 0
+    def peer(self, update: PeerUpdate, time_s: float) -> None:
+        self.controller.on_peer(update)
 
-    def decide(self, position: np.ndarray, time_s: float) -> Decision:
-        index = min(self._k, self._waypoints.shape[0] - 1)
-        self._k += 1
-        return Decision(self._waypoints[index].copy(), self._k - 1, DecisionKind.ACQUISITION)
+    def control(self, time_s: float) -> ControlOutput:
+        return self.controller.control(time_s)
 
 
-def _make_agents(
-    spec: MissionSpec,
-    algorithm: str,
-    n_robots: int,
-    seeds: list[np.random.SeedSequence],
-    world: PointRobotField,
-) -> list[_Agent]:
-    if algorithm == 'levy':
-        return [
-            _LevyAgent(LevyWalk(spec.levy, spec.arena, seed=seeds[i + 1])) for i in range(n_robots)
-        ]
-    if algorithm == 'exhaustive':
-        spacing = spec.exhaustive.spacing_m(spec.planner.detection_radius_m)
-        paths = sweep_paths(spec.arena, world.starts, spacing, spec.exhaustive.partition)
-        return [_SweepAgent(p) for p in paths]
-    agents: list[_Agent] = []
-    for i in range(n_robots):
-        _, fan_index, fan_size, offset = robot_start_and_fan(spec, n_robots, i)
-        cfg = replace(
-            spec.planner,
-            robot_index=i,
-            n_robots=n_robots,
-            penalty_enabled=algorithm == 'bayes_swarm_p' and spec.planner.penalty_enabled,
-        )
-        planner = BayesSwarmPlanner(
-            cfg,
-            f'r{i}',
-            seed=seeds[i + 1],
-            fan_index=fan_index,
-            fan_size=fan_size,
-            direction_offset_deg=offset,
-        )
-        agents.append(_BayesAgent(planner))
-    return agents
+def robot_settings(
+    spec: MissionSpec, algorithm: str, n_robots: int, robot: int, seed: int
+) -> NodeSettings:
+    """The node settings of robot ``robot`` (0-based) in a mission seeded ``seed``.
+
+    The same values the spawner gives its nodes: the spec's planner with this robot's index,
+    the swarm size, its depot's fan and :func:`~bayes_swarm.controller.robot_seed`.
+    """
+    _, fan_index, fan_size, offset = robot_start_and_fan(spec, n_robots, robot)
+    planner = replace(spec.planner, robot_index=robot, n_robots=n_robots)
+    return NodeSettings(
+        algorithm=algorithm,
+        seed=robot_seed(seed, robot),
+        planner=planner,
+        initial_direction_offset_deg=offset,
+        fan_index=fan_index,
+        fan_size=fan_size,
+        levy=spec.levy,
+        glowworm=spec.glowworm,
+        exhaustive=spec.exhaustive,
+    )
+
+
+def ros_time_s(time_s: float) -> float:
+    """``time_s`` rounded to whole nanoseconds, as a ROS clock carries it."""
+    return round(time_s * 1e9) * 1e-9
 
 
 # ----------------------------------------------------------------------- event loop
 def _deliver(
-    spec: MissionSpec, world: PointRobotField, agents: list[_Agent], sender: int, update: PeerUpdate
+    spec: MissionSpec,
+    world: PointRobotField,
+    robots: Sequence[RobotLink],
+    sender: int,
+    update: PeerUpdate,
+    time_s: float,
 ) -> None:
-    for j, agent in enumerate(agents):
+    for j, robot in enumerate(robots):
         if j == sender:
             continue
         if spec.comm_range_m is not None:
@@ -302,42 +296,57 @@ def _deliver(
                 continue
         if spec.loss_probability > 0.0 and world.rng.uniform() < spec.loss_probability:
             continue
-        agent.receive(update)
+        robot.peer(update, time_s)
 
 
-def _run_events(
-    spec: MissionSpec, world: PointRobotField, agents: list[_Agent], keep_planners: bool
+def run_events(
+    spec: MissionSpec, n_robots: int, seed: int, robots: Sequence[RobotLink]
 ) -> MissionResult:
+    """World stepping of one mission with the given robots (see :func:`run_mission`).
+
+    Events: the observation clock (every robot gets its pose and a sample), and arrivals
+    (the arrived robot gets its pose and a control tick, which decides; its broadcast is
+    delivered at once). Times passed to the robots are rounded to nanoseconds.
+    """
+    seeds = np.random.SeedSequence(seed).spawn(n_robots + 1)
+    world = _world(spec, n_robots, np.random.default_rng(seeds[0]))
     cfg = spec.planner
-    n = len(agents)
+    n = len(robots)
     period = 1.0 / cfg.observation_rate_hz
     speed = cfg.velocity_mps
-    t_max = cfg.max_mission_time_s
+    t_max = cfg.max_mission_time_s if spec.stop_time_s is None else spec.stop_time_s
     decisions: list[list[Decision]] = [[] for _ in range(n)]
     waypoints = world.positions.copy()
+    yaws = np.zeros(n)
     tick = 0
     t = 0.0
 
     def sample_all() -> None:
         values = world.sample(world.positions)
-        for agent, p, v in zip(agents, world.positions, values, strict=True):
-            agent.observe(p, float(v))
+        stamp = ros_time_s(t)
+        for i, robot in enumerate(robots):
+            robot.pose(world.positions[i].copy(), float(yaws[i]), stamp)
+            robot.signal(float(values[i]), stamp)
 
-    def decide(i: int) -> None:
-        decision = agents[i].decide(world.positions[i].copy(), t)
-        decisions[i].append(decision)
-        waypoints[i] = decision.waypoint_m
+    def tick_robot(i: int) -> None:
+        stamp = ros_time_s(t)
+        robots[i].pose(world.positions[i].copy(), float(yaws[i]), stamp)
+        out = robots[i].control(stamp)
+        if out.decision is None:
+            return
+        decisions[i].append(out.decision)
+        waypoints[i] = out.decision.waypoint_m
+        leg = waypoints[i] - world.positions[i]
+        if np.hypot(*leg) > 0.0:
+            yaws[i] = math.atan2(leg[1], leg[0])
         world.trajectories[i].append(world.positions[i].copy())
-        update = agents[i].broadcast(world.positions[i].copy())
-        if update is not None:
-            _deliver(spec, world, agents, i, update)
+        if out.broadcast is not None:
+            _deliver(spec, world, robots, i, out.broadcast, stamp)
 
     sample_all()
-    if world.move(waypoints, 0.0, 0.0, speed):
-        pass
-    else:
+    if not world.move(waypoints, 0.0, 0.0, speed):
         for i in range(n):
-            decide(i)
+            tick_robot(i)
     while world.finder < 0 and t < t_max - _TIME_EPS:
         remaining = np.hypot(*(waypoints - world.positions).T)
         arrivals = t + remaining / speed
@@ -354,10 +363,9 @@ def _run_events(
             sample_all()
         arrived = np.flatnonzero(np.hypot(*(waypoints - world.positions).T) <= 1e-9)
         for i in arrived:
-            decide(int(i))
+            tick_robot(int(i))
     for i in range(n):
         world.trajectories[i].append(world.positions[i].copy())
-    planners = [a.planner for a in agents if a.planner is not None] if keep_planners else []
     return MissionResult(
         found=world.finder >= 0,
         found_time_s=world.found_time_s,
@@ -365,7 +373,6 @@ def _run_events(
         tau=_tau(spec, world),
         decisions=decisions,
         trajectories=[np.array(tr) for tr in world.trajectories],
-        planners=planners,
         end_time_s=t,
     )
 

@@ -31,6 +31,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from bayes_swarm.profiles import PROFILES, profile_options
 from sim_bridge.signal_extension import SignalExtension
 from swarm_common.cli import (
     EXIT_INTERRUPTED,
@@ -86,7 +87,6 @@ SPAWNER_PARAMETERS = (
     'n_robots',
     'seed',
     'noise_std',
-    'outer_optimizer',
 )
 
 ALGORITHMS = ('bayes_swarm_p', 'bayes_swarm_o', 'glowworm', 'levy', 'exhaustive')
@@ -119,7 +119,8 @@ class SpawnSettings:
         noise_std: additive Gaussian measurement noise std.
         relative_noise: measurement noise std as a fraction of |f|.
         max_mission_time_s: T_max (None: the case's).
-        outer_optimizer: Bayes-Swarm's Eq. 1 solver (grid, cobyla, pso).
+        profile: Bayes-Swarm settings profile (:data:`bayes_swarm.profiles.PROFILES`:
+            'paper', the as-published solvers, or 'grid', the project's).
         record: bag directory to write, or None.
         out_dir: where the PNGs go (None: no plots).
         extra_parameters: further node parameters (name -> value).
@@ -136,7 +137,7 @@ class SpawnSettings:
     noise_std: float = 0.0
     relative_noise: float = 0.0
     max_mission_time_s: float | None = None
-    outer_optimizer: str = 'grid'
+    profile: str = 'paper'
     record: Path | None = None
     out_dir: Path | None = None
     extra_parameters: dict[str, Any] = field(default_factory=dict)
@@ -168,6 +169,9 @@ class BayesSwarmRun:
 def _check(settings: SpawnSettings) -> SignalCase:
     if settings.algorithm not in ALGORITHMS:
         msg = f'unknown algorithm {settings.algorithm!r}; choose one of {", ".join(ALGORITHMS)}'
+        raise ExperimentError(msg)
+    if settings.profile not in PROFILES:
+        msg = f'unknown profile {settings.profile!r}; choose one of {", ".join(PROFILES)}'
         raise ExperimentError(msg)
     try:
         case = get_case(settings.case)
@@ -232,7 +236,7 @@ def node_parameter_overrides(items: Sequence[str]) -> dict[str, Any]:
     Raises:
         ConfigurationError: a malformed item, an unknown or spawner-set name
             (:data:`SPAWNER_PARAMETERS`: use ``--algorithm``, ``--robots``, ``--seed``,
-            ``--noise``, ``--outer-optimizer``), a value of the wrong type, or one the node
+            ``--noise``), a value of the wrong type, or one the node
             rejects.
     """
     from bayes_swarm.node_settings import BAYES_SWARM_PARAMETERS
@@ -265,9 +269,9 @@ def node_parameters(case: SignalCase, settings: SpawnSettings, n: int, i: int) -
         'max_signal': float(case.max_signal),
         'lipschitz': float(case.lipschitz),
         'noise_std': float(max(1e-3, settings.noise_std)),
-        'outer_optimizer': settings.outer_optimizer,
         'dimensionless_acquisition': case.dimensionless_acquisition,
     }
+    params.update(profile_options(settings.profile))
     params.update(settings.extra_parameters)
     return params
 
@@ -279,11 +283,13 @@ def batch_mission_spec(
     comm_range_m: float | None = None,
     partition: str = 'strips',
     planner_options: dict[str, Any] | None = None,
+    profile: str = 'paper',
 ) -> Any:
     """The case as a spec of the ROS-free batch simulator (:mod:`swarm_experiments.bayes_batch`).
 
     The planners get the case's settings (arena, V, T, f_Hz, eps, T_max, delta theta, M, L),
-    never its source; ``planner_options`` override BayesSwarmConfig fields. With measurement
+    never its source; the ``profile``'s options and then ``planner_options`` override
+    BayesSwarmConfig fields. With measurement
     noise the GP noise term is raised to it unless ``planner_options`` sets ``gp``.
     """
     from bayes_swarm.settings import Arena, BayesSwarmConfig, ExhaustiveConfig
@@ -300,7 +306,7 @@ def batch_mission_spec(
         lipschitz=case.lipschitz,
         dimensionless_acquisition=case.dimensionless_acquisition,
     )
-    options = dict(planner_options or {})
+    options = {**profile_options(profile), **(planner_options or {})}
     if noise_std > 0.0:
         options.setdefault(
             'gp', replace(planner.gp, noise_std=max(noise_std, planner.gp.noise_std))
@@ -491,7 +497,9 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument('--noise', type=float, default=0.0, help='measurement noise std')
     parser.add_argument('--relative-noise', type=float, default=0.0, help='noise std / |f|')
     parser.add_argument('--t-max', type=float, default=None, help='T_max [s] (case default)')
-    parser.add_argument('--outer-optimizer', choices=('grid', 'cobyla', 'pso'), default='grid')
+    parser.add_argument(
+        '--profile', choices=tuple(PROFILES), default='paper', help='Bayes-Swarm settings profile'
+    )
     add_run_options(parser, out_default=Path('bayes_swarm_run'), plots='the PNGs')
     parser.add_argument(
         '--param',
@@ -526,7 +534,7 @@ def _main(argv: list[str]) -> int:
         noise_std=args.noise,
         relative_noise=args.relative_noise,
         max_mission_time_s=args.t_max,
-        outer_optimizer=args.outer_optimizer,
+        profile=args.profile,
         record=args.record,
         physics=args.physics,
     )

@@ -43,9 +43,8 @@ from swarm_common.cli import (
     run_tool,
 )
 from swarm_sim.engine import EngineConfig, SiteGeometry
-from swarm_sim.errors import ConfigurationError
 from swarm_sim.physics import require_backend
-from swarm_sim.rssi_targets import RssiTargetConfig, RssiTargetField, place_robots
+from swarm_sim.rssi_targets import RssiTargetField
 
 from swarm_experiments.cli_args import (
     SPAWNER_EXIT_CODES,

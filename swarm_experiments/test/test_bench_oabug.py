@@ -95,6 +95,6 @@ def test_the_profile_goes_under_the_set_parameters(bench, monkeypatch):
 
     monkeypatch.setattr(bench, 'run', fake_run)
     with pytest.raises(RuntimeError, match='stop here'):
-        bench.main(['--profile', 'paper', '--set', 'robot_hit_repeat_s=2'])
+        bench._main(['--profile', 'paper', '--set', 'robot_hit_repeat_s=2'])
     assert seen['parameters']['gas_sound_wall_side'] == 'every_contact'
     assert seen['parameters']['robot_hit_repeat_s'] == 2.0

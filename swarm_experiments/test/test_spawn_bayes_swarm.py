@@ -34,27 +34,24 @@ def test_case_2_decisions_follow_the_samples_and_never_the_true_source():
 
     Moving only the declared source leaves every decision unchanged. Moving the field with
     its source keeps the first decisions (a fixed fan) and moves every robot's expected source
-    (Eq. 5) at its second decision, and so the waypoint of every robot that exploits it;
-    exploring legs may end at the same point of the discrete polar grid.
+    (Eq. 5) at its second decision. (At t = 20 s of T_max = 1000 s alpha is about 0.04, so
+    the second legs explore and mostly keep their direction.)
     """
-    case = dataclasses.replace(get_case('case2'), max_mission_time_s=21.0)  # 2 decisions each
-    base = run_harness(batch_mission_spec(case), 'bayes_swarm_p', 10, seed=0)
+    case = get_case('case2')
+
+    def spec(signal_case):  # the world stops after 2 decisions each
+        return dataclasses.replace(batch_mission_spec(signal_case), stop_time_s=21.0)
+
+    base = run_harness(spec(case), 'bayes_swarm_p', 10, seed=0)
     decoy_case = dataclasses.replace(case, source_m=np.array([-20.0, -20.0]))
-    decoy = run_harness(batch_mission_spec(decoy_case), 'bayes_swarm_p', 10, seed=0)
-    moved = run_harness(
-        batch_mission_spec(case.with_source_moved((-2.0, 1.0))), 'bayes_swarm_p', 10, seed=0
-    )
+    decoy = run_harness(spec(decoy_case), 'bayes_swarm_p', 10, seed=0)
+    moved = run_harness(spec(case.with_source_moved((-2.0, 1.0))), 'bayes_swarm_p', 10, seed=0)
     assert _waypoints(decoy) == _waypoints(base)
-    exploiting = 0
     for original, shifted in zip(base.decisions, moved.decisions, strict=True):
         assert len(original) == len(shifted) == 2
         np.testing.assert_array_equal(shifted[0].waypoint_m, original[0].waypoint_m)
         expected = original[1].expected_source_m
         assert np.hypot(*(shifted[1].expected_source_m - expected)) > 0.1
-        if np.hypot(*(original[1].waypoint_m - expected)) < 3.0:
-            exploiting += 1
-            assert np.hypot(*(shifted[1].waypoint_m - original[1].waypoint_m)) > 0.1
-    assert exploiting >= 2
 
 
 @pytest.mark.slow

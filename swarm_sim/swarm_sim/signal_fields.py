@@ -13,11 +13,16 @@ Choices where the paper is silent or inconsistent (see docs/bayes_swarm.md):
   x = 125 m lies just outside and still shapes the field). The main bump is so wide (divisor
   6500 m^2) that the weaker bumps shift the global maximum from c1 = (55, 45) to
   (65.52, 44.31); the source to find is that maximum, what Bayes-Swarm seeks.
-* Avalanche: the beacon lies flat (moment along world x) ``depth_m`` = 2 m below the UAVs'
+* Avalanche: the beacon lies flat (moment along world x) ``depth_m`` = 6 m below the UAVs'
   sensing plane at (20, 20); the moment is scaled so that the maximum |H| directly above the
-  beacon is the paper's 47. The depot is the corner (0, 0), which gives the paper's
-  t_idealized = 56.57 s at 0.5 m/s. The penalty uses M = 47 and L = 20, the largest gradient
-  of this field (Sec. 2.5: L = max |grad f|). The paper's L = 2 with M = 47 would exclude a
+  beacon is the paper's 47. The paper gives no depth, but it chose the 40 x 40 m area
+  "given the limited range within which the beacon signal can be registered": from the
+  depot at the corner (0, 0), 28.3 m from the beacon, the signal must exceed the paper's
+  noise (std 47 / 100 = 0.47). That needs at least 5.4 m; at 6 m |H| exceeds 0.47 within
+  27 m of the beacon in every direction (32 m along the diagonal; 0.66 at the depot), at
+  2 m only within 9-11 m. The depot gives the paper's t_idealized = 56.57 s at 0.5 m/s.
+  The penalty uses M = 47 and L = the largest gradient of this field (Sec. 2.5:
+  L = max |grad f|; 6.7 at 6 m, 20 at 2 m). The paper's L = 2 with M = 47 would exclude a
   ball of radius (M - mu) / L ~ 23 m around every peer's waypoint, i.e. the whole reachable
   area; it did not matter in the authors' code only because their penalty is inert.
 """
@@ -254,15 +259,15 @@ def _case3() -> SignalCase:
     )
 
 
-AVALANCHE_DEPTH_M = 2.0
+AVALANCHE_DEPTH_M = 6.0
 
 
 def avalanche_case(depth_m: float = AVALANCHE_DEPTH_M) -> SignalCase:
     """The avalanche case with the beacon ``depth_m`` below the sensing plane.
 
     The peak stays 47; the field's largest gradient, the penalty's L, scales as 1 / depth
-    (20 at the default 2 m). Other depths serve as a sensitivity check: at 2 m the beacon
-    rises above noise of 1 % of its peak only within 9.3 m of it, at 5 m within 23 m.
+    (6.7 at the default 6 m, 20 at 2 m). The beacon rises above noise of 1 % of its peak
+    within 27 m of it in every direction at 6 m, 23 m at 5 m and 9 m at 2 m.
     """
     if not depth_m > 0.0:
         msg = f'depth_m must be > 0, got {depth_m}'
@@ -278,7 +283,7 @@ def avalanche_case(depth_m: float = AVALANCHE_DEPTH_M) -> SignalCase:
         detection_radius_m=0.15,
         max_mission_time_s=100.0,
         max_signal=47.0,
-        lipschitz=20.0 * AVALANCHE_DEPTH_M / depth_m,  # max |grad f|; see the module docstring
+        lipschitz=40.0 / depth_m,  # max |grad f|; see the module docstring
         direction_range_deg=90.0,
         observation_rate_hz=0.5,
         default_robots=6,

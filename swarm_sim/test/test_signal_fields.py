@@ -96,10 +96,13 @@ def test_dipole_field_matches_eqs_13_14_computed_with_the_matrix_form():
 def test_avalanche_peak_is_47_directly_above_the_beacon_and_decays_with_distance():
     case = get_case('avalanche')
     assert case.field(np.array([[20.0, 20.0]]))[0] == pytest.approx(47.0)
-    result = minimize(lambda p: -case.field(p[None])[0], x0=np.array([21.0, 19.2]))
+    result = minimize(
+        lambda p: -case.field(p[None])[0], x0=np.array([21.0, 19.2]), method='Nelder-Mead'
+    )
     assert result.x == pytest.approx([20.0, 20.0], abs=0.02)
     far = case.field(np.array([[0.0, 0.0], [40.0, 40.0]]))
-    assert np.all(far < 0.1)
+    assert np.all(far < 0.03 * 47.0)
+    assert np.all(far < case.field(np.array([[10.0, 10.0], [30.0, 30.0]])))
 
 
 def test_unknown_case_is_rejected_with_the_choices_listed():
@@ -107,7 +110,7 @@ def test_unknown_case_is_rejected_with_the_choices_listed():
         get_case('case9')
 
 
-@pytest.mark.parametrize('depth_m', [2.0, 5.0])
+@pytest.mark.parametrize('depth_m', [2.0, 5.0, 6.0])
 def test_avalanche_lipschitz_constant_is_the_largest_gradient_of_its_field(depth_m):
     case = avalanche_case(depth_m)
     grid = np.linspace(10.0, 30.0, 401)
@@ -116,3 +119,17 @@ def test_avalanche_lipschitz_constant_is_the_largest_gradient_of_its_field(depth
     d_dy, d_dx = np.gradient(values, grid, grid)
     assert np.hypot(d_dx, d_dy).max() == pytest.approx(case.lipschitz, rel=0.05)
     assert case.field(case.source_m[None])[0] == pytest.approx(47.0)
+
+
+def test_the_default_avalanche_beacon_registers_above_the_papers_noise_across_the_arena():
+    """At the default depth the beacon's |H| exceeds the paper's noise std (47 / 100) at the
+    depot, 28.3 m away, and within 27 m of the beacon in every direction; at 2 m it would
+    only within about 10 m."""
+    case = get_case('avalanche')
+    noise = 47.0 / 100.0
+    assert case.field(np.zeros((1, 2)))[0] > noise
+    angles = np.linspace(0.0, 2.0 * math.pi, 72, endpoint=False)
+    ring = case.source_m + 27.0 * np.column_stack([np.cos(angles), np.sin(angles)])
+    assert np.all(case.field(ring) > noise)
+    shallow = avalanche_case(2.0)
+    assert shallow.field((case.source_m + np.array([12.0, 0.0]))[None])[0] < noise

@@ -1,0 +1,145 @@
+"""The node path and the batch path of Bayes-Swarm run one controller and agree exactly.
+
+The batch runner's world (straight legs at V, samples on the observation clock, decisions on
+arrival) drives, once, the RobotController objects directly and, once, real BayesSwarmNode
+objects through their messages: odometry, signal samples and peer broadcasts go in as ROS
+messages through the node's own subscriptions, the control tick is the node's own timer
+callback on a ROS clock set to the world's time, and what the node publishes on peers/out is
+what the world relays. The world replaces the follower's unicycle by holonomic legs (its
+velocity commands are ignored); everything the robots decide must match bit for bit.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+from bayes_swarm.controller import ControlOutput
+from bayes_swarm.conversions import peer_update_from_ros, peer_update_to_ros
+from bayes_swarm.node import BayesSwarmNode
+from bayes_swarm.node_settings import BAYES_SWARM_PARAMETERS, NodeSettings
+from swarm_experiments.bayes_batch import (
+    MissionSpec,
+    robot_settings,
+    run_events,
+    run_mission,
+)
+from swarm_runtime.messages import get_message_module
+from swarm_runtime.ros import Parameter, SingleThreadedExecutor, Time, rclpy, using_real_rclpy
+from swarm_sim.signal_fields import get_case
+
+pytestmark = pytest.mark.skipif(using_real_rclpy(), reason='drives the built-in runtime')
+
+nav = get_message_module('nav_msgs')
+swarm = get_message_module('swarm_interfaces')
+
+
+class NodeLink:
+    """One BayesSwarmNode driven by the batch world through its messages."""
+
+    def __init__(self, settings: NodeSettings, name: str, probe, executor) -> None:
+        values = BAYES_SWARM_PARAMETERS.values_of(settings)
+        overrides = [Parameter(k, value=v) for k, v in values.items()]
+        overrides.append(Parameter('use_sim_time', value=True))
+        self.node = BayesSwarmNode(namespace=f'/{name}', parameter_overrides=overrides)
+        self.subs = {s.topic_name: s.callback for s in self.node.subscriptions}
+        (self.timer,) = [t for t in self.node.timers]
+        self.name = name
+        self.outbox: list = []
+        probe.create_subscription(
+            swarm.BayesSwarmPeer, f'/{name}/peers/out', self.outbox.append, 100
+        )
+        self.executor = executor
+
+    def _clock(self, time_s: float) -> None:
+        self.node.get_clock().set_ros_time_override(Time(nanoseconds=round(time_s * 1e9)))
+
+    def pose(self, position_m, yaw_rad, time_s) -> None:
+        self._clock(time_s)
+        msg = nav.Odometry()
+        msg.pose.pose.position.x = float(position_m[0])
+        msg.pose.pose.position.y = float(position_m[1])
+        msg.pose.pose.orientation.z = float(np.sin(yaw_rad / 2.0))
+        msg.pose.pose.orientation.w = float(np.cos(yaw_rad / 2.0))
+        self.subs[f'/{self.name}/odom'](msg)
+
+    def signal(self, value, time_s) -> None:
+        self._clock(time_s)
+        self.subs[f'/{self.name}/signal'](swarm.SignalSample(value=float(value)))
+
+    def peer(self, update, time_s) -> None:
+        self._clock(time_s)
+        self.subs[f'/{self.name}/peers/in'](peer_update_to_ros(update, time_s))
+
+    def control(self, time_s) -> ControlOutput:
+        self._clock(time_s)
+        before = len(self.node.decisions)
+        self.timer.callback()
+        if len(self.node.decisions) == before:
+            return ControlOutput(0.0, 0.0)
+        for _ in range(10):
+            if self.outbox:
+                break
+            self.executor.spin_once(timeout_sec=0.0)
+        broadcast = peer_update_from_ros(self.outbox.pop()) if self.outbox else None
+        return ControlOutput(0.0, 0.0, self.node.decisions[-1], broadcast)
+
+
+def _spec(case_name: str, **planner: object) -> MissionSpec:
+    case = get_case(case_name)
+    from swarm_experiments.spawn_bayes_swarm import batch_mission_spec
+
+    spec = batch_mission_spec(case, planner_options=dict(planner))
+    return replace(spec, planner=replace(spec.planner, max_mission_time_s=60.0))
+
+
+def _node_run(spec: MissionSpec, algorithm: str, n: int, seed: int):
+    rclpy.init(args=[])
+    probe = rclpy.create_node('probe')
+    executor = SingleThreadedExecutor()
+    executor.add_node(probe)
+    links = [
+        NodeLink(robot_settings(spec, algorithm, n, i, seed), f'r{i}', probe, executor)
+        for i in range(n)
+    ]
+    try:
+        return run_events(spec, n, seed, links)
+    finally:
+        executor.shutdown()
+        for link in links:
+            link.node.destroy_node()
+        probe.destroy_node()
+        rclpy.try_shutdown()
+
+
+def _trace(result):
+    return [
+        [(d.kind, d.decision_index, tuple(d.waypoint_m), d.alpha, d.n_samples) for d in decisions]
+        for decisions in result.decisions
+    ]
+
+
+@pytest.mark.parametrize(
+    ('case_name', 'algorithm', 'robots', 'planner'),
+    [
+        ('case1', 'bayes_swarm_p', 5, {}),
+        ('case1', 'bayes_swarm_o', 3, {'outer_optimizer': 'cobyla', 'inner_optimizer': 'lbfgsb'}),
+        ('case1', 'levy', 3, {}),
+    ],
+)
+def test_node_and_batch_paths_take_identical_decisions_on_seeded_runs(
+    case_name, algorithm, robots, planner
+):
+    spec = _spec(case_name, **planner)
+    batch = run_mission(spec, algorithm, robots, seed=11)
+    nodes = _node_run(spec, algorithm, robots, seed=11)
+    assert sum(len(d) for d in batch.decisions) > 3 * robots
+    assert _trace(nodes) == _trace(batch)
+    for ours, theirs in zip(nodes.trajectories, batch.trajectories, strict=True):
+        np.testing.assert_array_equal(ours, theirs)
+    assert (nodes.found, nodes.finder, nodes.found_time_s) == (
+        batch.found,
+        batch.finder,
+        batch.found_time_s,
+    ) or (np.isnan(nodes.found_time_s) and np.isnan(batch.found_time_s))

@@ -1,0 +1,65 @@
+"""The Bayes-Swarm-P studies: registered, named for the paper's tables, runs give rows."""
+
+import math
+
+import pytest
+from swarm_experiments.bayes_studies import PAPER, run_bayes, studies
+from swarm_experiments.study import RunSpec, load_registry
+
+EXPECTED = {
+    'bayes-table1-2-optimizers',
+    'bayes-table3-baselines',
+    'bayes-table4-case3',
+    'bayes-table5-penalty',
+    'bayes-table6-comm',
+    'bayes-table7-noise',
+    'bayes-table8-avalanche',
+    'bayes-fig4-scaling',
+}
+
+
+def test_every_paper_study_is_registered_through_the_entry_point_with_55_seeds():
+    registry = load_registry()
+    assert {study.name for study in registry} >= EXPECTED
+    for study in studies():
+        assert study.runs == 55
+        assert study.smoke.runs <= 2
+        assert study.params['profile'] == 'paper'
+        assert study.params['seed_offset'] == 0
+
+
+def _spec(config, seed=3):
+    return RunSpec('test', config, seed, 'id')
+
+
+def test_a_run_returns_tau_and_a_censored_tau_that_pairs_failures():
+    found = run_bayes(_spec({'case': 'case1', 'robots': 3, 'variant': 'o'}))
+    assert found['found']
+    assert found['tau'] == found['tau_censored']
+    assert found['finder_decision_cpu_ms'] > 0.0
+    short = run_bayes(_spec({'case': 'case1', 'robots': 3, 't_max_s': 12.0}))
+    assert not short['found']
+    assert math.isnan(short['tau'])
+    assert short['tau_censored'] == pytest.approx(
+        (12.0 - math.sqrt(5) / 0.1) / (math.sqrt(5) / 0.1)
+    )
+
+
+def test_random_sources_follow_the_seed_and_stay_inside_the_arena():
+    a = run_bayes(_spec({'case': 'case1', 'robots': 2, 'source': 'random', 't_max_s': 1.0}, 5))
+    b = run_bayes(_spec({'case': 'case1', 'robots': 2, 'source': 'random', 't_max_s': 1.0}, 6))
+    assert (a['source_x_m'], a['source_y_m']) != (b['source_x_m'], b['source_y_m'])
+    for row in (a, b):
+        assert 0.24 <= row['source_x_m'] <= 2.16
+        assert 0.24 <= row['source_y_m'] <= 2.16
+
+
+def test_unknown_parameters_are_refused():
+    with pytest.raises(ValueError, match='colour'):
+        run_bayes(_spec({'case': 'case1', 'colour': 'red'}))
+
+
+def test_the_papers_published_numbers_are_written_down_for_every_table():
+    assert PAPER['table5'][('case2', 'o')] == (0.75, 0.42)
+    assert PAPER['table8'][('bayes_swarm_p', 0.47)] == (0.66, 0.47)
+    assert set(PAPER) == {'table3', 'table4', 'table5', 'table6', 'table7', 'table8'}
