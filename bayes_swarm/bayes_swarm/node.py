@@ -21,12 +21,11 @@ import math
 from typing import Any
 
 import numpy as np
+from swarm_runtime.node_main import run_node
 from swarm_runtime.ros import (
-    ExternalShutdownException,
     Node,
     message_module,
     qos_profile_sensor_data,
-    rclpy,
 )
 
 from bayes_swarm import conversions
@@ -256,18 +255,10 @@ class BayesSwarmNode(Node):
         self._decisions += 1
 
 
-def main(args: list[str] | None = None) -> None:
+def main(args: list[str] | None = None) -> int:
     """Entry point of ``ros2 run bayes_swarm bayes_swarm_node``."""
-    rclpy.init(args=args)
-    node = None
-    try:
-        node = BayesSwarmNode()
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    except BayesSwarmError as err:
-        rclpy.logging.get_logger('bayes_swarm').error(str(err))
-    finally:
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
+    return run_node(BayesSwarmNode, args, name='bayes_swarm', fatal_errors=(BayesSwarmError,))
+
+
+if __name__ == '__main__':
+    raise SystemExit(main())

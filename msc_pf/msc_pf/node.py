@@ -26,12 +26,11 @@ import math
 from typing import Any
 
 import numpy as np
+from swarm_runtime.node_main import run_node
 from swarm_runtime.ros import (
-    ExternalShutdownException,
     Node,
     message_module,
     qos_profile_sensor_data,
-    rclpy,
 )
 
 from msc_pf import conversions
@@ -218,20 +217,10 @@ class MscPfNode(Node):
         self._cmd_pub.publish(conversions.twist_to_ros(speed, yaw_rate, _geometry))
 
 
-def main(args: list[str] | None = None) -> None:
+def main(args: list[str] | None = None) -> int:
     """Entry point of ``ros2 run msc_pf msc_pf_node``."""
-    rclpy.init(args=args)
-    node = None
-    try:
-        node = MscPfNode()
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
+    return run_node(MscPfNode, args, name='msc_pf', fatal_errors=(ConfigError,))
 
 
 if __name__ == '__main__':
-    main()
+    raise SystemExit(main())

@@ -23,14 +23,13 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
+from swarm_runtime.node_main import run_node
 from swarm_runtime.ros import (
-    ExternalShutdownException,
     Node,
     QoSDurabilityPolicy,
     QoSProfile,
     message_module,
     qos_profile_sensor_data,
-    rclpy,
 )
 
 from sim_bridge import conversions
@@ -333,25 +332,10 @@ class SimBridgeNode(Node):
         return any(ext.is_done() for ext in self.extensions)
 
 
-def main(args: list[str] | None = None) -> None:
+def main(args: list[str] | None = None) -> int:
     """Entry point of ``ros2 run sim_bridge sim_bridge``."""
-    rclpy.init(args=args)
-    node = None
-    try:
-        node = SimBridgeNode()
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    except SimBridgeError as err:
-        if node is None:
-            rclpy.logging.get_logger('sim_bridge').error(str(err))
-        else:
-            node.get_logger().error(str(err))
-    finally:
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
+    return run_node(SimBridgeNode, args, name='sim_bridge', fatal_errors=(SimBridgeError,))
 
 
 if __name__ == '__main__':
-    main()
+    raise SystemExit(main())
