@@ -19,7 +19,7 @@ bootstrap:
 demo: bootstrap
 	rm -rf $(OUT)
 	SWARM_RUNTIME=builtin $(VENV)/bin/spawn --site small --robots $(ROBOTS) --variant $(VARIANT) --seed $(SEED) \
-		--record $(OUT)/bag --out-dir $(OUT)
+		--record $(OUT)/bag --out $(OUT)
 
 # The whole suite on both ROS runtimes (docs/runtime.md): the built-in one, then real rclpy
 # on DDS where scripts/install_ros_wheels.sh could install it.

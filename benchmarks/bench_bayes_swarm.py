@@ -1,6 +1,6 @@
 """Bayes-Swarm-P benchmark: tau and decision time on the paper's cases, against the baselines.
 
-Runs the ROS-free batch simulator (:mod:`bayes_swarm.batch_sim`, the same planner objects the
+Runs the batch runner (:mod:`swarm_experiments.bayes_batch`, the same planner objects the
 ROS node uses) over seeded runs and prints one table row per experiment: runs, failures
 (never dropped), tau mean +- std over the successful runs, and the median compute time per
 decision of the robot that found the source (median over its decisions, the first trivial
@@ -44,10 +44,10 @@ from pathlib import Path  # noqa: E402
 from typing import Any  # noqa: E402
 
 import numpy as np  # noqa: E402
-from bayes_swarm.batch_sim import MissionSpec, run_mission  # noqa: E402
 from bayes_swarm.messages import DecisionKind  # noqa: E402
-from sim_bridge.signal_fields import avalanche_case, get_case  # noqa: E402
-from sim_bridge.spawn_bayes_swarm import batch_mission_spec  # noqa: E402
+from swarm_experiments.bayes_batch import MissionSpec, run_mission  # noqa: E402
+from swarm_experiments.spawn_bayes_swarm import batch_mission_spec  # noqa: E402
+from swarm_sim.signal_fields import avalanche_case, get_case  # noqa: E402
 
 EXPERIMENTS = (
     'main',

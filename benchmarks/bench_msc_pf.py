@@ -1,6 +1,6 @@
 """MSC + particle filter benchmark: capture completion time of the three schemes.
 
-Runs the ROS-free batch simulator (:mod:`sim_bridge.msc_pf_batch`, the same controller
+Runs the ROS-free batch simulator (:mod:`swarm_experiments.msc_pf_batch`, the same controller
 objects the ROS node runs) over seeded runs of the paper's scenario (2000 m x 2000 m field,
 targets uniform, robots starting in a 30 m disc at the centre, Table I parameters) and prints:
 
@@ -45,14 +45,14 @@ from msc_pf.parameters import config_from_parameters, parameter_defaults  # noqa
 from msc_pf.particle_filter import ParticleFilterBank, resolve_backend  # noqa: E402
 from msc_pf.schemes import Scheme  # noqa: E402
 from msc_pf.settings import MscPfConfig, ParticleFilterConfig, RadioConfig  # noqa: E402
-from sim_bridge.errors import ConfigurationError  # noqa: E402
-from sim_bridge.msc_pf_batch import (  # noqa: E402
+from swarm_experiments.msc_pf_batch import (  # noqa: E402
     BatchScenario,
     SearchCoverage,
     run_batch,
     search_coverage,
 )
-from sim_bridge.node_overrides import parse_overrides  # noqa: E402
+from swarm_experiments.node_overrides import parse_overrides  # noqa: E402
+from swarm_sim.errors import ConfigurationError  # noqa: E402
 
 SCHEMES = ('proposed', 'msc_pf', 'msc')
 CSV_HEADER = (
@@ -96,7 +96,7 @@ def controller_overrides(items: Sequence[str]) -> Overrides:
     """Controller settings from ``SECTION.FIELD=VALUE`` items, typed and checked.
 
     The names and the checks are those of the msc_pf node's parameters
-    (``sim_bridge.node_overrides``); ``scheme`` comes from ``--schemes``.
+    (``swarm_experiments.node_overrides``); ``scheme`` comes from ``--schemes``.
 
     Raises:
         ConfigurationError: a malformed item, an unknown name, ``scheme``, a value of the

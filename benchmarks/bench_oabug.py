@@ -4,7 +4,7 @@ Runs every (site, variant, departure) combination, one run per worker process at
 prints the mean +- std coverage beside the authors' simulator measured on this project's
 machines (REFERENCE_OABUG_SIM.md §5), plus CPU and wall seconds per run, robot-metres
 simulated per wall second and the projected time of the 1000-run Small sweep. ``--path
-batch`` (the default) runs each mission on the batch path (:mod:`sim_bridge.oabug_batch`:
+batch`` (the default) runs each mission on the batch path (:mod:`swarm_experiments.oabug_batch`:
 the same engine and OA-Bug controller without the runtime, equal trajectories); ``--path
 ros`` runs the full simulation (sim bridge + OA-Bug nodes on the built-in runtime). Example
 (the Small sweep of the closing note, 20 sites, both cores)::
@@ -116,7 +116,7 @@ REFERENCE: dict[tuple[str, int], ReferenceSweep] = {
 
 def reference_for(config: str, robots: int, actions: int | None) -> ReferenceSweep | None:
     """The authors' figures comparable with a sweep, or None (other robots or budget)."""
-    from sim_bridge.site_loading import site_budget_actions
+    from swarm_sim.site_loading import site_budget_actions
 
     if actions is not None and actions != site_budget_actions(config):
         return None
@@ -165,10 +165,10 @@ def quiet_garbage_collector() -> None:
 
 def run_job(job: Job) -> Outcome:
     """Run one job headless (called in a worker process)."""
-    from sim_bridge.oabug_batch import run_spawn_batch
-    from sim_bridge.spawn import SpawnConfig, run
+    from swarm_experiments.oabug_batch import run_spawn_batch
+    from swarm_experiments.spawn import SpawnSettings, run
 
-    config = SpawnConfig(
+    config = SpawnSettings(
         site=job.config,
         site_seed=job.site_seed,
         variant=job.variant,
@@ -391,8 +391,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         help='OA-Bug node parameters other than the defaults (e.g. gas_threshold=300)',
     )
     args = parser.parse_args(argv)
-    from sim_bridge.errors import ConfigurationError
-    from sim_bridge.spawn import oabug_parameter_overrides
+    from swarm_experiments.spawn import oabug_parameter_overrides
+    from swarm_sim.errors import ConfigurationError
 
     try:
         parameters = oabug_parameter_overrides(args.set)

@@ -28,7 +28,7 @@ from pathlib import Path
 
 import numpy as np
 from scipy import ndimage
-from sim_bridge.sites import PRESETS, Layout, generate_layout, layout_to_site
+from swarm_sim.sites import PRESETS, Layout, generate_layout, layout_to_site
 
 # The authors' generator, as measured: interior cells (min, median, max), doors per site
 # (corridor, inner), corridors (horizontal range, vertical range).

@@ -11,7 +11,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 PYTHON=${PYTHON:-python3}
 VENV=${VENV:-.venv}
-PACKAGES=(src/swarm_runtime src/swarm_analysis oabug_robot bayes_swarm msc_pf hw_drivers sim_bridge)
+PACKAGES=(swarm_common src/swarm_runtime src/swarm_analysis oabug_robot bayes_swarm msc_pf hw_drivers swarm_sim sim_bridge swarm_experiments)
 # Debian packages: the real ROS message parser and package.xml tools used by the tests.
 APT_PACKAGES=(python3-rosidl python3-catkin-pkg python3-ament-xmllint)
 

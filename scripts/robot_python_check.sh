@@ -6,7 +6,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 VENV=${VENV_ROBOT:-.venv-robot}
-ROBOT_PACKAGES=(src/swarm_runtime oabug_robot bayes_swarm msc_pf hw_drivers)
+ROBOT_PACKAGES=(swarm_common src/swarm_runtime oabug_robot bayes_swarm msc_pf hw_drivers)
 
 find_python() {
   if [ -n "${PYTHON_ROBOT:-}" ]; then echo "$PYTHON_ROBOT"; return; fi

@@ -23,38 +23,17 @@ setup(
         ('share/ament_index/resource_index/packages', [f'resource/{PACKAGE_NAME}']),
         (f'share/{PACKAGE_NAME}', ['package.xml']),
         *share_files('config'),
-        *share_files('config/sites'),
     ],
-    install_requires=[
-        'numpy',
-        'scipy',
-        'matplotlib',
-        'pybullet',
-        # The compiled lidar kernel (simulation only, like pybullet).
-        'numba',
-        'PyYAML',
-        'swarm_runtime',
-        'swarm_analysis',
-        # The spawners start these algorithm nodes.
-        'oabug_robot',
-        'bayes_swarm',
-        'msc_pf',
-    ],
+    install_requires=['numpy', 'swarm_common', 'swarm_runtime', 'swarm_sim'],
     zip_safe=True,
     maintainer='Swarm search maintainers',
     maintainer_email='maintainers@swarm-search.org',
     description=(
-        "pybullet simulation bridge publishing the robots' sensor topics, site generator "
-        'and layout importer, signal fields, and the launch-free spawner.'
+        'The sim bridge node: the simulator behind the sensor topics of the robots, /clock '
+        'and the ground truth, with the signal and RSSI mission extensions.'
     ),
     license='Apache-2.0',
     entry_points={
-        'console_scripts': [
-            'sim_bridge = sim_bridge.bridge_node:main',
-            'spawn = sim_bridge.spawn:main',
-            'spawn_bayes_swarm = sim_bridge.spawn_bayes_swarm:main',
-            'spawn_msc_pf = sim_bridge.spawn_msc_pf:main',
-            'site_tool = sim_bridge.sites.cli:main',
-        ],
+        'console_scripts': ['sim_bridge = sim_bridge.bridge_node:main'],
     },
 )

@@ -44,6 +44,9 @@ def test_workspace_has_the_documented_packages() -> None:
         'msc_pf',
         'oabug_robot',
         'sim_bridge',
+        'swarm_common',
+        'swarm_experiments',
+        'swarm_sim',
         'swarm_analysis',
         'swarm_runtime',
     }

@@ -9,6 +9,8 @@ import math
 from typing import Any
 
 import numpy as np
+from swarm_common.angles import yaw_from_unit_quaternion
+from swarm_common.stamps import stamp_from_seconds, stamp_to_seconds
 from swarm_runtime.ros import message_module
 
 from bayes_swarm.errors import ObservationError
@@ -30,18 +32,10 @@ _builtin = message_module('builtin_interfaces')
 _geometry = message_module('geometry_msgs')
 _swarm = message_module('swarm_interfaces')
 
-_NS_PER_S = 1_000_000_000
-
 
 def seconds_to_stamp(time_s: float) -> Any:
     """builtin_interfaces/Time for a non-negative time [s]."""
-    total_ns = round(time_s * _NS_PER_S)
-    return _builtin.Time(sec=int(total_ns // _NS_PER_S), nanosec=int(total_ns % _NS_PER_S))
-
-
-def stamp_to_seconds(stamp: Any) -> float:
-    """Seconds of a builtin_interfaces/Time."""
-    return float(stamp.sec) + float(stamp.nanosec) * 1e-9
+    return stamp_from_seconds(time_s, _builtin.Time)
 
 
 def _floats(values: np.ndarray) -> list[float]:
@@ -149,7 +143,7 @@ def odometry_to_pose(msg: Any) -> tuple[float, float, float]:
     """(x [m], y [m], yaw [rad]) of a nav_msgs/Odometry (planar yaw from the quaternion)."""
     p = msg.pose.pose.position
     q = msg.pose.pose.orientation
-    yaw = math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+    yaw = yaw_from_unit_quaternion(q.x, q.y, q.z, q.w)
     return float(p.x), float(p.y), yaw
 
 

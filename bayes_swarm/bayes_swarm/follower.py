@@ -10,14 +10,11 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from swarm_common.angles import wrap_angle
+
 from bayes_swarm.errors import ConfigError
 
 __all__ = ['FollowerConfig', 'VelocityCommand', 'WaypointFollower', 'wrap_angle']
-
-
-def wrap_angle(angle_rad: float) -> float:
-    """Angle wrapped to [-pi, pi) [rad]."""
-    return (angle_rad + math.pi) % (2.0 * math.pi) - math.pi
 
 
 @dataclass(frozen=True)

@@ -93,6 +93,12 @@ class BearingCollector:
         with self._lock:
             return {tag: now_s - seen_s for tag, seen_s in self.last_seen_s.items()}
 
+    @property
+    def pending(self) -> bool:
+        """True when a bearing waits to be taken."""
+        with self._lock:
+            return bool(self._pending)
+
     def take(self) -> list[PeerBearingData]:
         """Latest bearing of each tag heard since the previous call, sorted by tag id."""
         with self._lock:

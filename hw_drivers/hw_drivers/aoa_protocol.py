@@ -1,4 +1,4 @@
-"""Silicon Labs BG22 AoA locator reports: JSON stream framing and validation (HARDWARE.md §5).
+"""Silicon Labs BG22 AoA locator reports: JSON stream framing and validation.
 
 The locator host sends one JSON object per angle estimate over TCP: the authors' binary
 pretty-prints it over several lines and ends it with CR LF, a patched one may send compact
@@ -161,7 +161,7 @@ def _wrap_deg(angle_deg: float) -> float:
 
 
 def parse_angle_report(obj: Any) -> AngleReport | None:
-    """Validate one decoded JSON value (HARDWARE.md §5.4 canonical fields).
+    """Validate one decoded JSON value (the canonical fields).
 
     Returns None for objects of another ``type`` (the authors' server also carried
     "motion" and "olfactory" objects).
@@ -258,7 +258,7 @@ class AzimuthMapping:
 
     azimuth_rad = wrap(sign * radians(azimuth_deg) + offset_rad). The defaults assume the
     authors' convention (left positive) with the array's 0° facing forward; calibrate with a
-    tag at 0°, ±90° and 180° (HARDWARE.md §5.4, §9.5).
+    tag at 0°, ±90° and 180° (docs/hardware.md, first power-up checklist).
     """
 
     sign: int = 1

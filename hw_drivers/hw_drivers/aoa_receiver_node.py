@@ -34,6 +34,7 @@ from hw_drivers.node_common import (
     DeviceMonitor,
     DevicePoller,
     ParamSpec,
+    TimerGate,
     declare_parameter_table,
     publish_diagnostics,
     run_driver_node,
@@ -107,7 +108,9 @@ class AoaReceiverNode(Node):
             'aoa', self._listen, backoff=BackoffConfig(), clock=self._device_clock
         )
         self._poller = DevicePoller(self, worker, threaded=threaded)
-        self.create_timer(1.0 / float(values['publish_rate_hz']), self._publish_bearings)
+        self._bearing_gate = TimerGate(
+            self.create_timer(1.0 / float(values['publish_rate_hz']), self._publish_bearings)
+        )
         self.create_timer(1.0, self._publish_diagnostics)
 
     def _listen(self) -> LocatorServer:
@@ -120,7 +123,6 @@ class AoaReceiverNode(Node):
             max_buffer_bytes=self._max_buffer_bytes,
             select_timeout_s=select_timeout_s,
         )
-        self.get_logger().info(f'waiting for the AoA locator on {self._host}:{self.server.port}')
         return self.server
 
     def _on_report(self, report: AngleReport) -> None:
@@ -152,6 +154,7 @@ class AoaReceiverNode(Node):
             'old_reports': str(collector.sequence_filter.old),
         }
         note = None
+        state = ''
         if server is not None:
             extra.update(
                 {
@@ -163,12 +166,19 @@ class AoaReceiverNode(Node):
                     'buffer_overflows': str(server.decoder.overflows),
                 }
             )
-            if not server.client_connected:
-                note = (DiagnosticLevel.WARN, 'AoA locator not connected')
+            listening = f'listening on {self._host}:{server.port}'
+            if server.client_connected:
+                state = f'locator connected ({listening})'
+            else:
+                state = f'locator not connected ({listening})'
+                note = (DiagnosticLevel.WARN, f'AoA {state}')
         for tag, age_s in sorted(collector.ages_s(self._device_clock()).items()):
             extra[f'tag {tag} age_s'] = f'{age_s:.1f}'
-        entry = self._monitor.entry(now_ns, self._poller.worker, extra, note=note)
+        entry = self._monitor.entry(now_ns, self._poller.worker, extra, note=note, state=state)
         publish_diagnostics(self._diag_pub, [entry], now_ns)
+        self._bearing_gate.update(
+            (server is not None and server.client_connected) or self._collector.pending
+        )
 
     def destroy_node(self) -> None:
         """Close the server before the node goes."""
@@ -187,7 +197,9 @@ def _is_loopback(host: str) -> bool:
 
 def main(args: list[str] | None = None) -> None:
     """Entry point of ``ros2 run hw_drivers aoa_receiver_node``."""
-    run_driver_node(AoaReceiverNode, 'aoa_receiver_node', args)
+    run_driver_node(
+        AoaReceiverNode, 'aoa_receiver_node', args, summary=__doc__ or '', parameters=PARAMETERS
+    )
 
 
 if __name__ == '__main__':

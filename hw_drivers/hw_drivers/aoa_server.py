@@ -1,4 +1,4 @@
-"""The TCP server the AoA locator host connects to (HARDWARE.md §5.3, §5.4, §7.4).
+"""The TCP server the AoA locator host connects to.
 
 The authors' locator binary is a TCP *client* that exits when it cannot connect, so this
 side listens (on 127.0.0.1 by default) before the locator starts. One client at a time: a new

@@ -14,8 +14,8 @@ class BackoffConfig:
     """Delays between reconnect attempts.
 
     Attributes:
-        initial_s: delay after the first failure [s] (HARDWARE.md §7: 1 s).
-        max_s: ceiling of the delay [s] (HARDWARE.md §7: 5 s).
+        initial_s: delay after the first failure [s] (1 s).
+        max_s: ceiling of the delay [s] (5 s).
         factor: growth of the delay after each further failure.
         fatal_s: delay after a fatal error (wrong chip, permissions) [s].
     """

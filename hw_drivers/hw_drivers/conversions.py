@@ -17,6 +17,8 @@ from typing import Any
 
 import numpy as np
 import numpy.typing as npt
+from swarm_common.angles import yaw_to_quaternion
+from swarm_common.stamps import stamp_from_ns as _stamp_from_ns
 from swarm_runtime.ros import message_module
 
 from hw_drivers.aoa_bearings import PeerBearingData
@@ -58,8 +60,7 @@ LEVEL_VARIANCE_RAD_SQ = math.radians(2.0) ** 2
 
 def stamp_from_ns(stamp_ns: int) -> Any:
     """builtin_interfaces/Time of a node-clock time in nanoseconds."""
-    stamp_ns = max(int(stamp_ns), 0)
-    return _builtin.Time(sec=stamp_ns // 1_000_000_000, nanosec=stamp_ns % 1_000_000_000)
+    return _stamp_from_ns(max(int(stamp_ns), 0), _builtin.Time)
 
 
 def _header(stamp_ns: int, frame_id: str) -> Any:
@@ -90,12 +91,6 @@ def scan_to_ros(
         ranges=array.array('f', np.asarray(ranges_m, dtype=np.float32).tobytes()),
         intensities=array.array('f', np.asarray(intensities, dtype=np.float32).tobytes()),
     )
-
-
-def yaw_to_quaternion(yaw_rad: float) -> tuple[float, float, float, float]:
-    """(x, y, z, w) of a rotation by ``yaw_rad`` about z."""
-    half = 0.5 * yaw_rad
-    return 0.0, 0.0, math.sin(half), math.cos(half)
 
 
 def _diagonal(xx: float, yy: float, zz: float) -> list[float]:

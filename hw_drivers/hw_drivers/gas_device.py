@@ -1,4 +1,4 @@
-"""MP503 gas sensor I/O: three ADC backends behind one interface (HARDWARE.md §1.3, §4, §7.3).
+"""MP503 gas sensor I/O: three ADC backends behind one interface.
 
 * :class:`AdsGasBackend`: TI ADS1115/ADS1015 on I2C, single-shot conversions, averaged.
 * :class:`GroveHatGasBackend`: the Seeed Grove Base Hat's ratio register.

@@ -42,6 +42,7 @@ from hw_drivers.node_common import (
     DeviceMonitor,
     DevicePoller,
     ParamSpec,
+    TimerGate,
     declare_parameter_table,
     no_sleep,
     publish_diagnostics,
@@ -135,7 +136,7 @@ class GasNode(Node):
             'gas', self._connect, backoff=BackoffConfig(), clock=self._device_clock
         )
         self._poller = DevicePoller(self, worker, threaded=self._threaded)
-        self.create_timer(0.5 / self._rate_hz, self._publish_samples)
+        self._sample_gate = TimerGate(self.create_timer(0.5 / self._rate_hz, self._publish_samples))
         self.create_timer(1.0, self._publish_diagnostics)
 
     def _open_bus(self) -> SMBusLike:
@@ -215,6 +216,7 @@ class GasNode(Node):
             extra = {'skipped_replies': str(self._session.skipped)}
         entry = self._monitor.entry(now_ns, self._poller.worker, extra, note=note)
         publish_diagnostics(self._diag_pub, [entry], now_ns)
+        self._sample_gate.update(self._poller.worker.connected or bool(self._samples))
 
     def destroy_node(self) -> None:
         """Stop the device loop and close the ADC before the node goes."""
@@ -224,7 +226,7 @@ class GasNode(Node):
 
 def main(args: list[str] | None = None) -> None:
     """Entry point of ``ros2 run hw_drivers gas_adc_node``."""
-    run_driver_node(GasNode, 'gas_adc_node', args)
+    run_driver_node(GasNode, 'gas_adc_node', args, summary=__doc__ or '', parameters=PARAMETERS)
 
 
 if __name__ == '__main__':

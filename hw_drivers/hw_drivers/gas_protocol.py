@@ -1,6 +1,6 @@
 """MP503 gas sensor readout: ADC register codecs and the gas microcontroller's JSON replies.
 
-Pure functions only (HARDWARE.md §1.3, §4): the TI ADS1115/ADS1015 config and conversion
+Pure functions only: the TI ADS1115/ADS1015 config and conversion
 registers (16-bit, big-endian), the Seeed Grove Base Hat's registers (16-bit little-endian
 SMBus words), the Seeed XIAO M0 firmware's JSON reply, and the mapping of a voltage onto the
 paper's 10-bit scale (``raw10 = 1023 * V_signal / V_supply``).

@@ -1,4 +1,4 @@
-"""Yaw from a z gyro: start-up bias calibration and integration (HARDWARE.md §3.5, §3.6).
+"""Yaw from a z gyro: start-up bias calibration and integration.
 
 Pure numerics, no device: fed with (time, rate) pairs by the MPU6050 session.
 """
@@ -147,7 +147,7 @@ class YawIntegrator:
 
 @dataclass(frozen=True)
 class ZuptConfig:
-    """Zero-velocity bias tracking (HARDWARE.md §3.5): while the robot is commanded to stand
+    """Zero-velocity bias tracking : while the robot is commanded to stand
     still, the gyro-Z bias slowly follows the measured rate, removing warm-up drift.
 
     Attributes:

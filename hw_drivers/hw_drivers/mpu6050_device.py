@@ -1,4 +1,4 @@
-"""MPU6050 device I/O and the heading session (HARDWARE.md §3, §7.2).
+"""MPU6050 device I/O and the heading session.
 
 :class:`Mpu6050` initialises and reads the chip over an injected SMBus. :class:`ImuSession`
 polls it at a fixed rate: bounded retries per cycle, detection of stuck data and brown-outs

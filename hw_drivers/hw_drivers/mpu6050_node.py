@@ -38,6 +38,7 @@ from hw_drivers.node_common import (
     DeviceMonitor,
     DevicePoller,
     ParamSpec,
+    TimerGate,
     declare_parameter_table,
     no_sleep,
     publish_diagnostics,
@@ -139,7 +140,9 @@ class Mpu6050Node(Node):
         self._poller = DevicePoller(
             self, worker, threaded=self._threaded, poll_period_s=1.0 / self._rate_hz
         )
-        self.create_timer(1.0 / self._rate_hz, self._publish_readings)
+        self._reading_gate = TimerGate(
+            self.create_timer(1.0 / self._rate_hz, self._publish_readings)
+        )
         self.create_timer(1.0, self._publish_diagnostics)
 
     def _on_cmd_vel(self, msg: Any) -> None:
@@ -202,6 +205,7 @@ class Mpu6050Node(Node):
             extra['saturations'] = str(self._session.saturations)
         entry = self._monitor.entry(now_ns, self._poller.worker, extra, quiet_reason=quiet_reason)
         publish_diagnostics(self._diag_pub, [entry], now_ns)
+        self._reading_gate.update(self._poller.worker.connected or bool(self._readings))
 
     def destroy_node(self) -> None:
         """Stop the device loop and close the bus before the node goes."""
@@ -211,7 +215,7 @@ class Mpu6050Node(Node):
 
 def main(args: list[str] | None = None) -> None:
     """Entry point of ``ros2 run hw_drivers mpu6050_node``."""
-    run_driver_node(Mpu6050Node, 'mpu6050_node', args)
+    run_driver_node(Mpu6050Node, 'mpu6050_node', args, summary=__doc__ or '', parameters=PARAMETERS)
 
 
 if __name__ == '__main__':

@@ -1,4 +1,4 @@
-"""Pump safety logic, independent of the GPIO (HARDWARE.md §6.4, §7.5).
+"""Pump safety logic, independent of the GPIO.
 
 The ``pump`` topic carries the level the controller wants (OA-Bug publishes its duty cycle
 on every control tick). :class:`PumpController` decides the actual output and enforces, on

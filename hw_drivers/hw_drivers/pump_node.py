@@ -6,9 +6,11 @@ are older than ``command_timeout_s``, at most ``max_on_s`` per pulse, at least `
 between pulses. Besides the 50 Hz control timer, every pulse arms an independent
 ``threading.Timer`` that forces the line off after ``max_on_s`` even if the executor stalls.
 
-The line goes off on every exit path Python can see: normal shutdown (``destroy_node``),
-KeyboardInterrupt/ExternalShutdownException, SIGTERM and SIGINT (handlers turn the line off
-first), an exception in a callback, and ``atexit``. SIGKILL and power loss cannot be caught:
+A missing or failing GPIO is not fatal: the pump stays off, /diagnostics says why, and the
+line is requested again with back-off. The line goes off on every exit path Python can see:
+normal shutdown (``destroy_node``), KeyboardInterrupt/ExternalShutdownException, SIGTERM and
+SIGINT (handlers turn the line off first), an exception in a callback, and ``atexit``.
+SIGKILL and power loss cannot be caught:
 the hardware gate pull-down and the systemd ``ExecStopPost=`` line (docs/hardware.md) cover
 those.
 
@@ -23,20 +25,26 @@ from __future__ import annotations
 import atexit
 import signal
 import threading
+import time
 from collections.abc import Callable
 from types import FrameType
 from typing import Any
 
 from swarm_runtime.ros import ExternalShutdownException, Node, message_module, rclpy
 
+from hw_drivers.backoff import Backoff, BackoffConfig
 from hw_drivers.conversions import DiagnosticEntry, pump_state_to_ros
-from hw_drivers.errors import FatalDeviceError
+from hw_drivers.errors import FatalDeviceError, HwDriverError
 from hw_drivers.fakes.gpio import FakePumpOutput
 from hw_drivers.node_common import (
     DIAGNOSTICS_TOPIC,
     ParamSpec,
+    StatusLog,
+    TimerGate,
     declare_parameter_table,
     publish_diagnostics,
+    spin_node,
+    start_driver_process,
 )
 from hw_drivers.pump_control import PumpController, PumpLimits
 from hw_drivers.pump_output import GpiodPumpOutput, PumpOutput, SafePumpLine, parse_line_id
@@ -62,16 +70,27 @@ PARAMETERS: list[ParamSpec] = [
 class PumpNode(Node):
     """Subscribes ``pump``; drives the GPIO within the safety limits.
 
+    The line is requested at start; if that fails (no chip, line busy, no permission) the
+    node keeps running with the pump off, reports the fault on /diagnostics and requests the
+    line again with back-off (1, 2, 4, 5 ... s; 30 s after a fatal error such as a busy
+    line), like the sensor drivers. A line that fails while in use is driven off (as far as
+    it still can be), released and requested again the same way.
+
     Args:
         output: the pump line to drive (tests pass a fake; by default the GPIO from the
             parameters, or a simulated line with ``fake_device``).
-
-    Raises:
-        FatalDeviceError: the GPIO line cannot be requested (busy, permissions, no such line):
-            the node refuses to start rather than run blind.
+        open_output: opens the line; overrides ``output`` and the parameters (tests).
+        retry_clock: monotonic clock [s] of the reopen back-off; injectable for tests.
     """
 
-    def __init__(self, *, output: PumpOutput | None = None, **kwargs: Any) -> None:
+    def __init__(
+        self,
+        *,
+        output: PumpOutput | None = None,
+        open_output: Callable[[], PumpOutput] | None = None,
+        retry_clock: Callable[[], float] = time.monotonic,
+        **kwargs: Any,
+    ) -> None:
         super().__init__('pump_node', **kwargs)
         values = declare_parameter_table(self, PARAMETERS)
         self._limits = PumpLimits(
@@ -80,33 +99,85 @@ class PumpNode(Node):
             command_timeout_s=float(values['command_timeout_s']),
         )
         self._controller = PumpController(self._limits)
-        if output is None:
-            if values['fake_device']:
-                output = FakePumpOutput()
+        if open_output is None:
+            if output is not None:
+                given = output
+
+                def open_output() -> PumpOutput:
+                    return given
+            elif values['fake_device']:
+                open_output = FakePumpOutput
             else:
-                output = GpiodPumpOutput(
-                    str(values['chip']),
-                    parse_line_id(str(values['line'])),
-                    active_low=bool(values['active_low']),
-                )
-        self.line = SafePumpLine(output)
-        self._hardware_id = f'{values["chip"]} {values["line"]}'
+                chip, line = str(values['chip']), parse_line_id(str(values['line']))
+                active_low = bool(values['active_low'])
+
+                def open_output() -> PumpOutput:
+                    return GpiodPumpOutput(chip, line, active_low=active_low)
+
+        self._open_output = open_output
+        self._hardware_id = (
+            'fake' if values['fake_device'] else f'{values["chip"]} {values["line"]}'
+        )
+        self.line: SafePumpLine | None = None
+        self._backoff = Backoff(BackoffConfig())
+        self._retry_clock = retry_clock
+        self._next_open_s = retry_clock()
+        self._line_error = ''
+        self._line_fatal = False
+        self.line_failures = 0
         self._guard: threading.Timer | None = None
         self._guard_lock = threading.Lock()
         self.guard_trips = 0
         self._guard_tripped = False
-        self._last_logged: tuple[DiagnosticLevel, str] | None = None
-        atexit.register(self.line.close)
+        self._log = StatusLog(self.get_logger())
+        self._shut_down = False
+        atexit.register(self.shutdown_pump)
         self._state_pub = self.create_publisher(std_msgs.Bool, 'pump/state', 10)
         self._diag_pub = self.create_publisher(
             diagnostic_msgs.DiagnosticArray, DIAGNOSTICS_TOPIC, 10
         )
         self.create_subscription(std_msgs.Bool, 'pump', self._on_command, 10)
-        self.create_timer(1.0 / float(values['control_rate_hz']), self._on_timer)
+        self._control_gate = TimerGate(
+            self.create_timer(1.0 / float(values['control_rate_hz']), self._on_timer)
+        )
         self.create_timer(1.0, self._publish_diagnostics)
+        self._try_open()
+
+    @property
+    def line_available(self) -> bool:
+        """True while the GPIO line is held."""
+        return self.line is not None
 
     def _now_s(self) -> float:
         return self.get_clock().now().nanoseconds * 1e-9
+
+    def _try_open(self) -> None:
+        """Request the line if it is not held and a retry is due; the pump starts off."""
+        if self.line is not None or self._shut_down or self._retry_clock() < self._next_open_s:
+            self._control_gate.update(self.line is not None)
+            return
+        try:
+            output = self._open_output()
+        except (HwDriverError, OSError) as err:
+            self._line_failed(err)
+            return
+        self.line = SafePumpLine(output)  # requested with the inactive level: pump off
+        self._backoff.reset()
+        self._line_error = ''
+        self._control_gate.update(True)
+
+    def _line_failed(self, err: BaseException) -> None:
+        """The line cannot be requested or driven: pump off, release, retry later."""
+        self.line_failures += 1
+        line, self.line = self.line, None
+        if line is not None:
+            line.close()
+        self._controller.force_off(self._now_s())
+        self._line_fatal = isinstance(err, FatalDeviceError)
+        delay_s = self._backoff.next_delay_s(fatal=self._line_fatal)
+        self._next_open_s = self._retry_clock() + delay_s
+        self._line_error = f'{err}; retrying in {delay_s:.0f} s'
+        self._control_gate.update(False)
 
     def _on_command(self, msg: Any) -> None:
         self._apply(lambda now_s: self._controller.command(bool(msg.data), now_s))
@@ -116,16 +187,25 @@ class PumpNode(Node):
 
     def _apply(self, decide: Callable[[float], bool]) -> None:
         """Decide and drive the line; on any exception the pump goes off first."""
-        was_on = self.line.is_on
+        line = self.line
+        if line is None:
+            # No line: whatever is commanded, the pump stays off (and a command cannot
+            # switch it on the moment the line comes back).
+            self._controller.force_off(self._now_s())
+            return
+        was_on = line.is_on
         try:
             on = decide(self._now_s())
             if not on:
                 self._guard_tripped = False
             # After a guard trip the line stays off until the controller itself says off.
             on = on and not self._guard_tripped
-            self.line.set(on)
+            line.set(on)
+        except (HwDriverError, OSError) as err:
+            self._line_failed(err)
+            on = False
         except BaseException:
-            self.line.off()
+            line.off()
             self._controller.force_off(self._now_s())
             raise
         if on and not was_on:
@@ -143,41 +223,60 @@ class PumpNode(Node):
 
     def _guard_trip(self) -> None:
         """Runs in the guard thread if a pulse outlives max_on_s in wall time."""
-        if self.line.is_on:
+        line = self.line
+        if line is not None and line.is_on:
             self.guard_trips += 1
             self._guard_tripped = True
-            self.line.off()
+            line.off()
 
     def shutdown_pump(self) -> None:
         """Pump off and line released; safe to call from any exit path, repeatedly."""
-        self.line.close()
+        self._shut_down = True
+        line = self.line
+        if line is not None:
+            line.close()
         with self._guard_lock:
             if self._guard is not None:
                 self._guard.cancel()
 
-    def _publish_diagnostics(self) -> None:
-        """Once a second: diagnostics, and the pump state again for late subscribers."""
-        now_ns = self.get_clock().now().nanoseconds
-        self._state_pub.publish(pump_state_to_ros(self.line.is_on))
+    def _status(self) -> tuple[DiagnosticLevel, str, dict[str, str]]:
         controller = self._controller
-        level, message = DiagnosticLevel.OK, 'pump on' if self.line.is_on else 'pump off'
-        if self.line.off_failures:
-            level, message = DiagnosticLevel.ERROR, 'failed to drive the pump line off'
-        elif controller.forced_stops or self.guard_trips:
-            level, message = DiagnosticLevel.WARN, 'pulses were cut at max_on_s'
         values = {
             'pulses': str(controller.pulses),
             'forced_stops': str(controller.forced_stops),
             'stale_command_stops': str(controller.stale_stops),
             'guard_trips': str(self.guard_trips),
-            'off_failures': str(self.line.off_failures),
+            'line_failures': str(self.line_failures),
         }
+        line = self.line
+        if line is None:
+            kind = 'fatal error' if self._line_fatal else 'error'
+            return (
+                DiagnosticLevel.ERROR,
+                f'pump line unavailable ({kind}): {self._line_error}',
+                values,
+            )
+        values['off_failures'] = str(line.off_failures)
+        if line.off_failures:
+            return DiagnosticLevel.ERROR, 'failed to drive the pump line off', values
+        if controller.forced_stops or self.guard_trips:
+            return DiagnosticLevel.WARN, 'pulses were cut at max_on_s', values
+        return DiagnosticLevel.OK, 'pump on' if line.is_on else 'pump off', values
+
+    def _publish_diagnostics(self) -> None:
+        """Once a second: retry the line, diagnostics, and the pump state for late joiners."""
+        self._try_open()
+        now_ns = self.get_clock().now().nanoseconds
+        self._state_pub.publish(pump_state_to_ros(self.line is not None and self.line.is_on))
+        level, message, values = self._status()
         entry = DiagnosticEntry(
             f'{self.get_fully_qualified_name()}: pump', self._hardware_id, level, message, values
         )
-        if (level, message) != self._last_logged and level != DiagnosticLevel.OK:
-            self.get_logger().warning(message)
-        self._last_logged = (level, message)
+        # 'pump on'/'pump off' alternate with every pulse: log only the other states.
+        if level != DiagnosticLevel.OK:
+            self._log.report(level, message.split(';')[0], message)
+        else:
+            self._log.report(level, 'ok', 'pump line ready, pump off')
         publish_diagnostics(self._diag_pub, [entry], now_ns)
 
     def destroy_node(self) -> None:
@@ -207,17 +306,18 @@ def install_signal_handlers(turn_off: Callable[[], None]) -> None:
 
 def main(args: list[str] | None = None) -> None:
     """Entry point of ``ros2 run hw_drivers pump_node``."""
+    start_driver_process('pump_node', args, summary=__doc__ or '', parameters=PARAMETERS)
     rclpy.init(args=args)
     node = None
     try:
         node = PumpNode()
         install_signal_handlers(node.shutdown_pump)
-        rclpy.spin(node)
+        spin_node(node)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
-    except FatalDeviceError as err:
-        rclpy.logging.get_logger('pump_node').fatal(str(err))
-        raise SystemExit(1) from err
+    except FatalDeviceError as err:  # invalid parameters (ConfigurationError)
+        rclpy.logging.get_logger('pump_node').fatal(f'invalid parameters: {err}')
+        raise SystemExit(2) from None
     finally:
         if node is not None:
             node.shutdown_pump()

@@ -12,7 +12,7 @@ import errno
 import threading
 from typing import Protocol
 
-from hw_drivers.errors import FatalDeviceError
+from hw_drivers.errors import DeviceUnavailableError, FatalDeviceError
 
 __all__ = ['GpiodPumpOutput', 'PumpOutput', 'SafePumpLine', 'parse_line_id']
 
@@ -45,8 +45,10 @@ class GpiodPumpOutput:
         consumer: label shown by gpioinfo.
 
     Raises:
-        FatalDeviceError: the chip or line does not exist, is busy (EBUSY: another process
-            holds it) or access is denied; the pump must not run blind.
+        DeviceUnavailableError: the chip does not exist (not plugged, wrong path): the node
+            retries with back-off and keeps the pump off meanwhile.
+        FatalDeviceError: the line does not exist, is busy (EBUSY: another process holds
+            it), access is denied or the bindings are missing: retried only slowly.
     """
 
     def __init__(
@@ -75,6 +77,8 @@ class GpiodPumpOutput:
         except PermissionError as err:
             msg = f'permission denied on {chip_path} (add the service user to group gpio): {err}'
             raise FatalDeviceError(msg) from err
+        except FileNotFoundError as err:
+            raise DeviceUnavailableError(f'no GPIO chip {chip_path}: {err}') from err
         except OSError as err:
             reason = 'busy (held by another process)' if err.errno == errno.EBUSY else str(err)
             raise FatalDeviceError(f'cannot request {chip_path} line {line}: {reason}') from err

@@ -1,4 +1,4 @@
-"""RPLidar A1 device I/O: the request/response sequence and the scan session (HARDWARE.md §2, §7.1).
+"""RPLidar A1 device I/O: the request/response sequence and the scan session.
 
 :class:`RPLidar` speaks the protocol over an injected :class:`SerialPort` with an injected
 motor strategy and sleep function. :class:`RPLidarSession` is what the reconnecting
@@ -63,7 +63,7 @@ class DtrMotorControl:
     """A1 motor through the adapter's DTR line.
 
     Slamtec's SDK runs the motor with DTR de-asserted (``motor_on_dtr=False``); some adapter
-    revisions are reported the other way round, hence the parameter (HARDWARE.md §2.1, §9.1).
+    revisions are reported the other way round, hence the parameter.
     A pty has no DTR line (ENOTTY): that is tolerated so the driver runs against fakes.
     """
 

@@ -31,6 +31,7 @@ from hw_drivers.node_common import (
     DeviceMonitor,
     DevicePoller,
     ParamSpec,
+    TimerGate,
     declare_parameter_table,
     no_sleep,
     publish_diagnostics,
@@ -105,6 +106,7 @@ class RPLidarNode(Node):
         self._revolutions: deque[Revolution] = deque(maxlen=2)
         self._fake = FakeRPLidar() if values['fake_device'] else None
         self._session: RPLidarSession | None = None
+        self._connected_note = ''
         self._scan_pub = self.create_publisher(
             sensor_msgs.LaserScan, 'scan', qos_profile_sensor_data
         )
@@ -122,7 +124,9 @@ class RPLidarNode(Node):
             'lidar', self._connect, backoff=BackoffConfig(), clock=self._device_clock
         )
         self._poller = DevicePoller(self, worker, threaded=threaded)
-        self.create_timer(1.0 / float(values['publish_rate_hz']), self._publish_scans)
+        self._scan_gate = TimerGate(
+            self.create_timer(1.0 / float(values['publish_rate_hz']), self._publish_scans)
+        )
         self.create_timer(1.0, self._publish_diagnostics)
 
     def _connect(self) -> RPLidarSession:
@@ -143,9 +147,11 @@ class RPLidarNode(Node):
             sleep=sleep,
             clock=self._device_clock,
         )
-        self.get_logger().info(
-            f'lidar model {self._session.info.model} firmware {self._session.info.firmware}'
-            f' hardware {self._session.info.hardware} serial {self._session.info.serial_number}'
+        info = self._session.info
+        # Logged from the diagnostics timer: this runs in the device thread.
+        self._connected_note = (
+            f'lidar model {info.model} firmware {info.firmware} hardware {info.hardware}'
+            f' serial {info.serial_number}'
         )
         return self._session
 
@@ -168,6 +174,9 @@ class RPLidarNode(Node):
 
     def _publish_diagnostics(self) -> None:
         now_ns = self.get_clock().now().nanoseconds
+        if self._connected_note:
+            note, self._connected_note = self._connected_note, ''
+            self.get_logger().info(note)
         extra: dict[str, str] = {}
         session = self._session
         if session is not None:
@@ -185,6 +194,7 @@ class RPLidarNode(Node):
             note = (DiagnosticLevel.WARN, f'lidar reports health Warning (code 0x{code:04X})')
         entry = self._monitor.entry(now_ns, self._poller.worker, extra, note=note)
         publish_diagnostics(self._diag_pub, [entry], now_ns)
+        self._scan_gate.update(self._poller.worker.connected or bool(self._revolutions))
 
     def destroy_node(self) -> None:
         """Stop the device loop (STOP, motor off, close) before the node goes."""
@@ -194,7 +204,7 @@ class RPLidarNode(Node):
 
 def main(args: list[str] | None = None) -> None:
     """Entry point of ``ros2 run hw_drivers rplidar_node``."""
-    run_driver_node(RPLidarNode, 'rplidar_node', args)
+    run_driver_node(RPLidarNode, 'rplidar_node', args, summary=__doc__ or '', parameters=PARAMETERS)
 
 
 if __name__ == '__main__':

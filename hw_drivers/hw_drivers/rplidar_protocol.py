@@ -1,10 +1,12 @@
-"""Slamtec RPLidar A1 serial protocol: pure encode/decode functions (HARDWARE.md §2).
+"""Slamtec RPLidar A1 serial protocol: pure encode/decode functions.
 
 Nothing here touches a port. Requests are bytes, responses are decoded into frozen
 dataclasses, and the endless scan stream is decoded incrementally by
-:class:`SampleStreamDecoder`, which validates every 5-byte sample (S != !S, C == 1, angle
-below 360°) and resynchronises byte by byte after garbage. :class:`RevolutionAssembler` cuts
-the samples into 360° revolutions and :func:`bin_revolution` maps one revolution onto fixed
+:class:`SampleStreamDecoder`, which accepts a 5-byte sample only inside a run of consistent
+samples (check bits S != !S and C == 1, angle below 360°, small angle steps from sample to
+sample, plausible ends) and resynchronises byte by byte after garbage.
+:class:`RevolutionAssembler` cuts the samples into 360° revolutions by the rotation swept
+since the last start flag, and :func:`bin_revolution` maps one revolution onto fixed
 LaserScan bins in the REP 103 convention.
 """
 
@@ -28,6 +30,7 @@ __all__ = [
     'DeviceInfo',
     'Health',
     'HealthStatus',
+    'ResyncConfig',
     'Revolution',
     'RevolutionAssembler',
     'SampleStreamDecoder',
@@ -49,11 +52,10 @@ DESCRIPTOR_SIZE = 7
 SAMPLE_SIZE = 5
 ANGLE_Q6_FULL_TURN = 360 * 64
 _EMPTY = np.zeros(0, dtype=np.uint8)
-_RESYNC_WINDOW = 64
 
 
 class Command(IntEnum):
-    """Request command bytes (HARDWARE.md §2.2)."""
+    """Request command bytes."""
 
     STOP = 0x25
     RESET = 0x40
@@ -208,16 +210,66 @@ class ScanSamples:
         return int(self.start.shape[0])
 
 
-def _valid_offsets(buf: npt.NDArray[np.uint8]) -> npt.NDArray[np.bool_]:
-    """For each offset i with 5 bytes left, whether buf[i:i+5] is a plausible sample."""
+@dataclass(frozen=True)
+class ResyncConfig:
+    """How the scan decoder tells samples from junk (see :class:`SampleStreamDecoder`).
+
+    Attributes:
+        min_run: consecutive consistent samples needed to accept a stretch of the stream
+            after junk or at the start; a single window that passes the check bits is not
+            enough.
+        max_angle_step_deg: largest angle change between consecutive samples, either way
+            [deg]. The A1 steps about 1-2 deg per sample; samples without a return (distance
+            0) may sit several degrees ahead of their neighbours.
+        edge_distance_rel: a sample at the end of a consistent run (next to junk) with a
+            return must be within this fraction of the nearest return in the run...
+        edge_distance_abs_mm: ...or within this many millimetres [mm].
+        edge_quality_step: ...and its quality within this many steps of that return's.
+        edge_reference_samples: how far into the run that nearest return is looked for.
+        compare_samples: after junk, the runs starting at ``compare_offsets`` consecutive
+            offsets are compared over this many samples and the longest is taken...
+        compare_offsets: ...from the first offset where a run starts on.
+    """
+
+    min_run: int = 4
+    max_angle_step_deg: float = 15.0
+    edge_distance_rel: float = 0.25
+    edge_distance_abs_mm: float = 150.0
+    edge_quality_step: int = 24
+    edge_reference_samples: int = 3
+    compare_samples: int = 8
+    compare_offsets: int = 15
+
+    def __post_init__(self) -> None:
+        if self.min_run < 3:
+            raise ConfigurationError(f'min_run must be >= 3, got {self.min_run}')
+        if not 0.0 < self.max_angle_step_deg < 180.0:
+            msg = f'max_angle_step_deg must be in (0, 180), got {self.max_angle_step_deg}'
+            raise ConfigurationError(msg)
+        if self.edge_distance_rel < 0.0 or self.edge_distance_abs_mm < 0.0:
+            raise ConfigurationError('edge distance tolerances must be >= 0')
+        if self.compare_offsets < SAMPLE_SIZE:
+            msg = f'compare_offsets must be >= {SAMPLE_SIZE}, got {self.compare_offsets}'
+            raise ConfigurationError(msg)
+        if self.compare_samples < self.min_run:
+            msg = f'compare_samples must be >= min_run, got {self.compare_samples}'
+            raise ConfigurationError(msg)
+        if self.edge_quality_step < 0 or self.edge_reference_samples < 1:
+            raise ConfigurationError('edge_quality_step must be >= 0, edge_reference_samples >= 1')
+
+
+def _window_fields(
+    buf: npt.NDArray[np.uint8],
+) -> tuple[npt.NDArray[np.bool_], npt.NDArray[np.int64]]:
+    """For each offset with 5 bytes left: do the check bits pass, and the angle_q6 there."""
     n = buf.shape[0] - SAMPLE_SIZE + 1
     if n <= 0:
-        return np.zeros(0, dtype=bool)
+        return np.zeros(0, dtype=bool), np.zeros(0, dtype=np.int64)
     b0 = buf[:n]
     b1 = buf[1 : n + 1]
-    b2 = buf[2 : n + 2].astype(np.uint16)
-    angle_q6 = (b1 >> 1).astype(np.uint16) | (b2 << 7)
-    return ((b0 & 1) != ((b0 >> 1) & 1)) & ((b1 & 1) == 1) & (angle_q6 < ANGLE_Q6_FULL_TURN)
+    angle_q6 = (b1 >> 1).astype(np.int64) | (buf[2 : n + 2].astype(np.int64) << 7)
+    valid = ((b0 & 1) != ((b0 >> 1) & 1)) & ((b1 & 1) == 1) & (angle_q6 < ANGLE_Q6_FULL_TURN)
+    return valid, angle_q6
 
 
 def decode_samples(frames: npt.NDArray[np.uint8]) -> ScanSamples:
@@ -234,55 +286,224 @@ def decode_samples(frames: npt.NDArray[np.uint8]) -> ScanSamples:
     )
 
 
-class SampleStreamDecoder:
-    """Incremental decoder of the standard scan stream with byte-wise resynchronisation.
+def _frame_distance_mm(frame: npt.NDArray[np.uint8]) -> float:
+    return (int(frame[3]) | int(frame[4]) << 8) * 0.25
 
-    Feed it whatever the port delivered; it keeps at most 4 bytes of an incomplete sample
-    between calls. A 5-byte window is accepted only if S != !S, C == 1 and the angle is below
-    360°; otherwise one byte is dropped and counted in :attr:`rejected_bytes`. The search is
-    vectorised: a run of aligned valid samples is taken in one numpy step.
+
+class SampleStreamDecoder:
+    """Incremental decoder of the standard scan stream that accepts only consistent runs.
+
+    A 5-byte window is a *candidate* sample when its check bits pass (S != !S, C == 1) and
+    its angle is below 360°. Two candidates 5 bytes apart are *linked* when their angles
+    differ by at most ``max_angle_step_deg`` (modulo 360°), as consecutive samples of a
+    spinning lidar do. The decoder accepts:
+
+    * the samples of a run of at least ``min_run`` linked candidates, found by trying one
+      byte offset after another (every offset passed over is a rejected byte);
+    * while in such a run, each next sample linked to the previous one.
+
+    A sample at either end of a run (linked on one side only, i.e. next to junk or a gap) is
+    accepted only if it is plausible against the nearest return in the run: either no return
+    itself (distance 0) or a distance and quality close to that return's (``edge_*``
+    settings). Random junk passes the check bits in about one window
+    of six and a link in about one of twelve, so runs of junk are rare, and a junk window
+    glued to a real run by chance is caught by the edge test.
+
+    Feed it whatever the port delivered; decisions wait until the bytes they need have
+    arrived, so the output does not depend on how the stream was split into reads. At most
+    ``5 * compare_samples + compare_offsets - 2`` bytes stay pending between calls
+    (:attr:`pending_bytes`).
     """
 
-    def __init__(self) -> None:
+    def __init__(self, config: ResyncConfig | None = None) -> None:
+        self.config = config or ResyncConfig()
+        self._max_step_q6 = round(self.config.max_angle_step_deg * 64.0)
         self._pending = _EMPTY
+        self._last: npt.NDArray[np.uint8] | None = None  # last accepted sample while in a run
+        self._recent: list[npt.NDArray[np.uint8]] = []  # the run's last accepted samples
         self.accepted_samples = 0
         self.rejected_bytes = 0
+        self.rejected_edges = 0
+
+    @property
+    def pending_bytes(self) -> int:
+        """Bytes received but not yet accepted or rejected."""
+        return int(self._pending.shape[0])
 
     def reset(self) -> None:
-        """Forget buffered bytes (after a flush of the port); counters are kept."""
+        """Forget buffered bytes and the current run (after a flush); counters are kept."""
         self._pending = _EMPTY
+        self._last = None
+        self._recent = []
+
+    def _edge_ok(self, frame: npt.NDArray[np.uint8], run: list[npt.NDArray[np.uint8]]) -> bool:
+        """Whether a run's end sample ``frame`` fits the run (``run``: nearest first)."""
+        distance = _frame_distance_mm(frame)
+        if distance == 0.0:
+            return True
+        config = self.config
+        for other in run[: config.edge_reference_samples]:
+            reference = _frame_distance_mm(other)
+            if reference == 0.0:
+                continue
+            tolerance = max(config.edge_distance_rel * reference, config.edge_distance_abs_mm)
+            quality_step = abs(int(frame[0] >> 2) - int(other[0] >> 2))
+            return abs(distance - reference) <= tolerance and quality_step <= (
+                config.edge_quality_step
+            )
+        return False
+
+    def _links(
+        self, buf: npt.NDArray[np.uint8]
+    ) -> tuple[npt.NDArray[np.bool_], npt.NDArray[np.int64], int]:
+        """link[i]: candidates at i and i + 5 with a plausible angle step between them.
+
+        Also returns the size of that step (angle_q6, either way) and the number of links.
+        """
+        valid, angle_q6 = _window_fields(buf)
+        n_links = max(buf.shape[0] - 2 * SAMPLE_SIZE + 1, 0)
+        step = np.abs(angle_q6[SAMPLE_SIZE : SAMPLE_SIZE + n_links] - angle_q6[:n_links])
+        step = np.minimum(step, ANGLE_Q6_FULL_TURN - step)
+        link = valid[:n_links] & valid[SAMPLE_SIZE : SAMPLE_SIZE + n_links]
+        link &= step <= self._max_step_q6
+        return link, step, n_links
+
+    def _longest_run_start(
+        self,
+        link: npt.NDArray[np.bool_],
+        step_q6: npt.NDArray[np.int64],
+        n_links: int,
+        found: int,
+    ) -> int | None:
+        """Of the runs starting at ``found`` and the next ``compare_offsets - 1`` offsets, the best.
+
+        Bytes where junk meets real samples can form a run shifted against the real samples
+        by a few bytes, sometimes led in by a junk window or two. Its angles come from the
+        samples' quality and distance bytes, which change slowly, so it barely turns; the
+        real samples form the longer run, or one as long that turns more. Runs are compared
+        over up to ``compare_samples`` samples by length, then by the angle they turn
+        through. None when the bytes needed to decide have not all arrived.
+        """
+        cap = self.config.compare_samples - 1  # links
+        width = self.config.compare_offsets
+        if found + width - 1 + SAMPLE_SIZE * (cap - 1) >= n_links:
+            return None
+        lengths = np.zeros(width, dtype=np.int64)
+        turned = np.zeros(width, dtype=np.int64)
+        alive = np.ones(width, dtype=bool)
+        for k in range(cap):
+            start = found + SAMPLE_SIZE * k
+            alive &= link[start : start + width]
+            lengths += alive
+            turned += np.where(alive, step_q6[start : start + width], 0)
+        best = np.lexsort((-turned, -lengths))[0]  # longest first, then most turned
+        return found + int(best)
 
     def feed(self, data: bytes) -> ScanSamples:
-        """Decode all complete samples in the pending bytes plus ``data``."""
+        """Decode all samples that the pending bytes plus ``data`` decide."""
         incoming = np.frombuffer(data, dtype=np.uint8)
-        buf = np.concatenate((self._pending, incoming)) if self._pending.size else incoming
-        valid = _valid_offsets(buf)
-        n_offsets = valid.shape[0]
-        runs: list[npt.NDArray[np.uint8]] = []
-        pos = 0
-        while pos < n_offsets:
-            chain = valid[pos::SAMPLE_SIZE]
-            bad = np.flatnonzero(~chain)
-            run = int(bad[0]) if bad.size else chain.shape[0]
-            if run:
-                # A run of aligned valid samples is a contiguous block: reshape, no copy.
-                runs.append(buf[pos : pos + SAMPLE_SIZE * run].reshape(run, SAMPLE_SIZE))
-                pos += SAMPLE_SIZE * run
+        head = self._pending if self._last is None else np.concatenate((self._last, self._pending))
+        buf = np.concatenate((head, incoming)) if head.size else incoming
+        link, step_q6, n_links = self._links(buf)
+        min_run = self.config.min_run
+        # start_ok[i]: min_run candidates linked one to the next begin at offset i.
+        n_starts = max(buf.shape[0] - SAMPLE_SIZE * min_run + 1, 0)
+        start_ok = np.ones(n_starts, dtype=bool)
+        for k in range(min_run - 1):
+            start_ok &= link[SAMPLE_SIZE * k : SAMPLE_SIZE * k + n_starts]
+        # Accepted samples as (first offset, count) segments of consecutive samples.
+        accepted: list[tuple[int, int]] = []
+        in_run = self._last is not None
+        earlier = self._recent if in_run else []  # the run's samples from earlier feeds
+        run_begin = 0  # index into ``accepted`` of the current run's first segment
+        n_ref = self.config.edge_reference_samples
+        pos = SAMPLE_SIZE if in_run else 0
+        while True:
+            if in_run:
+                # Invariant: the sample at pos - 5 is the run's last accepted sample.
+                if pos - SAMPLE_SIZE >= n_links:
+                    break  # the window at pos is not complete yet
+                chain = link[pos - SAMPLE_SIZE : n_links : SAMPLE_SIZE]
+                broken = np.flatnonzero(~chain)
+                # ``linked`` samples from pos on are linked to their predecessor; all but the
+                # last of them are linked to their successor as well.
+                linked = int(broken[0]) if broken.size else int(chain.shape[0])
+                if linked > 1:
+                    accepted.append((pos, linked - 1))
+                    pos += SAMPLE_SIZE * (linked - 1)
+                if not broken.size:
+                    break  # whether pos links forwards is decided by the next bytes
+                if linked:
+                    # pos ends the run: linked backwards only.
+                    run = _last_frames(buf, accepted[run_begin:], n_ref)
+                    if self._edge_ok(buf[pos : pos + SAMPLE_SIZE], run + earlier):
+                        accepted.append((pos, 1))
+                        pos += SAMPLE_SIZE
+                    else:
+                        self.rejected_edges += 1
+                        self.rejected_bytes += 1
+                        pos += 1
+                in_run = False
+                earlier = []
                 continue
-            # Look for the next plausible offset in a short window (cost independent of the
-            # buffer size); an all-junk window is skipped as a whole.
-            window = valid[pos + 1 : pos + 1 + _RESYNC_WINDOW]
-            later = np.flatnonzero(window)
-            skip = int(later[0]) + 1 if later.size else window.shape[0] + 1
-            self.rejected_bytes += skip
-            pos += skip
-        # Every offset with 5 bytes left was taken or skipped: at most 4 bytes remain.
-        self._pending = buf[pos:].copy() if pos < buf.shape[0] else _EMPTY
-        if not runs:
-            return decode_samples(np.zeros((0, SAMPLE_SIZE), dtype=np.uint8))
-        frames = runs[0] if len(runs) == 1 else np.concatenate(runs)
+            if pos >= n_starts:
+                break
+            later = np.flatnonzero(start_ok[pos:])
+            if not later.size:
+                self.rejected_bytes += n_starts - pos
+                pos = n_starts
+                break
+            found = pos + int(later[0])
+            best = self._longest_run_start(link, step_q6, n_links, found)
+            if best is None:
+                self.rejected_bytes += found - pos
+                pos = found
+                break  # the competing offsets are not decidable yet
+            self.rejected_bytes += best - pos
+            pos = best
+            # A run starts at pos; its first sample is linked forwards only.
+            following = [
+                buf[pos + SAMPLE_SIZE * k : pos + SAMPLE_SIZE * (k + 1)] for k in range(1, min_run)
+            ]
+            run_begin = len(accepted)
+            if self._edge_ok(buf[pos : pos + SAMPLE_SIZE], following):
+                accepted.append((pos, 1))
+            else:
+                self.rejected_edges += 1
+                self.rejected_bytes += SAMPLE_SIZE
+                pos += SAMPLE_SIZE
+                accepted.append((pos, 1))  # linked on both sides within the run (min_run >= 3)
+            pos += SAMPLE_SIZE
+            in_run = True
+        blocks = [buf[a : a + SAMPLE_SIZE * c].reshape(c, SAMPLE_SIZE) for a, c in accepted]
+        if not blocks:
+            frames = np.zeros((0, SAMPLE_SIZE), dtype=np.uint8)
+        else:
+            frames = blocks[0] if len(blocks) == 1 else np.concatenate(blocks)
+        if in_run:
+            run = [f.copy() for f in _last_frames(buf, accepted[run_begin:], n_ref)]
+            self._recent = (run + earlier)[:n_ref]
+            self._last = buf[pos - SAMPLE_SIZE : pos].copy()
+        else:
+            self._recent = []
+            self._last = None
+        self._pending = buf[pos:].copy()
         self.accepted_samples += int(frames.shape[0])
         return decode_samples(frames)
+
+
+def _last_frames(
+    buf: npt.NDArray[np.uint8], segments: list[tuple[int, int]], count: int
+) -> list[npt.NDArray[np.uint8]]:
+    """The last ``count`` accepted frames of ``segments``, nearest (latest) first."""
+    frames: list[npt.NDArray[np.uint8]] = []
+    for first, n in reversed(segments):
+        for k in range(n - 1, -1, -1):
+            if len(frames) == count:
+                return frames
+            offset = first + SAMPLE_SIZE * k
+            frames.append(buf[offset : offset + SAMPLE_SIZE])
+    return frames
 
 
 @dataclass(frozen=True)
@@ -308,77 +529,183 @@ class Revolution:
 
 
 class RevolutionAssembler:
-    """Cut a sample stream into revolutions.
+    """Cut a sample stream into revolutions by the rotation swept since the last start.
 
-    A revolution starts at a sample with S = 1, or where the angle wraps from above
-    ``wrap_high_deg`` to below ``wrap_low_deg`` (a missed S flag). The samples before the
-    first boundary and revolutions with fewer than ``min_points`` samples are dropped and
-    counted in :attr:`dropped_revolutions`.
+    The rotation is followed sample by sample (angle steps modulo 360°; a step back of up
+    to ``max_back_step_deg`` is jitter, not a turn). A sample with the start flag S begins
+    a new revolution once at least ``min_sweep_deg`` have been swept since the current one
+    began; an earlier S is ignored (counted in :attr:`ignored_start_flags`), so a stray
+    flag cannot break a revolution into fragments. No sample is dropped at an angle wrap: a
+    start flag that comes late keeps the samples between the wrap and the flag in the
+    revolution. When ``max_sweep_deg`` have been swept without a start flag (S was lost),
+    the revolution is cut where it completed 360° and the rest begins the next one.
+
+    The samples before the first boundary form a revolution only if they sweep at least
+    ``min_sweep_deg`` (a turn whose first samples were lost); otherwise they are dropped,
+    like revolutions with fewer than ``min_points`` samples, and counted in
+    :attr:`dropped_revolutions` and :attr:`dropped_samples`.
     """
 
     def __init__(
-        self, *, min_points: int = 50, wrap_high_deg: float = 350.0, wrap_low_deg: float = 10.0
+        self,
+        *,
+        min_points: int = 50,
+        min_sweep_deg: float = 270.0,
+        max_sweep_deg: float = 380.0,
+        max_back_step_deg: float = 30.0,
     ) -> None:
         if min_points < 1:
             raise ConfigurationError(f'min_points must be >= 1, got {min_points}')
+        if not 0.0 < min_sweep_deg < 360.0 <= max_sweep_deg < 720.0:
+            msg = (
+                'need 0 < min_sweep_deg < 360 <= max_sweep_deg < 720,'
+                f' got {min_sweep_deg} and {max_sweep_deg}'
+            )
+            raise ConfigurationError(msg)
+        if not 0.0 <= max_back_step_deg < 180.0:
+            msg = f'max_back_step_deg must be in [0, 180), got {max_back_step_deg}'
+            raise ConfigurationError(msg)
         self._min_points = min_points
-        self._wrap_high_deg = wrap_high_deg
-        self._wrap_low_deg = wrap_low_deg
+        self._min_sweep = min_sweep_deg
+        self._max_sweep = max_sweep_deg
+        self._max_back = max_back_step_deg
+        # The revolution in progress: its samples, their cumulative rotation, where it began.
         self._parts: list[ScanSamples] = []
-        self._start_time_s: float | None = None
+        self._parts_deg: list[npt.NDArray[np.float64]] = []
+        self._begin_deg = 0.0
+        self._start_time_s = 0.0
+        self._in_revolution = False
         self._last_angle_deg: float | None = None
+        self._unwrapped_deg = 0.0
         self.dropped_revolutions = 0
+        self.dropped_samples = 0
+        self.ignored_start_flags = 0
 
     def reset(self) -> None:
         """Drop the revolution in progress (after a scan restart)."""
         self._parts = []
-        self._start_time_s = None
+        self._parts_deg = []
+        self._in_revolution = False
         self._last_angle_deg = None
+        self._unwrapped_deg = 0.0
 
-    def add(self, samples: ScanSamples, receive_time_s: float) -> list[Revolution]:
-        """Add samples received at ``receive_time_s``; return the revolutions they complete."""
-        if len(samples) == 0:
-            return []
-        angles = samples.angle_deg
+    def _unwrap(self, angles: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
+        """Cumulative rotation [deg] at each sample, continuing from the previous batch."""
         previous = np.empty_like(angles)
         previous[0] = angles[0] if self._last_angle_deg is None else self._last_angle_deg
         previous[1:] = angles[:-1]
-        wrapped = (previous > self._wrap_high_deg) & (angles < self._wrap_low_deg)
-        if self._last_angle_deg is None:
-            wrapped[0] = False
-        boundaries = np.flatnonzero(samples.start | wrapped)
+        step = np.mod(angles - previous, 360.0)
+        step[step > 360.0 - self._max_back] -= 360.0
+        unwrapped = self._unwrapped_deg + np.cumsum(step)
         self._last_angle_deg = float(angles[-1])
+        self._unwrapped_deg = float(unwrapped[-1])
+        return unwrapped
+
+    def _append(self, samples: ScanSamples, unwrapped: npt.NDArray[np.float64]) -> None:
+        if len(samples):
+            self._parts.append(samples)
+            self._parts_deg.append(unwrapped)
+
+    def _begin(
+        self, samples: ScanSamples, unwrapped: npt.NDArray[np.float64], time_s: float
+    ) -> None:
+        """Start a new revolution with ``samples`` (its first sample is the boundary)."""
+        self._in_revolution = True
+        self._start_time_s = time_s
+        self._begin_deg = float(unwrapped[0])
+        self._append(samples, unwrapped)
+
+    def add(self, samples: ScanSamples, receive_time_s: float) -> list[Revolution]:
+        """Add samples received at ``receive_time_s``; return the revolutions they complete."""
+        n = len(samples)
+        if n == 0:
+            return []
+        fresh = self._last_angle_deg is None
+        unwrapped = self._unwrap(samples.angle_deg)
+        begin = 0  # first sample of this batch not yet in the revolution in progress
+        search = 0  # first sample that may begin the next revolution
+        if fresh:
+            # The first sample after a reset begins a part: a revolution if it carries S.
+            self._begin(_slice(samples, 0, 1), unwrapped[:1], receive_time_s)
+            self._in_revolution = bool(samples.start[0])
+            begin = search = 1
         done: list[Revolution] = []
-        begin = 0
-        for cut in boundaries:
-            cut = int(cut)
-            if cut > begin:
-                self._parts.append(_slice(samples, begin, cut))
-            revolution = self._close(receive_time_s)
+        while search < n:
+            swept = unwrapped[search:] - self._begin_deg
+            flagged = samples.start[search:]
+            if self._in_revolution:
+                boundary = (flagged & (swept >= self._min_sweep)) | (swept >= self._max_sweep)
+            else:
+                boundary = flagged | (swept >= self._max_sweep)
+            hits = np.flatnonzero(boundary)
+            end = search + int(hits[0]) if hits.size else n
+            if self._in_revolution:
+                self.ignored_start_flags += int(np.count_nonzero(samples.start[search:end]))
+            if not hits.size:
+                break
+            self._append(_slice(samples, begin, end), unwrapped[begin:end])
+            if samples.start[end] and swept[end - search] <= self._max_sweep:
+                revolution = self._close(receive_time_s, float(unwrapped[end - 1]))
+                carried: tuple[ScanSamples, npt.NDArray[np.float64]] | None = None
+            else:
+                revolution, carried = self._cut_missed_start(receive_time_s)
             if revolution is not None:
                 done.append(revolution)
-            self._start_time_s = receive_time_s
-            begin = cut
-        self._parts.append(_slice(samples, begin, len(samples)))
+            if carried is not None:
+                self._begin(*carried, receive_time_s)
+                self._append(_slice(samples, end, end + 1), unwrapped[end : end + 1])
+            else:
+                self._begin(_slice(samples, end, end + 1), unwrapped[end : end + 1], receive_time_s)
+            begin = search = end + 1
+        self._append(_slice(samples, begin, n), unwrapped[begin:])
         return done
 
-    def _close(self, end_time_s: float) -> Revolution | None:
+    def _cut_missed_start(
+        self, time_s: float
+    ) -> tuple[Revolution | None, tuple[ScanSamples, npt.NDArray[np.float64]] | None]:
+        """No S within max_sweep: close at 360°, return the rest as the next one's start."""
+        whole = _concat(self._parts)
+        degrees = np.concatenate(self._parts_deg)
+        cut = int(np.searchsorted(degrees - self._begin_deg, 360.0))
+        cut = max(cut, 1)
+        self._parts = [_slice(whole, 0, cut)]
+        self._parts_deg = [degrees[:cut]]
+        revolution = self._close(time_s, float(degrees[cut - 1]))
+        if cut >= len(whole):
+            return revolution, None
+        return revolution, (_slice(whole, cut, len(whole)), degrees[cut:])
+
+    def _close(self, end_time_s: float, last_deg: float) -> Revolution | None:
         parts, self._parts = self._parts, []
-        start_time_s = self._start_time_s
+        self._parts_deg = []
         count = sum(len(p) for p in parts)
         if count == 0:
             return None
-        if start_time_s is None or count < self._min_points:
-            # A leading part whose start was not seen, or a revolution broken up by a resync.
+        partial = not self._in_revolution and last_deg - self._begin_deg < self._min_sweep
+        if partial or count < self._min_points:
+            # Most of a turn before the first start flag, or too few samples.
             self.dropped_revolutions += 1
+            self.dropped_samples += count
             return None
+        whole = _concat(parts)
         return Revolution(
-            angle_deg=np.concatenate([p.angle_deg for p in parts]),
-            distance_mm=np.concatenate([p.distance_mm for p in parts]),
-            quality=np.concatenate([p.quality for p in parts]),
-            start_time_s=start_time_s,
-            period_s=max(end_time_s - start_time_s, 0.0),
+            angle_deg=whole.angle_deg,
+            distance_mm=whole.distance_mm,
+            quality=whole.quality,
+            start_time_s=self._start_time_s,
+            period_s=max(end_time_s - self._start_time_s, 0.0),
         )
+
+
+def _concat(parts: list[ScanSamples]) -> ScanSamples:
+    if len(parts) == 1:
+        return parts[0]
+    return ScanSamples(
+        np.concatenate([p.start for p in parts]),
+        np.concatenate([p.quality for p in parts]),
+        np.concatenate([p.angle_deg for p in parts]),
+        np.concatenate([p.distance_mm for p in parts]),
+    )
 
 
 def _slice(samples: ScanSamples, begin: int, end: int) -> ScanSamples:
@@ -396,7 +723,7 @@ class ScanBinning:
 
     ROS angle = wrap(zero_offset_rad + angle_direction * device_angle). The defaults
     (direction -1, offset pi) are Slamtec's ROS mapping, which puts laser +x at the device's
-    180° mark (HARDWARE.md §2.7).
+    180° mark.
 
     Attributes:
         bins: number of bins over [-pi, pi).

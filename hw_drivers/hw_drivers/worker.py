@@ -184,7 +184,9 @@ class DeviceWorker:
                 self._fail(err, fatal=False, while_='running (unexpected)')
                 produced = False
             if self._session is None:
-                wait_s = max(0.0, min(self._next_attempt_s - self._clock(), 0.1))
+                # Sleep until the next attempt is due (at most a second: the clock is
+                # injectable), so a missing device costs no CPU between attempts.
+                wait_s = max(0.0, min(self._next_attempt_s - self._clock(), 1.0))
                 self._stop.wait(wait_s)
             elif not produced:
                 self._stop.wait(self._idle_wait_s)

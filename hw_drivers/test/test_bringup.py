@@ -1,5 +1,6 @@
 """robot_bringup: what it starts, in which order, and how it stops."""
 
+import io
 import signal
 import sys
 from pathlib import Path
@@ -7,7 +8,13 @@ from pathlib import Path
 import pytest
 import yaml
 from hw_drivers.robot_bringup import cli
-from hw_drivers.robot_bringup.cli import BringupOptions, ChildSpec, build_plan, driver_parameters
+from hw_drivers.robot_bringup.cli import (
+    BringupOptions,
+    ChildSpec,
+    Supervisor,
+    build_plan,
+    driver_parameters,
+)
 
 from hw_drivers import aoa_receiver_node, gas_node, mpu6050_node, pump_node, rplidar_node
 
@@ -44,11 +51,11 @@ def test_dry_run_prints_the_commands(capsys):
     assert lines[0].split()[1:3] == ['-m', 'hw_drivers.pump_node']
 
 
-def test_a_dying_child_stops_the_others_and_fails_the_bringup(monkeypatch, tmp_path):
+def test_a_dying_child_stops_the_others_and_fails_the_bringup(tmp_path):
     marker = tmp_path / 'stopped'
     sleeper = (
         'import signal, sys, time\n'
-        f'signal.signal(signal.SIGINT, lambda *a: (open({str(marker)!r}, "w").close(), '
+        f'signal.signal(signal.SIGTERM, lambda *a: (open({str(marker)!r}, "w").close(), '
         'sys.exit(0)))\n'
         'time.sleep(30)\n'
     )
@@ -56,13 +63,12 @@ def test_a_dying_child_stops_the_others_and_fails_the_bringup(monkeypatch, tmp_p
         ChildSpec('long_running', (sys.executable, '-c', sleeper), settle_s=0.5),
         ChildSpec('crashing', (sys.executable, '-c', 'raise SystemExit(4)')),
     ]
-    monkeypatch.setattr(cli, 'build_plan', lambda options: plan)
     handler_before = signal.getsignal(signal.SIGINT)
-    assert cli.run(BringupOptions(), grace_s=5.0) == 1
-    assert marker.exists()  # the survivor got SIGINT and shut down cleanly
-    assert (
-        signal.getsignal(signal.SIGINT) is handler_before
-    )  # the survivor got SIGINT and shut down cleanly
+    out = io.StringIO()
+    assert Supervisor(plan, grace_s=5.0, out=out).run() == cli.EXIT_CHILD_FAILED
+    assert marker.exists()  # the survivor got SIGTERM and shut down cleanly
+    assert signal.getsignal(signal.SIGINT) is handler_before
+    assert 'crashing exited with status 4; stopping the other 1 process(es)' in out.getvalue()
 
 
 def test_example_parameter_file_names_real_parameters():
@@ -82,7 +88,7 @@ def test_example_parameter_file_names_real_parameters():
 
 
 @pytest.mark.slow
-def test_the_locator_is_respawned_alone(monkeypatch, tmp_path):
+def test_the_locator_is_respawned_alone(tmp_path):
     runs = tmp_path / 'runs'
     runs.mkdir()
     locator = f'import pathlib, uuid; (pathlib.Path({str(runs)!r}) / uuid.uuid4().hex).touch()'
@@ -90,8 +96,8 @@ def test_the_locator_is_respawned_alone(monkeypatch, tmp_path):
         ChildSpec('aoa_locator', (sys.executable, '-c', locator), respawn=True),
         ChildSpec('crashing_later', (sys.executable, '-c', 'import time; time.sleep(1)')),
     ]
-    monkeypatch.setattr(cli, 'build_plan', lambda options: plan)
-    assert cli.run(BringupOptions(), grace_s=2.0, respawn_delay_s=0.1) == 1
+    supervisor = Supervisor(plan, grace_s=2.0, respawn_delay_s=0.1, out=io.StringIO())
+    assert supervisor.run() == cli.EXIT_CHILD_FAILED
     assert len(list(runs.iterdir())) >= 2
 
 

@@ -1,13 +1,18 @@
 """Hypothesis fuzzing of every parser: only documented exceptions escape, state stays sound."""
 
+import itertools
 import json
 import math
 
 import numpy as np
+import pytest
 from hw_drivers.aoa_protocol import JsonStreamDecoder, SequenceFilter, parse_angle_report
-from hw_drivers.errors import ProtocolError
+from hw_drivers.errors import DeviceIdentityError, DeviceTimeoutError, ProtocolError
+from hw_drivers.fakes.clock import FakeClock
+from hw_drivers.fakes.i2c import FakeSMBus
 from hw_drivers.fakes.lidar import encode_sample
 from hw_drivers.fakes.locator import authors_payload, ndjson_payload
+from hw_drivers.gas_device import AdsGasBackend, GroveHatGasBackend, XiaoGasBackend
 from hw_drivers.gas_protocol import (
     AdsChip,
     AdsConfig,
@@ -15,7 +20,8 @@ from hw_drivers.gas_protocol import (
     decode_xiao_reply,
     grove_ratio_to_raw10,
 )
-from hw_drivers.mpu6050_protocol import decode_data_block
+from hw_drivers.mpu6050_device import Mpu6050
+from hw_drivers.mpu6050_protocol import Mpu6050Config, decode_data_block
 from hw_drivers.pump_control import PumpController, PumpLimits
 from hw_drivers.rplidar_protocol import (
     HEALTH_DESCRIPTOR,
@@ -65,7 +71,9 @@ def test_sample_decoder_accounts_for_every_byte_and_emits_only_valid_samples(par
         assert np.all((out.angle_deg >= 0.0) & (out.angle_deg < 360.0))
         assert np.all(out.distance_mm >= 0.0)
     pending = total - 5 * accepted - decoder.rejected_bytes
-    assert 0 <= pending <= 4
+    assert pending == decoder.pending_bytes
+    config = decoder.config
+    assert 0 <= pending <= 5 * config.compare_samples + config.compare_offsets - 2
 
 
 @FUZZ
@@ -278,3 +286,107 @@ def test_pump_never_breaks_its_limits_whatever_the_commands(steps, max_on, min_o
 def test_grove_ratio_register_maps_or_raises_only_protocol_errors(word):
     raw10 = _only_protocol_errors(grove_ratio_to_raw10, word)
     assert raw10 is None or 0 <= raw10 <= 1023
+
+
+# --- devices answering junk: only documented, recoverable errors, and no reading ---------
+
+
+class _JunkPort:
+    """A serial port that answers anything with random bytes (a wrong or noisy device)."""
+
+    def __init__(self, seed, max_chunk):
+        self._rng = np.random.default_rng(seed)
+        self._max_chunk = max_chunk
+        self.reads = 0
+
+    @property
+    def in_waiting(self):
+        return int(self._rng.integers(0, self._max_chunk + 1))
+
+    def read(self, size=1):
+        self.reads += 1
+        count = int(self._rng.integers(0, min(size, self._max_chunk) + 1))
+        return self._rng.integers(0, 256, count, dtype=np.uint8).tobytes()
+
+    def write(self, data):
+        return len(data)
+
+    def reset_input_buffer(self):
+        pass
+
+    def close(self):
+        pass
+
+
+class _JunkRegisters:
+    """An I2C device whose every register reads as random bytes."""
+
+    def __init__(self, seed):
+        self._rng = np.random.default_rng(seed)
+
+    def read(self, register, length):
+        return self._rng.integers(0, 256, length).tolist()
+
+    def write(self, register, data):
+        pass
+
+
+def _ticking_clock():
+    clock = FakeClock()
+
+    def now():
+        clock.advance(0.001)
+        return clock()
+
+    return now
+
+
+@FUZZ
+@given(st.integers(0, 2**31), st.integers(1, 64))
+def test_a_gas_board_sending_random_bytes_yields_no_reading(seed, max_chunk):
+    backend = XiaoGasBackend(_JunkPort(seed, max_chunk), clock=_ticking_clock())
+    for _ in range(20):
+        with pytest.raises((ProtocolError, DeviceTimeoutError)):
+            backend.read()
+
+
+@FUZZ
+@given(st.integers(0, 2**31))
+def test_random_register_contents_are_never_taken_for_an_mpu6050(seed):
+    bus = FakeSMBus({0x68: _JunkRegisters(seed)})
+    device = Mpu6050(bus, Mpu6050Config(), sleep=lambda _s: None)
+    with pytest.raises((DeviceIdentityError, ProtocolError)):
+        device.initialise()
+
+
+@FUZZ
+@given(st.integers(0, 2**31), st.sampled_from(list(AdsChip)))
+def test_random_register_contents_are_never_taken_for_an_ads1x15(seed, chip):
+    config = AdsConfig(chip=chip, data_rate_sps=128 if chip is AdsChip.ADS1115 else 1600)
+    bus = FakeSMBus({0x48: _JunkRegisters(seed)})
+    with pytest.raises(DeviceIdentityError):
+        AdsGasBackend(bus, config=config, sleep=lambda _s: None, clock=_ticking_clock())
+
+
+@FUZZ
+@given(st.integers(0, 2**31))
+def test_random_register_contents_are_never_taken_for_a_grove_hat(seed):
+    bus = FakeSMBus({0x04: _JunkRegisters(seed)})
+    with pytest.raises(DeviceIdentityError):
+        GroveHatGasBackend(bus)
+
+
+@FUZZ
+@given(st.integers(0, 2**31), st.integers(1, 20_000), st.lists(st.integers(0, 20_000)))
+def test_random_bytes_from_the_locator_yield_no_report(seed, size, cuts):
+    junk = np.random.default_rng(seed).integers(0, 256, size, dtype=np.uint8).tobytes()
+    decoder = JsonStreamDecoder()
+    reports = []
+    bounds = [0, *sorted(c for c in cuts if c <= size), size]
+    for a, b in itertools.pairwise(bounds):
+        for value in decoder.feed(junk[a:b]):
+            report = _only_protocol_errors(parse_angle_report, value)
+            if report is not None:
+                reports.append(report)
+    assert reports == []
+    assert decoder.buffered_chars <= 16 * 1024

@@ -39,7 +39,7 @@ from hw_drivers.worker import DeviceWorker
 
 
 def test_ads_config_word_matches_the_datasheet_example():
-    # Single-shot AIN0 vs GND, +-4.096 V, 128 SPS, comparator off (HARDWARE.md §4.1).
+    # Single-shot AIN0 vs GND, +-4.096 V, 128 SPS, comparator off.
     assert encode_ads_config(AdsConfig()) == 0xC383
     assert encode_ads_config(AdsConfig(), start=False) == 0x4383
 

@@ -8,7 +8,7 @@ import textwrap
 import time
 
 import pytest
-from hw_drivers.errors import ConfigurationError, FatalDeviceError
+from hw_drivers.errors import ConfigurationError, DeviceUnavailableError, FatalDeviceError
 from hw_drivers.fakes.gpio import FakePumpOutput
 from hw_drivers.pump_control import PumpController, PumpLimits
 from hw_drivers.pump_node import PumpNode
@@ -23,6 +23,7 @@ from swarm_runtime.ros import (
 from swarm_runtime.simulation import spin_until, wall_time_s
 
 std_msgs = message_module('std_msgs')
+diagnostic_msgs = message_module('diagnostic_msgs')
 
 
 def _run(controller, commands, until_s, step_s=0.01):
@@ -110,8 +111,8 @@ def test_line_ids_parse_as_offsets_or_names():
     assert parse_line_id(' GPIO17 ') == 'GPIO17'
 
 
-def test_missing_gpio_chip_is_a_fatal_error():
-    with pytest.raises(FatalDeviceError, match='gpiochip99'):
+def test_a_missing_gpio_chip_is_a_recoverable_error():
+    with pytest.raises(DeviceUnavailableError, match='gpiochip99'):
         GpiodPumpOutput('/dev/gpiochip99', 17)
 
 
@@ -203,6 +204,100 @@ def test_guard_thread_cuts_a_pulse_when_the_executor_stalls():
         node.destroy_node()
     finally:
         rclpy.try_shutdown()
+
+
+class FlakyLine:
+    """Opens a FakePumpOutput only after ``failures`` failed attempts; records them."""
+
+    def __init__(self, failures, error=None):
+        self.failures = failures
+        self.error = error or DeviceUnavailableError('no GPIO chip /dev/gpiochip0')
+        self.attempts = []
+        self.outputs = []
+
+    def __call__(self):
+        self.attempts.append(wall_time_s())
+        if len(self.attempts) <= self.failures:
+            raise self.error
+        self.outputs.append(FakePumpOutput(lambda: wall_time_s()))
+        return self.outputs[-1]
+
+
+@pytest.fixture
+def flaky_pump():
+    rclpy.init()
+    nodes = []
+    executor = SingleThreadedExecutor()
+    controller = Node('controller')
+    executor.add_node(controller)
+    pub = controller.create_publisher(std_msgs.Bool, 'pump', 10)
+    diagnostics = []
+    controller.create_subscription(
+        diagnostic_msgs.DiagnosticArray, '/diagnostics', diagnostics.append, 10
+    )
+
+    def make(opener):
+        node = PumpNode(open_output=opener, retry_clock=wall_time_s)
+        nodes.append(node)
+        executor.add_node(node)
+        return node
+
+    yield make, executor, controller, pub, diagnostics
+    for node in nodes:
+        node.destroy_node()
+    controller.destroy_node()
+    rclpy.try_shutdown()
+
+
+def test_a_missing_gpio_backs_off_keeps_the_pump_off_and_recovers(flaky_pump):
+    make, executor, controller, pub, diagnostics = flaky_pump
+    opener = FlakyLine(failures=3)
+    node = make(opener)
+    # Commands while the line is missing change nothing (and no exception).
+    _publish_for(executor, controller, pub, True, 2.5)
+    assert not node.line_available
+    status = diagnostics[-1].status[0]
+    assert status.level == diagnostic_msgs.DiagnosticStatus.ERROR
+    assert status.message.startswith('pump line unavailable (error): no GPIO chip')
+    assert 'retrying in' in status.message
+    spin_until(executor, lambda: node.line_available, max_wall_time_s=10.0)
+    # Back-off 1, 2, 4 s between the four attempts (checked at the 1 Hz diagnostics tick).
+    gaps = [b - a for a, b in zip(opener.attempts, opener.attempts[1:], strict=False)]
+    assert [round(g) for g in gaps] == [1, 2, 4]
+    output = opener.outputs[0]
+    assert output.transitions == []  # came up off, stayed off without a fresh "on"
+    _publish_for(executor, controller, pub, True, 0.3)
+    assert output.level is True
+    spin_until(executor, lambda: False, max_wall_time_s=1.2)
+    assert output.level is False  # stale commands
+    assert diagnostics[-1].status[0].level == diagnostic_msgs.DiagnosticStatus.OK
+
+
+def test_a_line_that_fails_in_use_goes_off_is_released_and_is_requested_again(flaky_pump):
+    make, executor, controller, pub, _ = flaky_pump
+    opener = FlakyLine(failures=0)
+    node = make(opener)
+    _publish_for(executor, controller, pub, True, 0.2)
+    first, line = opener.outputs[0], node.line
+    assert first.level is True
+    first.fail_on_set = False  # the line can no longer be driven (e.g. chip gone)
+    _publish_for(executor, controller, pub, False, 0.1)
+    assert not node.line_available
+    assert node.line_failures == 1
+    assert line.closed  # released (its off failed and was counted, nothing raised)
+    assert line.off_failures >= 1
+    spin_until(executor, lambda: node.line_available, max_wall_time_s=3.0)
+    assert len(opener.outputs) == 2
+    assert opener.outputs[1].level is False
+
+
+def test_a_busy_line_is_retried_slowly(flaky_pump):
+    make, executor, _, _, diagnostics = flaky_pump
+    opener = FlakyLine(failures=100, error=FatalDeviceError('cannot request line 17: busy'))
+    make(opener)
+    spin_until(executor, lambda: False, max_wall_time_s=35.0)
+    assert len(opener.attempts) == 2  # at start, then after the 30 s fatal back-off
+    assert 'fatal error' in diagnostics[-1].status[0].message
 
 
 _CHILD = textwrap.dedent(

@@ -22,6 +22,7 @@ from hw_drivers.rplidar_protocol import (
     decode_descriptor,
     decode_health,
     decode_info,
+    decode_samples,
     encode_request,
 )
 
@@ -84,13 +85,32 @@ def test_health_with_unknown_status_is_a_protocol_error():
         decode_health(bytes((7, 0, 0)))
 
 
+def _run_from(first: bytes, count: int = 3) -> bytes:
+    """``first`` followed by ``count`` samples that continue its rotation 1 deg at a time."""
+    angle_q6 = (first[1] >> 1) | (first[2] << 7)
+    distance_mm = (first[3] | first[4] << 8) / 4.0
+    return first + b''.join(
+        encode_sample(angle_q6 / 64.0 + k, distance_mm, first[0] >> 2, start=False)
+        for k in range(1, count + 1)
+    )
+
+
 def test_documented_sample_decodes_to_90_degrees_and_one_metre():
-    samples = SampleStreamDecoder().feed(bytes.fromhex('3D012DA00F'))
-    assert len(samples) == 1
-    assert bool(samples.start[0])
-    assert samples.quality[0] == 15
-    assert samples.angle_deg[0] == pytest.approx(90.0)
-    assert samples.distance_mm[0] == pytest.approx(1000.0)
+    frame = bytes.fromhex('3D012DA00F')
+    direct = decode_samples(np.frombuffer(frame, dtype=np.uint8).reshape(1, 5))
+    samples = SampleStreamDecoder().feed(_run_from(frame, 11))
+    for decoded in (direct, samples):
+        assert bool(decoded.start[0])
+        assert decoded.quality[0] == 15
+        assert decoded.angle_deg[0] == pytest.approx(90.0)
+        assert decoded.distance_mm[0] == pytest.approx(1000.0)
+    assert len(samples) == 11  # the last one waits for its successor
+
+
+def test_a_lone_window_that_passes_the_check_bits_is_not_a_sample():
+    decoder = SampleStreamDecoder()
+    assert len(decoder.feed(bytes.fromhex('3D012DA00F') + bytes(20))) == 0
+    assert decoder.rejected_bytes == 25 - decoder.pending_bytes
 
 
 @pytest.mark.parametrize(
@@ -100,12 +120,16 @@ def test_documented_sample_decodes_to_90_degrees_and_one_metre():
         bytes.fromhex('3C012DA00F'),  # S = !S = 0
         bytes.fromhex('3D002DA00F'),  # check bit C = 0
         bytes.fromhex('3D01FFA00F'),  # angle beyond 360 degrees
+        encode_sample(300.0, 1000.0, 15, start=False),  # angle far from its neighbours
     ],
 )
-def test_samples_failing_the_checks_are_rejected(corrupt):
+def test_samples_failing_the_checks_are_rejected_and_their_neighbours_kept(corrupt):
+    before = b''.join(encode_sample(80.0 + k, 1000.0, 15, start=False) for k in range(6))
+    after = b''.join(encode_sample(87.0 + k, 1000.0, 15, start=False) for k in range(12))
     decoder = SampleStreamDecoder()
-    assert len(decoder.feed(corrupt)) == 0
-    assert decoder.rejected_bytes == 1
+    out = decoder.feed(before + corrupt + after)
+    np.testing.assert_allclose(out.angle_deg, [*range(80, 86), *range(87, 98)])
+    assert decoder.rejected_bytes == 5
 
 
 def test_decoder_resynchronises_after_junk_and_counts_dropped_bytes():
@@ -113,7 +137,9 @@ def test_decoder_resynchronises_after_junk_and_counts_dropped_bytes():
     junk = bytes((0xFF, 0x00, 0xFF))
     decoder = SampleStreamDecoder()
     out = decoder.feed(good[:50] + junk + good[50:])
-    assert len(out) == 360
+    # Every sample but the last, which waits for its successor.
+    assert len(out) == 359
+    assert decoder.pending_bytes == 5
     assert decoder.rejected_bytes == 3
     np.testing.assert_allclose(np.diff(out.angle_deg), 1.0)
 
@@ -151,7 +177,7 @@ def test_revolutions_are_cut_at_start_flags_and_the_partial_first_one_dropped():
 
 def test_partial_revolutions_below_min_points_are_dropped():
     # A revolution with only 20 samples left (the rest lost to noise) between two good ones.
-    counts = (100, 20, 100, 1)
+    counts = (100, 20, 100, 50)
     out = bytearray()
     for count in counts:
         out += b''.join(
@@ -163,7 +189,7 @@ def test_partial_revolutions_below_min_points_are_dropped():
     assert assembler.dropped_revolutions == 1
 
 
-def test_missed_start_flag_is_caught_by_the_angle_wrap():
+def test_a_missed_start_flag_cuts_the_revolution_where_it_completed_a_turn():
     out = bytearray()
     for turn in range(3):
         for k in range(100):

@@ -12,6 +12,8 @@ from collections.abc import Collection
 from typing import Any
 
 import numpy as np
+from swarm_common.angles import yaw_from_unit_quaternion
+from swarm_common.stamps import stamp_from_seconds, stamp_to_seconds
 
 from msc_pf.peers import PeerInfo, Phase, Role
 from msc_pf.robot import RobotStatus
@@ -40,20 +42,19 @@ def robot_id_from_name(name: str) -> int:
 
 def stamp_from_ros(stamp: Any) -> float:
     """builtin_interfaces/Time -> seconds."""
-    return float(stamp.sec) + 1e-9 * float(stamp.nanosec)
+    return stamp_to_seconds(stamp)
 
 
 def stamp_to_ros(time_s: float, builtin_interfaces: Any) -> Any:
     """Seconds -> builtin_interfaces/Time (rounded to the nanosecond)."""
-    ns = round(time_s * 1e9)
-    return builtin_interfaces.Time(sec=int(ns // 1_000_000_000), nanosec=int(ns % 1_000_000_000))
+    return stamp_from_seconds(time_s, builtin_interfaces.Time)
 
 
 def pose_from_odometry(msg: Any) -> tuple[float, float, float]:
     """nav_msgs/Odometry -> (x [m], y [m], yaw [rad]) in the odometry (world) frame."""
     p = msg.pose.pose.position
     q = msg.pose.pose.orientation
-    yaw = math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+    yaw = yaw_from_unit_quaternion(q.x, q.y, q.z, q.w)
     return float(p.x), float(p.y), yaw
 
 

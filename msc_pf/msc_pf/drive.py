@@ -10,12 +10,9 @@ from __future__ import annotations
 
 import math
 
+from swarm_common.angles import wrap_angle
+
 __all__ = ['unicycle_command', 'wrap_angle']
-
-
-def wrap_angle(angle_rad: float) -> float:
-    """Angle wrapped to [-pi, pi)."""
-    return (angle_rad + math.pi) % (2.0 * math.pi) - math.pi
 
 
 def unicycle_command(

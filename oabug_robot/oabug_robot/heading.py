@@ -4,36 +4,16 @@ from __future__ import annotations
 
 import math
 
+from swarm_common.angles import TWO_PI, wrap_angle, yaw_from_quaternion
+
 from oabug_robot.settings import Departure
 
 __all__ = ['angle_difference', 'preferred_direction', 'wrap_angle', 'yaw_from_quaternion']
-
-TWO_PI = 2.0 * math.pi
-
-
-def wrap_angle(angle_rad: float) -> float:
-    """Return ``angle_rad`` wrapped to (-pi, pi]."""
-    wrapped = math.fmod(angle_rad + math.pi, TWO_PI)
-    if wrapped <= 0.0:
-        wrapped += TWO_PI
-    return wrapped - math.pi
 
 
 def angle_difference(target_rad: float, source_rad: float) -> float:
     """Return the signed rotation [rad], in (-pi, pi], from ``source_rad`` to ``target_rad``."""
     return wrap_angle(target_rad - source_rad)
-
-
-def yaw_from_quaternion(x: float, y: float, z: float, w: float) -> float:
-    """Return the yaw [rad] (rotation about +z, REP 103) of the quaternion (x, y, z, w).
-
-    The quaternion need not be normalised; a zero quaternion raises ValueError.
-    """
-    norm_sq = x * x + y * y + z * z + w * w
-    if not norm_sq > 0.0 or not math.isfinite(norm_sq):
-        msg = f'quaternion ({x}, {y}, {z}, {w}) has no orientation'
-        raise ValueError(msg)
-    return math.atan2(2.0 * (w * z + x * y), w * w + x * x - y * y - z * z)
 
 
 def preferred_direction(

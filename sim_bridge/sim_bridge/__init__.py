@@ -1,3 +1,1 @@
-"""pybullet simulation bridge publishing the robots' sensor topics, site generator and layout
-importer, signal fields, and the launch-free spawner.
-"""
+"""The sim bridge node: the simulator's ROS face (world <-> topics, /clock, ground truth)."""

@@ -1,18 +1,19 @@
 """The sim bridge node: publishes every robot's sensor topics from the simulated world.
 
 Per robot ``<name>`` (r0, r1, ...) it publishes ``/<name>/scan``, ``gas``, ``bearings``,
-``imu`` and ``odom`` (sensor-data QoS) and subscribes ``/<name>/cmd_vel`` and ``pump``;
+``imu`` and ``odom`` (sensor-data QoS; only the sensors of the engine configuration's
+``sensors``, all by default) and subscribes ``/<name>/cmd_vel`` and ``pump``;
 swarm-wide it publishes ``/clock`` and the ground truth ``/sim/poses``, ``/sim/coverage``
 (and ``/sim/site`` when the site model can be converted). With ``peer_msg_type`` set it
 relays ``/<name>/peers/out`` to the other robots' ``peers/in`` within ``comm_range_m``.
 
-The node holds no simulation logic: :class:`sim_bridge.engine.SimEngine` does the work and
+The node holds no simulation logic: :class:`swarm_sim.engine.SimEngine` does the work and
 :mod:`sim_bridge.conversions` builds the messages. It steps the engine on a wall timer of one
 physics period divided by ``real_time_factor``; in the built-in runtime that timer runs on a
 virtual clock, so a headless simulation goes as fast as the machine allows.
 
 Standalone: ``ros2 run sim_bridge sim_bridge --ros-args -p site_file:=site.yaml
--p robot_count:=6 -p departure:=center``; the mission runner (:mod:`sim_bridge.mission`)
+-p robot_count:=6 -p departure:=center``; the mission runner (:mod:`swarm_experiments.mission`)
 builds it in-process with a site object and start poses instead.
 """
 
@@ -31,15 +32,15 @@ from swarm_runtime.ros import (
     message_module,
     qos_profile_sensor_data,
 )
+from swarm_sim.departure import departure_poses
+from swarm_sim.engine import EngineConfig, SimEngine, SiteGeometry, StepOutput
+from swarm_sim.errors import ConfigurationError, SimulationError
+from swarm_sim.peer_relay import RelayConfig, RelayModel, parse_message_type
+from swarm_sim.site_geometry import geometry_from_site
 
 from sim_bridge import conversions
 from sim_bridge.bridge_parameters import ENGINE_PARAMETERS, config_from_values, values_from_config
-from sim_bridge.departure import departure_poses
-from sim_bridge.engine import EngineConfig, SimEngine, SiteGeometry, StepOutput
-from sim_bridge.errors import ConfigurationError, SimBridgeError
 from sim_bridge.extensions import RobotStates, SimExtension
-from sim_bridge.peer_relay import RelayConfig, RelayModel, parse_message_type
-from sim_bridge.site_geometry import geometry_from_site
 
 __all__ = ['SimBridgeNode', 'main']
 
@@ -73,7 +74,7 @@ class SimBridgeNode(Node):
         """Build the bridge.
 
         Args:
-            site: a :class:`sim_bridge.sites.model.Site` or a :class:`SiteGeometry`; None
+            site: a :class:`swarm_sim.sites.model.Site` or a :class:`SiteGeometry`; None
                 loads the ``site_file`` parameter.
             initial_poses: (N, 3) start poses; None places ``robot_count`` robots on the
                 ``departure`` fan of the site.
@@ -115,25 +116,28 @@ class SimBridgeNode(Node):
         self._poses_pub = self.create_publisher(_swarm.TruePoseArray, '/sim/poses', 10)
         self._coverage_pub = self.create_publisher(_swarm.Coverage, '/sim/coverage', _LATCHED)
         sensor_qos = qos_profile_sensor_data
-        self._scan_pubs = []
-        self._gas_pubs = []
-        self._bearing_pubs = []
-        self._imu_pubs = []
-        self._odom_pubs = []
+        sensors = self.engine.sensors
+        # Per robot, a publisher of each sensor the mission runs (None: not simulated).
+        self._scan_pubs: list[Any] = []
+        self._gas_pubs: list[Any] = []
+        self._bearing_pubs: list[Any] = []
+        self._imu_pubs: list[Any] = []
+        self._odom_pubs: list[Any] = []
+        topics = (
+            ('scan', self._scan_pubs, _sensor.LaserScan),
+            ('gas', self._gas_pubs, _swarm.GasReading),
+            ('bearings', self._bearing_pubs, _swarm.PeerBearingArray),
+            ('imu', self._imu_pubs, _sensor.Imu),
+            ('odometry', self._odom_pubs, _nav.Odometry),
+        )
         for i, name in enumerate(self.robot_names):
-            self._scan_pubs.append(
-                self.create_publisher(_sensor.LaserScan, f'/{name}/scan', sensor_qos)
-            )
-            self._gas_pubs.append(
-                self.create_publisher(_swarm.GasReading, f'/{name}/gas', sensor_qos)
-            )
-            self._bearing_pubs.append(
-                self.create_publisher(_swarm.PeerBearingArray, f'/{name}/bearings', sensor_qos)
-            )
-            self._imu_pubs.append(self.create_publisher(_sensor.Imu, f'/{name}/imu', sensor_qos))
-            self._odom_pubs.append(
-                self.create_publisher(_nav.Odometry, f'/{name}/odom', sensor_qos)
-            )
+            for sensor, pubs, msg_type in topics:
+                topic = f'/{name}/{"odom" if sensor == "odometry" else sensor}'
+                pubs.append(
+                    self.create_publisher(msg_type, topic, sensor_qos)
+                    if sensor in sensors
+                    else None
+                )
             self.create_subscription(
                 _geometry.Twist, f'/{name}/cmd_vel', self._make_cmd_callback(i), 10
             )
@@ -170,7 +174,7 @@ class SimBridgeNode(Node):
             path = str(self.get_parameter('site_file').value)
             if not path:
                 raise ConfigurationError('no site given: set the site_file parameter')
-            from sim_bridge.site_loading import load_site
+            from swarm_sim.site_loading import load_site
 
             site = load_site(path, seed=self.config.seed)
             self._site_model = site
@@ -191,7 +195,7 @@ class SimBridgeNode(Node):
         if self._site_model is None:
             return
         try:
-            from sim_bridge.sites.site_msgs import site_to_ros
+            from sim_bridge.site_msgs import site_to_ros
         except ImportError:
             self.get_logger().warning('no Site message conversion available: /sim/site is off')
             return
@@ -334,7 +338,7 @@ class SimBridgeNode(Node):
 
 def main(args: list[str] | None = None) -> int:
     """Entry point of ``ros2 run sim_bridge sim_bridge``."""
-    return run_node(SimBridgeNode, args, name='sim_bridge', fatal_errors=(SimBridgeError,))
+    return run_node(SimBridgeNode, args, name='sim_bridge', fatal_errors=(SimulationError,))
 
 
 if __name__ == '__main__':

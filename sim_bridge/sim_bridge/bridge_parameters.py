@@ -13,8 +13,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
-from sim_bridge.engine import EngineConfig
-from sim_bridge.errors import ConfigurationError
+from swarm_sim.engine import EngineConfig
+from swarm_sim.errors import ConfigurationError
 
 __all__ = ['ENGINE_PARAMETERS', 'EngineParameter', 'config_from_values', 'values_from_config']
 

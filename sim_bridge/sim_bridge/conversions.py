@@ -14,11 +14,12 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
+from swarm_common.angles import yaw_from_unit_quaternion, yaw_to_quaternion
+from swarm_common.stamps import stamp_from_seconds, stamp_to_seconds
 from swarm_runtime.ros import message_module
-
-from sim_bridge.ground_truth import RoomEntry
-from sim_bridge.sensors.bearings import PeerBearings
-from sim_bridge.sensors.lidar import LidarConfig
+from swarm_sim.ground_truth import RoomEntry
+from swarm_sim.sensors.bearings import PeerBearings
+from swarm_sim.sensors.lidar import LidarConfig
 
 __all__ = [
     'RoomVisitRecord',
@@ -50,28 +51,16 @@ _swarm = message_module('swarm_interfaces')
 
 def seconds_to_stamp(time_s: float) -> object:
     """builtin_interfaces/Time for a time in seconds (rounded to the nanosecond)."""
-    total_ns = round(time_s * 1e9)
-    return _builtin.Time(sec=int(total_ns // 1_000_000_000), nanosec=int(total_ns % 1_000_000_000))
-
-
-def stamp_to_seconds(stamp: object) -> float:
-    """Seconds of a builtin_interfaces/Time."""
-    return float(stamp.sec) + 1e-9 * float(stamp.nanosec)
+    return stamp_from_seconds(time_s, _builtin.Time)
 
 
 def _header(time_s: float, frame_id: str) -> object:
     return _std.Header(stamp=seconds_to_stamp(time_s), frame_id=frame_id)
 
 
-def yaw_to_quaternion(yaw_rad: float) -> tuple[float, float, float, float]:
-    """(x, y, z, w) of a rotation by ``yaw_rad`` about +z."""
-    half = 0.5 * float(yaw_rad)
-    return (0.0, 0.0, math.sin(half), math.cos(half))
-
-
 def quaternion_to_yaw(q: object) -> float:
     """Yaw [rad] of a geometry_msgs/Quaternion (rotation about z only, or its z part)."""
-    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+    return yaw_from_unit_quaternion(q.x, q.y, q.z, q.w)
 
 
 def tag_id_for(robot_name: str) -> str:

@@ -1,6 +1,6 @@
 """RSSI targets in the sim bridge (MSC + PF mission), as a SimExtension.
 
-The ROS-free model is :class:`sim_bridge.rssi_targets.RssiTargetField`. This adapter, every
+The ROS-free model is :class:`swarm_sim.rssi_targets.RssiTargetField`. This adapter, every
 physics step:
 
 * lets robots that stand still within D_th of a target work on it (R_w load/s each) and,
@@ -22,10 +22,11 @@ import math
 from typing import Any
 
 import numpy as np
+from swarm_common.stamps import stamp_from_seconds
 from swarm_runtime.ros import message_module, qos_profile_sensor_data
+from swarm_sim.rssi_targets import Capture, RssiTargetField
 
 from sim_bridge.extensions import RobotStates
-from sim_bridge.rssi_targets import Capture, RssiTargetField
 
 __all__ = ['RssiExtension']
 
@@ -77,8 +78,7 @@ class RssiExtension:
         self._targets_pub = node.create_publisher(swarm.RssiTargetArray, '/sim/targets', 10)
 
     def _stamp(self, time_s: float) -> Any:
-        ns = round(time_s * 1e9)
-        return self._builtin.Time(sec=int(ns // 1_000_000_000), nanosec=int(ns % 1_000_000_000))
+        return stamp_from_seconds(time_s, self._builtin.Time)
 
     def on_step(self, sim_time_s: float, states: RobotStates) -> None:
         """Work, capture, sample and publish for the physics step ending at ``sim_time_s``."""

@@ -8,9 +8,6 @@ import pytest
 import yaml
 from sim_bridge.bridge_node import SimBridgeNode
 from sim_bridge.bridge_parameters import values_from_config
-from sim_bridge.engine import EngineConfig
-from sim_bridge.errors import ConfigurationError
-from sim_bridge.site_loading import load_site
 from swarm_runtime.ros import (
     Node,
     Parameter,
@@ -20,6 +17,9 @@ from swarm_runtime.ros import (
     rclpy,
 )
 from swarm_runtime.simulation import spin_until
+from swarm_sim.engine import EngineConfig
+from swarm_sim.errors import ConfigurationError
+from swarm_sim.site_loading import load_site
 
 FIVE_ROOMS = Path(__file__).parent / 'data' / 'five_rooms.lay'
 CONFIG = Path(__file__).parents[1] / 'config' / 'sim_bridge.yaml'

@@ -4,10 +4,10 @@ import math
 
 import numpy as np
 import pytest
-from sim_bridge.ground_truth import RoomEntry
-from sim_bridge.sensors.bearings import PeerBearings
-from sim_bridge.sensors.lidar import LidarConfig
 from swarm_runtime.messages import cdr_roundtrip
+from swarm_sim.ground_truth import RoomEntry
+from swarm_sim.sensors.bearings import PeerBearings
+from swarm_sim.sensors.lidar import LidarConfig
 
 from sim_bridge import conversions
 

@@ -5,10 +5,10 @@ import math
 import numpy as np
 import pytest
 from sim_bridge.bridge_parameters import ENGINE_PARAMETERS, config_from_values, values_from_config
-from sim_bridge.departure import departure_poses, preferred_directions
-from sim_bridge.engine import EngineConfig
-from sim_bridge.errors import ConfigurationError
-from sim_bridge.peer_relay import RelayConfig, RelayModel, parse_message_type
+from swarm_sim.departure import departure_poses, preferred_directions
+from swarm_sim.engine import EngineConfig
+from swarm_sim.errors import ConfigurationError
+from swarm_sim.peer_relay import RelayConfig, RelayModel, parse_message_type
 
 
 def test_relay_delivers_only_within_range_and_never_to_the_sender():

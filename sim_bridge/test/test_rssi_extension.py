@@ -5,7 +5,7 @@ import math
 import numpy as np
 from sim_bridge.extensions import RobotStates, SimExtension
 from sim_bridge.rssi_extension import RssiExtension
-from sim_bridge.rssi_targets import RssiTargetConfig, RssiTargetField
+from swarm_sim.rssi_targets import RssiTargetConfig, RssiTargetField
 
 
 class RecordingPublisher:

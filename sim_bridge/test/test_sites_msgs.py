@@ -6,9 +6,9 @@ import math
 
 import numpy as np
 import pytest
-from sim_bridge.sites import DeparturePoint, Door, Room, Site, SiteError, generate_site
-from sim_bridge.sites.site_msgs import site_from_ros, site_to_ros
+from sim_bridge.site_msgs import site_from_ros, site_to_ros
 from swarm_runtime.messages import cdr_roundtrip
+from swarm_sim.sites import DeparturePoint, Door, Room, Site, SiteError, generate_site
 
 
 def assert_same_site(a: Site, b: Site) -> None:

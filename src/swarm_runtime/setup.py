@@ -24,7 +24,7 @@ setup(
         (f'share/{PACKAGE_NAME}', ['package.xml']),
         *share_files('config'),
     ],
-    install_requires=['numpy', 'PyYAML', 'rosbags'],
+    install_requires=['numpy', 'PyYAML', 'rosbags', 'mcap'],
     zip_safe=True,
     maintainer='Swarm search maintainers',
     maintainer_email='maintainers@swarm-search.org',

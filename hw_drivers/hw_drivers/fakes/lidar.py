@@ -9,7 +9,14 @@ from dataclasses import dataclass
 
 from hw_drivers.rplidar_protocol import Command
 
-__all__ = ['FakeRPLidar', 'FakeRPLidarPort', 'RectangularRoom', 'encode_sample', 'revolution_bytes']
+__all__ = [
+    'FakeRPLidar',
+    'FakeRPLidarPort',
+    'RectangularRoom',
+    'drifting_scan_frames',
+    'encode_sample',
+    'revolution_bytes',
+]
 
 _INFO_PAYLOAD = bytes((0x18, 29, 1, 7)) + bytes(range(16))
 
@@ -218,3 +225,36 @@ def revolution_bytes(device: FakeRPLidar, revolutions: int) -> bytes:
     data = device.scan_bytes(revolutions * device.samples_per_revolution)
     device.scanning = was_scanning
     return data
+
+
+def drifting_scan_frames(
+    revolutions: int,
+    *,
+    samples_per_revolution: int = 360,
+    start_drift_deg: float = 0.0,
+    room: RectangularRoom | None = None,
+    quality: int = 40,
+    revolution_tag_mm: float = 0.0,
+) -> list[bytes]:
+    """Sample frames (5 bytes each) of ``revolutions`` turns whose start flag drifts.
+
+    The rotation is continuous (angles step by 360 / samples_per_revolution from 0.25°), but
+    the start flag S of revolution ``k`` sits on the sample nearest ``k * start_drift_deg``
+    past the 0° mark, as on a unit whose flag comes a little later every turn: each
+    revolution then spans 360° plus the drift. Ranges come from ``room``, plus
+    ``k * revolution_tag_mm`` in revolution ``k`` (0.25 mm, the distance resolution, makes the
+    samples of every revolution distinct, for tests that match samples one by one).
+    """
+    room = room or RectangularRoom()
+    step = 360.0 / samples_per_revolution
+    starts = [
+        k * samples_per_revolution + round(k * start_drift_deg / step)
+        for k in range(revolutions + 1)
+    ]
+    frames: list[bytes] = []
+    for k in range(revolutions):
+        for i in range(starts[k], starts[k + 1]):
+            angle = (i * step + 0.25) % 360.0
+            distance = room.range_m(angle) * 1000.0 + k * revolution_tag_mm
+            frames.append(encode_sample(angle, distance, quality, start=i == starts[k]))
+    return frames

@@ -42,8 +42,13 @@ class CctResult:
     end_time_s: float
 
 
-def cct_from_bag(path: str | Path, topic: str = TARGETS_TOPIC) -> CctResult:
+def cct_from_bag(
+    path: str | Path, topic: str = TARGETS_TOPIC, *, allow_truncated: bool = False
+) -> CctResult:
     """Read ``topic`` of the bag at ``path`` and compute the CCT.
+
+    ``allow_truncated`` reads a damaged bag as far as it can be read (see
+    :func:`swarm_runtime.bag.read_messages`).
 
     Raises:
         CctError: the bag has no message on ``topic``.
@@ -54,7 +59,7 @@ def cct_from_bag(path: str | Path, topic: str = TARGETS_TOPIC) -> CctResult:
     captured: dict[int, float] = {}
     known: set[int] = set()
     end = math.nan
-    for item in read_messages(path, [topic]):
+    for item in read_messages(path, [topic], allow_truncated=allow_truncated):
         msg = item.message
         stamp = msg.header.stamp.sec + 1e-9 * msg.header.stamp.nanosec
         end = stamp

@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from swarm_common.stamps import stamp_to_seconds
 
 from swarm_analysis.coverage import CoverageSummary, RoomFirstVisit
 from swarm_analysis.plots import plot_coverage_curves, plot_site_paths
@@ -57,10 +58,6 @@ class RecordedRun:
     coverage: CoverageSummary
 
 
-def _seconds(stamp: Any) -> float:
-    return float(stamp.sec) + 1e-9 * float(stamp.nanosec)
-
-
 def _site_geometry(msg: Any) -> tuple[str, np.ndarray, tuple[np.ndarray, ...]]:
     walls = np.asarray(msg.walls, dtype=float).reshape(-1, 4)
     entrance = [np.array([e.x0, e.y0, e.x1, e.y1], dtype=float) for e in msg.entrance]
@@ -70,8 +67,10 @@ def _site_geometry(msg: Any) -> tuple[str, np.ndarray, tuple[np.ndarray, ...]]:
     return str(msg.name), walls, rooms
 
 
-def load_run(bag: str | Path) -> RecordedRun:
+def load_run(bag: str | Path, *, allow_truncated: bool = False) -> RecordedRun:
     """Read a run's ground truth from the bag directory ``bag``.
+
+    ``allow_truncated`` reads a damaged bag as far as it can be read.
 
     Raises:
         ReportError: a topic the report needs is missing from the bag.
@@ -84,12 +83,14 @@ def load_run(bag: str | Path) -> RecordedRun:
     poses: list[np.ndarray] = []
     names: tuple[str, ...] = ()
     end_s = 0.0
-    for item in read_messages(bag, [SITE_TOPIC, POSES_TOPIC, COVERAGE_TOPIC, CLOCK_TOPIC]):
+    for item in read_messages(
+        bag, [SITE_TOPIC, POSES_TOPIC, COVERAGE_TOPIC, CLOCK_TOPIC], allow_truncated=allow_truncated
+    ):
         msg = item.message
         if item.topic == SITE_TOPIC and site_msg is None:
             site_msg = msg
         elif item.topic == POSES_TOPIC:
-            t = _seconds(msg.header.stamp)
+            t = stamp_to_seconds(msg.header.stamp)
             current = tuple(p.robot for p in msg.poses)
             if names and current != names:
                 raise ReportError(f'the robots in {POSES_TOPIC} changed at t = {t:.2f} s')
@@ -99,9 +100,9 @@ def load_run(bag: str | Path) -> RecordedRun:
             end_s = max(end_s, t)
         elif item.topic == COVERAGE_TOPIC:
             coverage_msg = msg
-            end_s = max(end_s, _seconds(msg.header.stamp))
+            end_s = max(end_s, stamp_to_seconds(msg.header.stamp))
         elif item.topic == CLOCK_TOPIC:
-            end_s = max(end_s, _seconds(msg.clock))
+            end_s = max(end_s, stamp_to_seconds(msg.clock))
     missing = [
         topic
         for topic, found in (
@@ -117,7 +118,7 @@ def load_run(bag: str | Path) -> RecordedRun:
     assert coverage_msg is not None
     site_name, walls, rooms = _site_geometry(site_msg)
     visits = [
-        RoomFirstVisit(int(v.room_index), str(v.robot), _seconds(v.stamp))
+        RoomFirstVisit(int(v.room_index), str(v.robot), stamp_to_seconds(v.stamp))
         for v in coverage_msg.visits
     ]
     summary = CoverageSummary.build(int(coverage_msg.rooms_total), visits, end_s, names)

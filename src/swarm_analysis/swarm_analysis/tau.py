@@ -16,6 +16,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from swarm_common.segments import first_entry_fraction
 
 __all__ = [
     'TauError',
@@ -85,7 +86,7 @@ def first_detection(
             continue
         best: tuple[float, int] | None = None
         for i in range(pos.shape[1]):
-            s = _entry_fraction(pos[k - 1, i], pos[k, i], src, radius_m)
+            s = first_entry_fraction(pos[k - 1, i], pos[k, i], src, radius_m)
             if s is not None:
                 t = float(times_s[k - 1] + s * (times_s[k] - times_s[k - 1]))
                 if best is None or t < best[0]:
@@ -93,20 +94,6 @@ def first_detection(
         if best is not None:
             return best
     return None
-
-
-def _entry_fraction(p0: np.ndarray, p1: np.ndarray, c: np.ndarray, r: float) -> float | None:
-    d, f = p1 - p0, p0 - c
-    a, b, cc = float(d @ d), 2.0 * float(f @ d), float(f @ f) - r * r
-    if cc <= 0.0:
-        return 0.0
-    if a <= 0.0:
-        return None
-    disc = b * b - 4.0 * a * cc
-    if disc < 0.0:
-        return None
-    s = (-b - math.sqrt(disc)) / (2.0 * a)
-    return s if 0.0 <= s <= 1.0 else None
 
 
 def tau_from_tracks(
@@ -133,9 +120,15 @@ def tau_from_tracks(
 
 
 def tau_from_bag(
-    path: str | Path, status_topic: str = STATUS_TOPIC, poses_topic: str = POSES_TOPIC
+    path: str | Path,
+    status_topic: str = STATUS_TOPIC,
+    poses_topic: str = POSES_TOPIC,
+    *,
+    allow_truncated: bool = False,
 ) -> TauResult:
     """tau of a recorded simulated mission (rosbag2 directory or .mcap file).
+
+    ``allow_truncated`` reads a damaged bag as far as it can be read.
 
     Raises:
         TauError: if the bag has no status message or no poses of the status's robots.
@@ -146,7 +139,7 @@ def tau_from_bag(
     reported = math.nan
     times: list[float] = []
     rows: list[dict[str, tuple[float, float]]] = []
-    for item in read_messages(path, [status_topic, poses_topic]):
+    for item in read_messages(path, [status_topic, poses_topic], allow_truncated=allow_truncated):
         msg = item.message
         if item.topic == status_topic:
             status = msg

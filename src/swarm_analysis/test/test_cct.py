@@ -5,7 +5,7 @@ import math
 import pytest
 from swarm_analysis.cct import CctError, cct_from_bag
 from swarm_runtime.bag import BagWriter
-from swarm_runtime.ros import message_module
+from swarm_runtime.messages import get_message_module as message_module
 
 swarm = message_module('swarm_interfaces')
 builtin = message_module('builtin_interfaces')

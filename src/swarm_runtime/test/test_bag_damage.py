@@ -1,22 +1,30 @@
-"""Damaged bags: clear errors naming the file, and recovery of everything before the damage."""
+"""Damaged bags: clear errors naming the file, damage never decoded, and recovery of the rest."""
 
 from __future__ import annotations
 
 import shutil
+from array import array
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import pytest
 from swarm_runtime.bag import (
+    BagMessage,
     BagNotFoundError,
     BagWriter,
     CorruptBagError,
     TruncatedBagWarning,
+    read_bag_info,
     read_messages,
 )
 from swarm_runtime.messages import get_message_module
 
 MESSAGES_PER_CHUNK = 10
 CHUNKS = 3
+# Uncompressed chunk layout: record header (9) + chunk header (40, no compression name), then
+# one record per Int32 message: header (9) + channel, sequence, two times (22) + CDR (8).
+CHUNK_HEADER_BYTES = 9 + 40
+INT32_RECORD_BYTES = 9 + 22 + 8
 
 
 @pytest.fixture(scope='module')
@@ -42,18 +50,24 @@ def intact(recording: tuple[Path, list[int]]) -> Path:
 
 
 @pytest.fixture
-def inside_last_chunk(recording: tuple[Path, list[int]]) -> int:
-    """A byte offset in the middle of the third (last) chunk."""
-    chunk_ends = recording[1]
-    return (chunk_ends[1] + chunk_ends[2]) // 2
+def chunk_starts(recording: tuple[Path, list[int]]) -> list[int]:
+    """Byte offset of the second and third chunk (each holds only messages)."""
+    ends = recording[1]
+    return [0, ends[0], ends[1]]
 
 
-def _damaged_copy(intact: Path, tmp_path: Path, damage: callable) -> Path:
+def _damaged_copy(intact: Path, tmp_path: Path, damage: Callable[[bytes], bytes]) -> Path:
     copy = tmp_path / 'damaged'
     shutil.copytree(intact, copy)
     mcap = copy / 'intact.mcap'
     mcap.write_bytes(damage(mcap.read_bytes()))
     return copy
+
+
+def _collect(messages: Iterator[BagMessage], into: list[int]) -> None:
+    """Append each message's data to ``into`` (what was read before an exception)."""
+    for message in messages:
+        into.append(message.message.data)
 
 
 def _recover(path: Path) -> tuple[list[int], list[str]]:
@@ -66,65 +80,134 @@ def test_intact_bag_reads_without_warnings(intact: Path) -> None:
     assert [m.message.data for m in read_messages(intact)] == list(range(30))
 
 
-def test_cut_mcap_raises_naming_the_file(
-    intact: Path, inside_last_chunk: int, tmp_path: Path
+def test_cut_mcap_raises_one_line_naming_the_file(
+    intact: Path, chunk_starts: list[int], tmp_path: Path
 ) -> None:
-    damaged = _damaged_copy(intact, tmp_path, lambda data: data[:inside_last_chunk])
-    with pytest.raises(CorruptBagError, match=r'damaged/intact\.mcap: cannot open the bag'):
+    damaged = _damaged_copy(intact, tmp_path, lambda data: data[: chunk_starts[2] + 100])
+    with pytest.raises(
+        CorruptBagError, match=r'damaged/intact\.mcap: cannot read the bag: .*cut'
+    ) as caught:
         list(read_messages(damaged))
+    assert caught.value.recoverable
+    assert '\n' not in str(caught.value)
+    assert 'allow_truncated' not in str(caught.value)
 
 
-def test_cut_mcap_recovers_every_complete_chunk(
-    intact: Path, inside_last_chunk: int, tmp_path: Path
+@pytest.mark.parametrize(
+    'into_chunk', [0, 30, 49, 49 + 38, 49 + 39, 49 + 5 * 39 + 20, 49 + 10 * 39 - 1]
+)
+def test_a_cut_inside_the_last_chunk_keeps_its_complete_messages(
+    intact: Path, chunk_starts: list[int], tmp_path: Path, into_chunk: int
 ) -> None:
-    damaged = _damaged_copy(intact, tmp_path, lambda data: data[:inside_last_chunk])
+    cut = chunk_starts[2] + into_chunk
+    damaged = _damaged_copy(intact, tmp_path, lambda data: data[:cut])
     values, warnings = _recover(damaged)
-    assert values == list(range(2 * MESSAGES_PER_CHUNK))
+    complete_in_cut_chunk = max(0, (into_chunk - CHUNK_HEADER_BYTES) // INT32_RECORD_BYTES)
+    assert values == list(range(2 * MESSAGES_PER_CHUNK + complete_in_cut_chunk))
     assert any('intact.mcap' in text and 'cut' in text for text in warnings)
 
 
-def test_garbage_in_the_middle_stops_reading_at_the_damage(
-    intact: Path, inside_last_chunk: int, tmp_path: Path
+@pytest.mark.parametrize('compression', ['zstd', 'lz4'])
+def test_a_cut_inside_a_compressed_chunk_keeps_what_decompresses(
+    tmp_path: Path, compression: str
 ) -> None:
+    """Incompressible payloads make many compression blocks; a cut keeps the whole ones."""
+    import numpy as np
+
+    std_msgs = get_message_module('std_msgs')
+    rng = np.random.default_rng(3)
+    path = tmp_path / 'compressed'
+    with BagWriter(path, chunk_compression=compression, chunk_size_bytes=1 << 24) as writer:
+        for index in range(400):  # two chunks of 200 x 4 KiB
+            payload = array('B', bytes(rng.integers(0, 256, 4096, dtype=np.uint8)))
+            writer.write_message('/blob', index, std_msgs.UInt8MultiArray(data=payload))
+            if index == 199:
+                writer.flush()
+    mcap = path / 'compressed.mcap'
+    data = mcap.read_bytes()
+    mcap.write_bytes(data[: len(data) * 3 // 4])  # the middle of the second chunk
+    with pytest.warns(TruncatedBagWarning) as caught:
+        recovered = [m.log_time_ns for m in read_messages(path, allow_truncated=True)]
+    assert any('cut inside a chunk' in str(w.message) for w in caught)
+    # The complete first chunk, and of the second what its whole compression blocks hold
+    # (about half of it, less at most one zstd block of 128 KiB, 32 messages).
+    assert recovered == list(range(len(recovered)))
+    assert 200 + 50 < len(recovered) < 400
+
+
+def test_a_flipped_byte_inside_a_chunk_is_caught_by_its_crc(
+    intact: Path, chunk_starts: list[int], tmp_path: Path
+) -> None:
+    """The payload of message 15 (chunk 2) changes from 15 to 15 + 256: still a valid Int32."""
+    position = chunk_starts[1] + CHUNK_HEADER_BYTES + 5 * INT32_RECORD_BYTES + 9 + 22 + 5
+
+    def flip(data: bytes) -> bytes:
+        assert data[position - 1] == 15
+        return data[:position] + bytes([data[position] ^ 1]) + data[position + 1 :]
+
+    damaged = _damaged_copy(intact, tmp_path, flip)
+    received: list[int] = []
+    with pytest.raises(CorruptBagError, match=r'intact\.mcap: damaged data: .*CRC'):
+        _collect(read_messages(damaged), received)
+    assert received == list(range(10))
+    values, warnings = _recover(damaged)
+    assert values == [*range(10), *range(20, 30)]
+    assert any('CRC' in text and 'skipped' in text for text in warnings)
+
+
+def test_garbage_inserted_into_a_chunk_is_skipped_and_reading_resumes_after_it(
+    intact: Path, chunk_starts: list[int], tmp_path: Path
+) -> None:
+    middle = chunk_starts[1] + 200
+
     def insert_garbage(data: bytes) -> bytes:
-        middle = inside_last_chunk
         return data[:middle] + b'\xde\xad\xbe\xef' * 64 + data[middle:]
 
     damaged = _damaged_copy(intact, tmp_path, insert_garbage)
     with pytest.raises(CorruptBagError, match=r'intact\.mcap'):
         list(read_messages(damaged))
     values, warnings = _recover(damaged)
-    assert values == list(range(len(values)))
-    assert 2 * MESSAGES_PER_CHUNK <= len(values) < MESSAGES_PER_CHUNK * CHUNKS
-    assert any('intact.mcap' in text and 'damaged' in text for text in warnings)
+    assert values == [*range(10), *range(20, 30)]
+    assert any(f'at byte {chunk_starts[1]}' in text and 'resumed' in text for text in warnings)
 
 
-def test_strict_reading_yields_messages_before_the_damage_then_raises(
-    intact: Path, inside_last_chunk: int, tmp_path: Path
+def test_garbage_overwriting_chunk_headers_resumes_at_the_next_intact_chunk(
+    intact: Path, chunk_starts: list[int], tmp_path: Path
 ) -> None:
-    def overwrite_last_chunk(data: bytes) -> bytes:
-        start = inside_last_chunk
-        return data[:start] + b'\xff' * 48 + data[start + 48 :]
+    start = chunk_starts[1] - 20
 
-    damaged = _damaged_copy(intact, tmp_path, overwrite_last_chunk)
+    def overwrite(data: bytes) -> bytes:
+        return data[:start] + b'\xff' * 64 + data[start + 64 :]
+
+    damaged = _damaged_copy(intact, tmp_path, overwrite)
+    values, _ = _recover(damaged)
+    assert values == [*range(10), *range(20, 30)]
+
+
+def test_bytes_that_do_not_fit_the_type_are_not_decoded(tmp_path: Path) -> None:
+    std_msgs = get_message_module('std_msgs')
+    path = tmp_path / 'odd'
+    with BagWriter(path) as writer:
+        writer.write_message('/counter', 0, std_msgs.Int32(data=0))
+        writer.write('/counter', 1, b'\x00\x01\x00\x00\x07\x00\x00\x00\x00\x00\x00\x00')
+        writer.write_message('/counter', 2, std_msgs.Int32(data=2))
     received: list[int] = []
-
-    def read_all() -> None:
-        for message in read_messages(damaged):
-            received.append(message.message.data)
-
-    with pytest.raises(CorruptBagError, match=r'intact\.mcap: damaged data'):
-        read_all()
-    assert received == list(range(len(received)))
-    assert 2 * MESSAGES_PER_CHUNK <= len(received) < MESSAGES_PER_CHUNK * CHUNKS
+    with pytest.raises(CorruptBagError, match=r'at 1 ns does not decode as std_msgs/msg/Int32'):
+        _collect(read_messages(path), received)
+    assert received == [0]
+    values, warnings = _recover(path)
+    assert values == [0, 2]
+    assert any('skipped' in text for text in warnings)
 
 
 def test_missing_metadata_is_reported_and_recoverable(intact: Path, tmp_path: Path) -> None:
     copy = tmp_path / 'unclosed'
     shutil.copytree(intact, copy)
     (copy / 'metadata.yaml').unlink()
-    with pytest.raises(BagNotFoundError, match=r'unclosed/metadata\.yaml is missing'):
+    with pytest.raises(BagNotFoundError, match=r'unclosed/metadata\.yaml is missing') as caught:
         list(read_messages(copy))
+    assert caught.value.recoverable
+    assert 'allow_truncated' not in str(caught.value)
     values, warnings = _recover(copy)
     assert values == list(range(30))
     assert any('metadata.yaml is missing' in text for text in warnings)
@@ -154,8 +237,27 @@ def test_unwritten_recording_without_footer_is_recovered(tmp_path: Path) -> None
         list(read_messages(path))
     values, warnings = _recover(path)
     assert values == [0, 1, 2, 3, 4]
-    assert any('without a data end or footer' in text for text in warnings)
+    assert any('ends without the MCAP data end and footer' in text for text in warnings)
     writer.close()
+
+
+def test_bag_info_of_a_cut_bag_counts_what_can_be_read(
+    intact: Path, chunk_starts: list[int], tmp_path: Path
+) -> None:
+    damaged = _damaged_copy(intact, tmp_path, lambda data: data[: chunk_starts[2] + 100])
+    with pytest.raises(CorruptBagError):
+        read_bag_info(damaged)
+    info = read_bag_info(damaged, allow_truncated=True)
+    assert not info.complete
+    assert info.message_count == 21
+    assert info.recorded_message_count == 30
+    assert info.topics['/counter'].message_count == 21
+    assert info.topics['/counter'].recorded_count == 30
+    (damage,) = info.damage
+    assert damage.offset == chunk_starts[2]
+    assert damage.resumed_at is None
+    assert 'intact.mcap: at byte' in damage.describe()
+    assert read_bag_info(intact, allow_truncated=True).complete
 
 
 def test_missing_bag_and_wrong_file_kinds_are_reported(tmp_path: Path) -> None:
@@ -165,6 +267,9 @@ def test_missing_bag_and_wrong_file_kinds_are_reported(tmp_path: Path) -> None:
     text_file.write_text('hello')
     with pytest.raises(BagNotFoundError, match='not a bag directory'):
         list(read_messages(text_file))
+    (tmp_path / 'empty').mkdir()
+    with pytest.raises(BagNotFoundError, match=r'not a bag \(no metadata.yaml and no \.mcap'):
+        read_messages(tmp_path / 'empty')
 
 
 def test_invalid_metadata_yaml_is_reported(intact: Path, tmp_path: Path) -> None:
@@ -178,3 +283,4 @@ def test_invalid_metadata_yaml_is_reported(intact: Path, tmp_path: Path) -> None
 def test_a_lone_mcap_file_reads_like_its_bag(intact: Path) -> None:
     values = [m.message.data for m in read_messages(intact / 'intact.mcap')]
     assert values == list(range(30))
+    assert read_bag_info(intact / 'intact.mcap').message_count == 30

@@ -12,7 +12,7 @@ import pytest
 import yaml
 from mcap.writer import CompressionType
 from mcap_ros2.writer import Writer as McapRos2Writer
-from swarm_runtime.bag import TruncatedBagWarning, read_bag_info, read_messages
+from swarm_runtime.bag import BagTypeError, TruncatedBagWarning, read_bag_info, read_messages
 from swarm_runtime.messages import get_message_class, get_typestore
 
 CUSTOM_STATUS = 'uint8 battery_percent\nstring mode\n'
@@ -170,3 +170,74 @@ def test_cut_robot_bag_recovers_through_compressed_chunks(robot_bag: Path) -> No
     assert [m.log_time_ns for m in recovered] == sorted(m.log_time_ns for m in recovered)
     assert recovered[0].topic == '/scan'
     assert list(recovered[0].message.ranges) == [1.0, 2.0, 0.0]
+
+
+def _set_recorded_hash(bag: Path, topic: str, digest: str) -> None:
+    path = bag / 'metadata.yaml'
+    metadata = yaml.safe_load(path.read_text())
+    for entry in metadata['rosbag2_bagfile_information']['topics_with_message_count']:
+        if entry['topic_metadata']['name'] == topic:
+            entry['topic_metadata']['type_description_hash'] = digest
+    path.write_text(yaml.safe_dump(metadata))
+
+
+def test_a_definition_matching_its_recorded_hash_is_used(robot_bag: Path) -> None:
+    from swarm_runtime.bag.decoding import definition_hash
+
+    old_hash = definition_hash(
+        'swarm_interfaces/msg/GasReading',
+        OLD_GAS_READING + '\n' + '=' * 80 + '\nMSG: std_msgs/Header\n' + _header_definition(),
+    )
+    assert old_hash != get_typestore().hash_rihs01('swarm_interfaces/msg/GasReading')
+    _set_recorded_hash(robot_bag, '/gas', old_hash)
+    assert [m.message.raw for m in read_messages(robot_bag, topics=['/gas'])] == [200, 201, 202]
+
+
+def test_a_definition_that_contradicts_its_recorded_hash_is_not_used(robot_bag: Path) -> None:
+    _set_recorded_hash(robot_bag, '/gas', 'RIHS01_' + '00' * 32)
+    with pytest.raises(
+        BagTypeError, match=r'/gas: the definition of .*GasReading.* does not match'
+    ):
+        list(read_messages(robot_bag, topics=['/gas']))
+    # The other topics still read; with recovery the bad topic is skipped with a warning.
+    assert len(list(read_messages(robot_bag, topics=['/scan', '/status']))) == 6
+    with pytest.warns(TruncatedBagWarning, match='cannot be decoded; skipped'):
+        recovered = list(read_messages(robot_bag, allow_truncated=True))
+    assert {m.topic for m in recovered} == {'/scan', '/status'}
+
+
+def test_a_recorded_hash_that_matches_the_workspace_type_rescues_a_wrong_definition() -> None:
+    """A recorder that stored a stale definition but the publishers' real type hash."""
+    from swarm_runtime.bag.decoding import Decoder
+
+    decision = Decoder().decision(
+        '/n',
+        'std_msgs/msg/Int32',
+        'ros2msg',
+        'int16 data\n',
+        get_typestore().hash_rihs01('std_msgs/msg/Int32'),
+    )
+    assert decision.source == 'workspace'
+    assert decision.verified
+    assert decision.decode(b'\x00\x01\x00\x00\x07\x00\x00\x00').data == 7
+
+
+def test_a_type_without_stored_definition_needs_a_matching_hash() -> None:
+    from swarm_runtime.bag.decoding import Decoder
+
+    decoder = Decoder()
+    ours = get_typestore().hash_rihs01('std_msgs/msg/Int32')
+    assert decoder.decision('/n', 'std_msgs/msg/Int32', '', '', ours).verified
+    assert not decoder.decision('/n', 'std_msgs/msg/Int32', '', '', '').verified
+    with pytest.raises(BagTypeError, match='stores no definition'):
+        decoder.decision('/n', 'std_msgs/msg/Int32', '', '', 'RIHS01_' + 'ab' * 32)
+    with pytest.raises(BagTypeError, match='not known here'):
+        decoder.decision('/n', 'robot_msgs/msg/Unknown', '', '', '')
+
+
+def test_messages_decode_to_the_same_classes_on_either_runtime(robot_bag: Path) -> None:
+    """Analysis code gets generated classes whatever runtime the process selected."""
+    from swarm_runtime.messages import is_message
+
+    read = list(read_messages(robot_bag))
+    assert all(is_message(m.message) for m in read)

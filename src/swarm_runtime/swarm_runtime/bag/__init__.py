@@ -17,8 +17,9 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
-from .errors import BagError, BagNotFoundError, BagWriteError, CorruptBagError
+from .errors import BagError, BagNotFoundError, BagTypeError, BagWriteError, CorruptBagError
 from .reader import (
+    BagDamage,
     BagInfo,
     BagMessage,
     TopicSummary,
@@ -33,12 +34,14 @@ if TYPE_CHECKING:
     from .recorder import BagRecorder
 
 __all__ = [
+    'BagDamage',
     'BagError',
     'BagInfo',
     'BagMessage',
     'BagNotFoundError',
     'BagPlayer',
     'BagRecorder',
+    'BagTypeError',
     'BagWriteError',
     'BagWriter',
     'CorruptBagError',

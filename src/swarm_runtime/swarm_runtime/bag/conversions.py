@@ -15,6 +15,7 @@ from rosbags.interfaces import (
 
 __all__ = [
     'INFINITE_QOS_TIME',
+    'matching_profile',
     'nanoseconds_to_qos_time',
     'qos_from_rosbags',
     'qos_time_to_nanoseconds',
@@ -104,3 +105,30 @@ def _finite(value: QosTime) -> int:
     """Recorded duration for a profile: rmw's infinity becomes 0 ('use the default')."""
     nanoseconds = qos_time_to_nanoseconds(value)
     return 0 if nanoseconds >= _INFINITE_NS else nanoseconds
+
+
+def matching_profile(
+    rclpy_module: Any,
+    *,
+    all_reliable: bool,
+    all_latched: bool,
+    depth: int,
+    **durations: Any,
+) -> Any:
+    """A KEEP_LAST ``QoSProfile`` that matches (or offers to) every one of a set of profiles.
+
+    Reliable only if all of them are, transient-local only if all of them are: what
+    rosbag2 subscribes with when recording and offers when replaying.
+    """
+    qos = rclpy_module.qos
+    return qos.QoSProfile(
+        history=qos.HistoryPolicy.KEEP_LAST,
+        depth=depth,
+        reliability=(
+            qos.ReliabilityPolicy.RELIABLE if all_reliable else qos.ReliabilityPolicy.BEST_EFFORT
+        ),
+        durability=(
+            qos.DurabilityPolicy.TRANSIENT_LOCAL if all_latched else qos.DurabilityPolicy.VOLATILE
+        ),
+        **durations,
+    )

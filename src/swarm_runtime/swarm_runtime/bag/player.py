@@ -15,18 +15,60 @@ next instant at once, for callers that drive the replay themselves.
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Iterator
+import fnmatch
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
-from ..ros import Node, QoSProfile, message_module, rclpy
-from .conversions import qos_from_rosbags
-from .reader import BagMessage, read_bag_info, read_messages
+from rosbags.interfaces import Qos, QosDurability, QosHistory, QosReliability
 
-__all__ = ['CLOCK_TOPIC', 'BagPlayer']
+from ..ros import (
+    Node,
+    QoSProfile,
+    message_module,
+    rclpy,
+)
+from .conversions import matching_profile, qos_from_rosbags
+from .reader import BagMessage, TopicSummary, read_bag_info, read_messages
+
+__all__ = ['CLOCK_TOPIC', 'BagPlayer', 'replay_qos']
 
 CLOCK_TOPIC = '/clock'
 _DEFAULT_QOS_DEPTH = 10
+
+
+def _selector(topics: Iterable[str] | None) -> Callable[[str], bool]:
+    if topics is None:
+        return lambda _topic: True
+    patterns = [topics] if isinstance(topics, str) else list(topics)
+    return lambda topic: any(fnmatch.fnmatchcase(topic, p) for p in patterns)
+
+
+def replay_qos(offered: Sequence[Qos]) -> QoSProfile:
+    """The QoS a replay publisher offers, from a topic's recorded offered profiles.
+
+    As ``ros2 bag play`` adapts them: reliable only if every recorded publisher was,
+    transient-local only if every one was; otherwise the most permissive choice, so every
+    subscription that matched one of the recorded publishers matches the replay. History is
+    the recorded KEEP_LAST depth where the middleware reported one; where it reported none
+    (history UNKNOWN, depth 0: DDS discovery does not carry it) a latched topic keeps its last
+    message and any other topic gets rclpy's default depth of 10.
+    """
+    if not offered:
+        return QoSProfile(depth=_DEFAULT_QOS_DEPTH)
+    latched = all(q.durability == QosDurability.TRANSIENT_LOCAL for q in offered)
+    depths = [q.depth for q in offered if q.history == QosHistory.KEEP_LAST and q.depth > 0]
+    base = qos_from_rosbags(offered[0], rclpy)
+    return matching_profile(
+        rclpy,
+        all_reliable=all(q.reliability == QosReliability.RELIABLE for q in offered),
+        all_latched=latched,
+        depth=max(depths) if depths else (1 if latched else _DEFAULT_QOS_DEPTH),
+        deadline=base.deadline,
+        lifespan=base.lifespan,
+        liveliness=base.liveliness,
+        liveliness_lease_duration=base.liveliness_lease_duration,
+    )
 
 
 class BagPlayer(Node):
@@ -39,7 +81,7 @@ class BagPlayer(Node):
         rate: Playback speed factor (2.0 replays twice as fast).
         publish_clock: Publish ``/clock`` (rosgraph_msgs/Clock) with the bag's time.
         start_paused: Do not schedule playback; call :meth:`play` or :meth:`step`.
-        allow_truncated: Replay a damaged bag up to its damage.
+        allow_truncated: Replay a damaged bag as far as it can be read.
         node_name: Name of the player node.
         **node_kwargs: Passed to ``Node`` (namespace, context ...).
 
@@ -63,7 +105,7 @@ class BagPlayer(Node):
         if rate <= 0.0:
             msg = f'rate must be positive, got {rate}'
             raise ValueError(msg)
-        info = read_bag_info(bag) if not allow_truncated else None
+        info = read_bag_info(bag, allow_truncated=allow_truncated)
         super().__init__(node_name, **node_kwargs)
         if self.get_parameter('use_sim_time').value:
             self.destroy_node()
@@ -71,18 +113,18 @@ class BagPlayer(Node):
             raise ValueError(msg)
         self._rate = rate
         self._publish_clock = publish_clock
-        self._qos = {
-            topic: summary.offered_qos_profiles[0]
-            for topic, summary in (info.topics.items() if info is not None else ())
-            if summary.offered_qos_profiles
-        }
-        replayed = (lambda topic: topic != CLOCK_TOPIC) if publish_clock else (lambda topic: True)
-        self._messages: Iterator[BagMessage] = (
-            m
-            for m in read_messages(bag, topics, allow_truncated=allow_truncated, raw=True)
-            if replayed(m.topic)
-        )
+        selected = _selector(topics)
         self._publishers_by_topic: dict[str, Any] = {}
+        for topic, summary in sorted(info.topics.items()):
+            if (publish_clock and topic == CLOCK_TOPIC) or not selected(topic):
+                continue
+            publisher = self._create_replay_publisher(topic, summary)
+            if publisher is not None:
+                self._publishers_by_topic[topic] = publisher
+        replayed = set(self._publishers_by_topic)
+        self._messages: Iterator[BagMessage] = read_messages(
+            bag, sorted(replayed), allow_truncated=allow_truncated, raw=True
+        )
         self._clock_publisher = (
             self.create_publisher(
                 message_module('rosgraph_msgs').Clock, CLOCK_TOPIC, QoSProfile(depth=1)
@@ -149,21 +191,31 @@ class BagPlayer(Node):
         self._pending = pending
         return log_time
 
+    def _create_replay_publisher(self, topic: str, summary: TopicSummary) -> Any:
+        """A publisher of ``topic`` with the recorded QoS; None if its type is not available."""
+        package, _, name = summary.typename.split('/')
+        try:
+            msg_type = getattr(message_module(package), name)
+        except (ImportError, AttributeError, LookupError):
+            self.get_logger().warning(
+                f'not replaying {topic}: message type {summary.typename} is not available here'
+            )
+            return None
+        return self.create_publisher(msg_type, topic, replay_qos(summary.offered_qos_profiles))
+
+    def subscription_counts(self) -> dict[str, int]:
+        """Topic -> number of subscriptions matched by its replay publisher.
+
+        On real DDS, wait until the nodes under test are matched (discovery takes time)
+        before :meth:`play` or :meth:`step`; create the player with ``start_paused=True``.
+        """
+        return {
+            topic: publisher.get_subscription_count()
+            for topic, publisher in self._publishers_by_topic.items()
+        }
+
     def _publisher_for(self, message: BagMessage) -> Any:
-        publisher = self._publishers_by_topic.get(message.topic)
-        if publisher is None:
-            package, _, name = message.typename.split('/')
-            recorded = self._qos.get(message.topic)
-            qos = (
-                qos_from_rosbags(recorded, rclpy)
-                if recorded is not None
-                else QoSProfile(depth=_DEFAULT_QOS_DEPTH)
-            )
-            publisher = self.create_publisher(
-                getattr(message_module(package), name), message.topic, qos
-            )
-            self._publishers_by_topic[message.topic] = publisher
-        return publisher
+        return self._publishers_by_topic[message.topic]
 
     def _schedule(self) -> None:
         """(Re)arm the one-shot timer for the pending instant."""

@@ -1,24 +1,25 @@
 """Reading rosbag2 bags (ours or a robot's ``ros2 bag record -s mcap``) as message objects.
 
 :func:`read_messages` yields :class:`BagMessage` tuples in log-time order. Messages are
-decoded into the generated classes of :mod:`swarm_runtime.messages`, or into the real rclpy
-classes when the process runs on real rclpy (``swarm_runtime.ros`` selected it). Types the
-bag defines differently from this workspace (an older swarm_interfaces, a robot's custom
-package) are decoded with the definitions stored in the bag itself.
+decoded with the definitions stored in the bag (see :mod:`swarm_runtime.bag.decoding`), into
+the generated classes of :mod:`swarm_runtime.messages`, whichever runtime the process uses:
+the shared classes where the bag's type is identical to this workspace's (same RIHS01 hash),
+classes generated from the bag's definition otherwise. Analysis code therefore sees the same
+objects on the built-in runtime and on real rclpy.
 
 Damage is reported, never glossed over: a missing or unreadable file raises a
-:class:`~swarm_runtime.bag.errors.BagError` that names the file and the problem. With
-``allow_truncated=True`` the reader instead recovers what it can: it falls back to a
-streaming scan of the MCAP records (a bag whose recorder died has no MCAP summary and no
-metadata.yaml), returns every message before the damage and stops there with a
-:class:`TruncatedBagWarning`.
+:class:`~swarm_runtime.bag.errors.BagError` that names the file and the problem, a chunk whose
+CRC or structure is wrong is never decoded, and a message whose bytes do not fit its type
+raises. With ``allow_truncated=True`` the reader recovers what it can instead: a file without
+a usable summary (cut, unfinished) is walked record by record, damaged chunks are skipped and
+reading resumes at the next intact one, the complete messages of a chunk cut off by the end
+of the file are kept, and each loss is reported in a :class:`TruncatedBagWarning`.
 """
 
 from __future__ import annotations
 
 import fnmatch
-import struct
-import sys
+import heapq
 import warnings
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field
@@ -26,25 +27,16 @@ from pathlib import Path
 from typing import Any, NamedTuple
 
 import yaml
-from rosbags.highlevel import AnyReader, AnyReaderError
-from rosbags.interfaces import Connection, ConnectionExtRosbag2, Qos
-from rosbags.rosbag2 import ReaderError
-from rosbags.serde import SerdeError
-from rosbags.typesys import (
-    Stores,
-    TypesysError,
-    get_types_from_idl,
-    get_types_from_msg,
-    get_typestore,
-)
-from rosbags.typesys.store import Typestore
+from rosbags.interfaces import Qos
+from rosbags.rosbag2.metadata import parse_qos
 
 from ..messages.errors import MessageError
-from ..messages.fields import referenced_types
-from .errors import BagError, BagNotFoundError, CorruptBagError
-from .mcap_scan import McapScan, ScannedMessage
+from .decoding import Decoder, TypeDecision
+from .errors import BagNotFoundError, BagTypeError, CorruptBagError
+from .mcap_scan import Damage, McapLayout, Segment, SegmentDamageError, open_layout, read_segment
 
 __all__ = [
+    'BagDamage',
     'BagInfo',
     'BagMessage',
     'TopicSummary',
@@ -53,32 +45,9 @@ __all__ = [
     'read_messages',
 ]
 
-# What a damaged file makes rosbags raise: its own errors, and plain ones from reading bogus
-# lengths and offsets (a garbage length can even ask for more memory than exists).
-_READ_ERRORS = (
-    AnyReaderError,
-    ReaderError,
-    SerdeError,
-    TypesysError,
-    MessageError,
-    OSError,
-    ValueError,
-    EOFError,
-    LookupError,
-    ArithmeticError,
-    struct.error,
-    MemoryError,
-    AssertionError,
-)
-
-
-def _error_text(err: BaseException) -> str:
-    text = str(err).strip().rstrip('.')
-    return f'{type(err).__name__}: {text}' if text else type(err).__name__
-
 
 class TruncatedBagWarning(UserWarning):
-    """A damaged bag was read only up to the damage (``allow_truncated=True``)."""
+    """A damaged bag was read with recovery; the text says what was lost, and where."""
 
 
 class BagMessage(NamedTuple):
@@ -94,19 +63,38 @@ class BagMessage(NamedTuple):
 
 
 @dataclass(frozen=True)
+class BagDamage:
+    """Where a storage file is damaged and why (one line from :meth:`describe`)."""
+
+    file: Path
+    offset: int
+    resumed_at: int | None
+    reason: str
+
+    def describe(self) -> str:
+        """'<file>: at byte N: <reason>; reading resumed at byte M' (or: nothing after it)."""
+        return f'{self.file}: {Damage(self.offset, self.resumed_at, self.reason).describe()}'
+
+
+@dataclass(frozen=True)
 class TopicSummary:
-    """What a bag holds for one topic."""
+    """What a bag holds for one topic.
+
+    ``recorded_count`` is the count metadata.yaml gives, when it differs from
+    ``message_count`` (the messages that could be read from a damaged bag).
+    """
 
     topic: str
     typename: str
     message_count: int
     type_hash: str
     offered_qos_profiles: tuple[Qos, ...]
+    recorded_count: int | None = None
 
 
 @dataclass(frozen=True)
 class BagInfo:
-    """Summary of a bag: its files, time span [ns] and topics."""
+    """Summary of a bag: its files, time span [ns], topics and, when recovered, its damage."""
 
     path: Path
     storage_files: tuple[Path, ...]
@@ -114,6 +102,79 @@ class BagInfo:
     end_time_ns: int
     message_count: int
     topics: dict[str, TopicSummary] = field(default_factory=dict)
+    damage: tuple[BagDamage, ...] = ()
+    recorded_message_count: int | None = None
+    problems: tuple[str, ...] = ()
+
+    @property
+    def complete(self) -> bool:
+        """True when nothing in the bag was damaged or missing."""
+        return not self.damage and not self.problems
+
+
+# --------------------------------------------------------------------------- metadata.yaml
+
+
+@dataclass(frozen=True)
+class _TopicMetadata:
+    name: str
+    typename: str
+    type_hash: str
+    offered_qos_profiles: tuple[Qos, ...]
+    message_count: int
+
+
+@dataclass(frozen=True)
+class _Metadata:
+    files: tuple[str, ...]
+    topics: dict[str, _TopicMetadata]
+    message_count: int
+    start_time_ns: int
+    duration_ns: int
+
+
+def _read_metadata(path: Path) -> _Metadata:
+    try:
+        document = yaml.safe_load(path.read_text(encoding='utf-8'))
+        info = document['rosbag2_bagfile_information']
+        storage = info.get('storage_identifier', 'mcap')
+        if storage != 'mcap':
+            msg = f'{path}: storage {storage!r} is not supported (only mcap bags are read)'
+            raise CorruptBagError(msg)
+        if (info.get('compression_mode') or '').lower() not in ('', 'none'):
+            msg = (
+                f'{path}: the bag is compressed as whole files '
+                f'({info.get("compression_mode")}); decompress it first '
+                '(ros2 bag convert) or record with chunk compression'
+            )
+            raise CorruptBagError(msg)
+        topics: dict[str, _TopicMetadata] = {}
+        for entry in info.get('topics_with_message_count') or []:
+            meta = entry['topic_metadata']
+            previous = topics.get(meta['name'])
+            qos = tuple(parse_qos(meta.get('offered_qos_profiles') or []))
+            count = int(entry.get('message_count', 0))
+            if previous is not None:
+                qos = previous.offered_qos_profiles + qos
+                count += previous.message_count
+            topics[meta['name']] = _TopicMetadata(
+                meta['name'],
+                meta['type'],
+                meta.get('type_description_hash', '') or '',
+                qos,
+                count,
+            )
+        return _Metadata(
+            files=tuple(str(name) for name in info['relative_file_paths']),
+            topics=topics,
+            message_count=int(info.get('message_count', 0)),
+            start_time_ns=int(info['starting_time']['nanoseconds_since_epoch']),
+            duration_ns=int(info['duration']['nanoseconds']),
+        )
+    except (OSError, yaml.YAMLError, KeyError, TypeError, ValueError, AttributeError) as err:
+        text = str(err).strip().splitlines()[0] if str(err).strip() else type(err).__name__
+        msg = f'{path}: not a valid rosbag2 metadata file ({text})'
+        raise CorruptBagError(msg) from err
 
 
 # --------------------------------------------------------------------------- locating files
@@ -123,6 +184,7 @@ class BagInfo:
 class _BagFiles:
     root: Path
     storage_files: tuple[Path, ...]
+    metadata: _Metadata | None
     problem: str | None  # why the files cannot be read through metadata.yaml, if they cannot
 
 
@@ -135,28 +197,23 @@ def _locate(path: Path) -> _BagFiles:
         if path.suffix != '.mcap':
             msg = f'{path}: not a bag directory or an .mcap file'
             raise BagNotFoundError(msg)
-        return _BagFiles(path, (path,), None)
+        return _BagFiles(path, (path,), None, None)
 
     on_disk = tuple(sorted(path.glob('*.mcap')))
     metadata_path = path / 'metadata.yaml'
     if not metadata_path.is_file():
-        problem = (
-            f'{metadata_path} is missing (was the recording closed?); '
-            'read with allow_truncated=True to recover what the .mcap files hold'
-        )
-        return _BagFiles(path, on_disk, problem)
-    try:
-        metadata = yaml.safe_load(metadata_path.read_text(encoding='utf-8'))
-        info = metadata['rosbag2_bagfile_information']
-        listed = tuple(path / name for name in info['relative_file_paths'])
-    except (OSError, yaml.YAMLError, KeyError, TypeError) as err:
-        msg = f'{metadata_path}: not a valid rosbag2 metadata file: {err}'
-        raise CorruptBagError(msg) from err
+        if not on_disk:
+            msg = f'{path}: not a bag (no metadata.yaml and no .mcap file)'
+            raise BagNotFoundError(msg)
+        problem = f'{metadata_path} is missing (the recording was not closed)'
+        return _BagFiles(path, on_disk, None, problem)
+    metadata = _read_metadata(metadata_path)
+    listed = tuple(path / Path(name).name for name in metadata.files)
     missing = [str(p) for p in listed if not p.is_file()]
     if missing:
         problem = f'{metadata_path} lists storage files that do not exist: {", ".join(missing)}'
-        return _BagFiles(path, tuple(p for p in listed if p.is_file()) or on_disk, problem)
-    return _BagFiles(path, listed, None)
+        return _BagFiles(path, tuple(p for p in listed if p.is_file()) or on_disk, None, problem)
+    return _BagFiles(path, listed, metadata, None)
 
 
 def _topic_filter(topics: Iterable[str] | None) -> Callable[[str], bool]:
@@ -174,93 +231,133 @@ def _topic_filter(topics: Iterable[str] | None) -> Callable[[str], bool]:
     return lambda topic: topic in names or any(fnmatch.fnmatchcase(topic, p) for p in patterns)
 
 
-# --------------------------------------------------------------------------- decoding
+# --------------------------------------------------------------------------- the bag's files
 
 
-def _real_rclpy_selected() -> bool:
-    """True when node code in this process runs on real rclpy (swarm_runtime.ros chose it)."""
-    ros = sys.modules.get('swarm_runtime.ros')
-    return bool(ros is not None and ros.using_real_rclpy())
+@dataclass(frozen=True)
+class _Channel:
+    """One MCAP channel with what the bag says about its type."""
+
+    topic: str
+    typename: str
+    encoding: str
+    definition: str
+    type_hash: str
+    offered_qos_profiles: tuple[Qos, ...]
 
 
-class _Decoder:
-    """Turns CDR bytes of a connection into message objects.
+class _Source:
+    """The storage files of a bag, mapped, with the damage found so far."""
 
-    Types this workspace knows with the same RIHS01 hash decode into the shared generated
-    classes; any other type decodes with the bag's own definitions.
-    """
+    def __init__(self, files: _BagFiles, *, recover: bool) -> None:
+        self.files = files
+        self.recover = recover
+        self.layouts: list[McapLayout] = []
+        self.channels: dict[tuple[int, int], _Channel] = {}
+        self.damage: list[BagDamage] = []
+        #: Files read by walking their records because their summary could not be used.
+        self.notes: list[str] = []
+        for index, storage_file in enumerate(files.storage_files):
+            try:
+                layout = open_layout(storage_file, walk=recover)
+            except OSError as err:
+                msg = f'{storage_file}: cannot read the file: {err.strerror or err}'
+                raise CorruptBagError(msg) from err
+            if layout.summary_problem is not None and not recover:
+                msg = f'{storage_file}: cannot read the bag: {layout.summary_problem}'
+                raise CorruptBagError(msg, recoverable=True)
+            if layout.damage and not recover:
+                msg = f'{storage_file}: damaged {layout.damage[0].describe()}'
+                raise CorruptBagError(msg, recoverable=True)
+            if layout.summary_problem is not None and not layout.damage:
+                problem = layout.summary_problem
+                self.notes.append(
+                    f'{storage_file}: {problem}; its records were read from the start'
+                )
+            for damage in layout.damage:
+                self.damage.append(
+                    BagDamage(storage_file, damage.offset, damage.resumed_at, damage.reason)
+                )
+            self.layouts.append(layout)
+            for channel_id, channel in layout.channels.items():
+                self.channels[index, channel_id] = self._describe(layout, channel)
 
-    def __init__(self, bag_typestore: Callable[[], Typestore]) -> None:
-        self._bag_typestore = bag_typestore
-        self._bag_registry: Any = None
-        self._real = _real_rclpy_selected()
-        self._decoders: dict[tuple[str, str], Callable[[bytes], Any]] = {}
+    def _describe(self, layout: McapLayout, channel: Any) -> _Channel:
+        schema = layout.schemas.get(channel.schema_id)
+        typename = schema.name if schema is not None else ''
+        meta = self.files.metadata.topics.get(channel.topic) if self.files.metadata else None
+        if meta is not None and meta.typename == typename:
+            type_hash = meta.type_hash
+            qos = meta.offered_qos_profiles
+        else:
+            type_hash = channel.metadata.get('topic_type_hash', '')
+            try:
+                qos = tuple(parse_qos(channel.metadata.get('offered_qos_profiles', '') or []))
+            except (KeyError, TypeError, ValueError, AttributeError):
+                qos = ()
+        return _Channel(
+            topic=channel.topic,
+            typename=typename,
+            encoding=schema.encoding if schema is not None else '',
+            definition=schema.data if schema is not None else '',
+            type_hash=type_hash,
+            offered_qos_profiles=qos,
+        )
 
-    def decode(self, typename: str, digest: str, data: bytes) -> Any:
-        key = (typename, digest)
-        decoder = self._decoders.get(key)
-        if decoder is None:
-            decoder = self._make(typename, digest)
-            self._decoders[key] = decoder
-        return decoder(data)
+    def raw(
+        self, wanted: set[tuple[int, int]], on_damage: Callable[[BagDamage], None]
+    ) -> Iterator[tuple[tuple[int, int], int, bytes]]:
+        """(channel key, log time, CDR bytes) of the wanted channels, in log-time order."""
+        per_file: dict[int, frozenset[int]] = {}
+        for file_index, channel_id in wanted:
+            per_file[file_index] = per_file.get(file_index, frozenset()) | {channel_id}
+        pending: list[tuple[int, int, int, Segment]] = []
+        for file_index in per_file:
+            for segment in self.layouts[file_index].segments:
+                pending.append((segment.start_ns, file_index, segment.offset, segment))
+        pending.sort(key=lambda item: item[:3])
+        heap: list[tuple[int, int, int, list[Any], int]] = []
+        loaded = 0
+        while True:
+            while loaded < len(pending) and (not heap or pending[loaded][0] <= heap[0][0]):
+                _, file_index, _, segment = pending[loaded]
+                order = loaded
+                loaded += 1
+                layout = self.layouts[file_index]
+                try:
+                    messages = read_segment(layout, segment, per_file[file_index])
+                except SegmentDamageError as err:
+                    damage = BagDamage(layout.path, segment.offset, segment.end, str(err))
+                    if not self.recover:
+                        msg = f'{layout.path}: damaged data: {err}'
+                        raise CorruptBagError(msg, recoverable=True) from err
+                    self.damage.append(damage)
+                    on_damage(damage)
+                    continue
+                if messages:
+                    heapq.heappush(heap, (messages[0].log_time_ns, order, 0, messages, file_index))
+            if not heap:
+                return
+            _, order, position, messages, file_index = heapq.heappop(heap)
+            message = messages[position]
+            if position + 1 < len(messages):
+                heapq.heappush(
+                    heap,
+                    (messages[position + 1].log_time_ns, order, position + 1, messages, file_index),
+                )
+            yield (file_index, message.channel_id), message.log_time_ns, message.data
 
-    def _make(self, typename: str, digest: str) -> Callable[[bytes], Any]:
-        if self._real:
-            from rclpy.serialization import deserialize_message
-            from rosidl_runtime_py.utilities import get_message
 
-            cls = get_message(typename)
-            return lambda data: deserialize_message(data, cls)
-
-        from swarm_runtime.messages import MessageRegistry, cdr, default_registry
-
-        registry = default_registry()
-        typestore = registry.typestore
-        ours = typestore.hash_rihs01(typename) if typename in typestore.fielddefs else None
-        theirs = digest or self._bag_hash(typename)
-        if ours is None or (theirs is not None and theirs != ours):
-            if self._bag_registry is None:
-                self._bag_registry = MessageRegistry(self._bag_typestore())
-            registry = self._bag_registry
-        return lambda data: cdr.deserialize_cdr(data, typename, registry)
-
-    def _bag_hash(self, typename: str) -> str | None:
-        """RIHS01 hash of the bag's own definition of ``typename``, if the bag has one."""
-        try:
-            typestore = self._bag_typestore()
-            if typename not in typestore.fielddefs:
-                return None
-            return typestore.hash_rihs01(typename)
-        except (TypesysError, KeyError, ValueError):
-            return None
+def _warn(text: str) -> None:
+    warnings.warn(text, TruncatedBagWarning, stacklevel=4)
 
 
-def _typestore_from_schemas(schemas: Iterable[tuple[str, str, str]]) -> Typestore:
-    """A typestore of the definitions stored in a bag, completed from the Jazzy types."""
-    from swarm_runtime.messages.typestore import jazzy_typestore
-
-    types: dict[str, Any] = {}
-    for name, encoding, text in schemas:
-        if not text:
-            continue
-        if encoding == 'ros2msg':
-            types.update(get_types_from_msg(text, name))
-        elif encoding == 'ros2idl':
-            separator = '=' * 80 + '\n'
-            for part in text.split(separator):
-                body = part.split('\n', 1)[1] if part.startswith('IDL: ') else part
-                if body.strip():
-                    types.update(get_types_from_idl(body))
-    jazzy = jazzy_typestore().fielddefs
-    missing = {n for defs in types.values() for n in referenced_types(defs[1])} - types.keys()
-    while missing:
-        name = missing.pop()
-        if name in jazzy and name not in types:
-            types[name] = jazzy[name]
-            missing |= referenced_types(jazzy[name][1]) - types.keys()
-    typestore = get_typestore(Stores.EMPTY)
-    typestore.register(types)
-    return typestore
+def _open_source(files: _BagFiles, *, recover: bool) -> _Source:
+    if files.problem is not None:
+        if not recover:
+            raise BagNotFoundError(files.problem, recoverable=bool(files.storage_files))
+        _warn(f'{files.problem}; reading the .mcap files it holds')
+    return _Source(files, recover=recover)
 
 
 # --------------------------------------------------------------------------- reading
@@ -278,158 +375,187 @@ def read_messages(
     Args:
         path: A rosbag2 directory (metadata.yaml + .mcap files) or a single .mcap file.
         topics: Topic names or glob patterns ('/r*/scan') to read; None reads all.
-        allow_truncated: Recover a damaged bag: read up to the damage, then stop with a
-            :class:`TruncatedBagWarning` instead of raising.
+        allow_truncated: Recover a damaged bag: read every intact part of it, skip the
+            damage, and report each loss with a :class:`TruncatedBagWarning`.
         raw: Yield the CDR bytes instead of decoding them.
 
     Raises:
         BagNotFoundError: the bag, its metadata.yaml or a listed file does not exist (raised
             by the call itself).
-        CorruptBagError: the bag is damaged (raised while iterating, at the damage; the
-            messages before it have been yielded).
+        CorruptBagError: the bag is damaged (raised on the first ``next()`` when the file's
+            structure is, or while iterating at a damaged chunk or message, after every
+            message before it).
+        BagTypeError: a selected topic's type cannot be decoded (on the first ``next()``).
     """
     files = _locate(Path(path))
     if files.problem is not None and (not allow_truncated or not files.storage_files):
-        raise BagNotFoundError(files.problem)
-    return _iterate(files, _topic_filter(topics), allow_truncated=allow_truncated, raw=raw)
+        raise BagNotFoundError(files.problem, recoverable=bool(files.storage_files))
+    return _iterate(files, _topic_filter(topics), recover=allow_truncated, raw=raw)
 
 
 def _iterate(
-    files: _BagFiles, selected: Callable[[str], bool], *, allow_truncated: bool, raw: bool
+    files: _BagFiles, selected: Callable[[str], bool], *, recover: bool, raw: bool
 ) -> Iterator[BagMessage]:
-    if files.problem is not None:
-        _warn(files.problem)
-        yield from _scan_files(files.storage_files, selected, raw=raw)
-        return
-
-    from swarm_runtime.messages import get_typestore
-
-    reader = AnyReader([files.root], default_typestore=get_typestore())
-    try:
-        reader.open()
-    except _READ_ERRORS as err:
-        problem = f'{_describe_files(files)}: cannot open the bag: {_error_text(err)}'
-        if not allow_truncated:
-            raise CorruptBagError(f'{problem}; allow_truncated=True recovers its messages') from err
-        _warn(problem)
-        yield from _scan_files(files.storage_files, selected, raw=raw)
-        return
-
-    try:
-        connections = [c for c in reader.connections if selected(c.topic)]
-        if not connections:
-            return
-        decoder = _Decoder(lambda: reader.typestore)
-        stream = reader.messages(connections)
-        while True:
-            try:
-                connection, log_time, data = next(stream)
-                message = (
-                    data if raw else decoder.decode(connection.msgtype, connection.digest, data)
-                )
-            except StopIteration:
-                return
-            except (*_READ_ERRORS, BagError) as err:
-                problem = f'{_describe_files(files)}: damaged data: {_error_text(err)}'
-                if not allow_truncated:
-                    raise CorruptBagError(problem) from err
-                _warn(f'{problem}; stopped reading there')
-                return
-            yield BagMessage(connection.topic, connection.msgtype, log_time, message)
-    finally:
-        reader.close()
-
-
-def _describe_files(files: _BagFiles) -> str:
-    return ', '.join(str(p) for p in files.storage_files) or str(files.root)
-
-
-def _warn(text: str) -> None:
-    warnings.warn(text, TruncatedBagWarning, stacklevel=3)
-
-
-def _scan_files(
-    storage_files: Iterable[Path], selected: Callable[[str], bool], *, raw: bool
-) -> Iterator[BagMessage]:
-    """Recovery path: stream every file's records, stop at the first damage."""
-    for storage_file in storage_files:
-        scan = McapScan(storage_file)
-        decoder = _Decoder(
-            lambda scan=scan: _typestore_from_schemas(
-                (s.name, s.encoding, s.data) for s in scan.schemas.values()
+    source = _open_source(files, recover=recover)
+    for note in source.notes:
+        _warn(note)
+    for damage in source.damage:
+        _warn(damage.describe())
+    decoder = Decoder()
+    decisions: dict[tuple[int, int], TypeDecision | None] = {}
+    for key, channel in source.channels.items():
+        if not selected(channel.topic):
+            continue
+        if raw:
+            decisions[key] = None
+            continue
+        try:
+            decisions[key] = decoder.decision(
+                channel.topic,
+                channel.typename,
+                channel.encoding,
+                channel.definition,
+                channel.type_hash,
             )
-        )
-        for record in scan:
-            if not selected(record.channel.topic):
+        except BagTypeError as err:
+            if not recover:
+                raise
+            _warn(f'{err}; skipped')
+    for key, log_time, data in source.raw(
+        set(decisions), lambda damage: _warn(f'{damage.describe()}; that chunk was skipped')
+    ):
+        channel = source.channels[key]
+        decision = decisions[key]
+        if decision is None:
+            message: Any = data
+        else:
+            try:
+                message = decision.decode(data)
+            except MessageError as err:
+                problem = (
+                    f'{files.storage_files[key[0]]}: the message on {channel.topic} at '
+                    f'{log_time} ns does not decode as {channel.typename} ({err})'
+                )
+                if not recover:
+                    raise CorruptBagError(problem) from err
+                _warn(f'{problem}; skipped')
                 continue
-            typename = _typename(scan, record)
-            if raw:
-                message = record.data
-            else:
-                try:
-                    message = decoder.decode(typename, '', record.data)
-                except (*_READ_ERRORS, BagError) as err:
-                    _warn(
-                        f'{storage_file}: message on {record.channel.topic} at '
-                        f'{record.log_time_ns} ns cannot be decoded ({_error_text(err)}); '
-                        'stopped reading there'
-                    )
-                    return
-            yield BagMessage(record.channel.topic, typename, record.log_time_ns, message)
-        if scan.damage is not None:
-            _warn(f'{storage_file}: {scan.damage}; read {scan.message_count} messages before it')
-            return
-
-
-def _typename(scan: McapScan, record: ScannedMessage) -> str:
-    schema = scan.schemas.get(record.channel.schema_id)
-    return schema.name if schema is not None else ''
+        yield BagMessage(channel.topic, channel.typename, log_time, message)
 
 
 # --------------------------------------------------------------------------- summary
 
 
-def read_bag_info(path: str | Path) -> BagInfo:
-    """Summarize an intact bag: files, time span, and per topic type, count, hash and QoS.
+def read_bag_info(path: str | Path, *, allow_truncated: bool = False) -> BagInfo:
+    """Summarize a bag: files, time span, and per topic type, count, hash and offered QoS.
+
+    With ``allow_truncated`` a damaged bag is summarized as far as it can be read: every
+    chunk is read and checked, counts are what can be read, ``damage`` says where the rest
+    was lost and each topic's ``recorded_count`` what metadata.yaml promised.
 
     Raises:
-        BagNotFoundError, CorruptBagError: as :func:`read_messages`.
+        BagNotFoundError, CorruptBagError: as :func:`read_messages` (without recovery).
     """
     files = _locate(Path(path))
-    if files.problem is not None:
-        raise BagNotFoundError(files.problem)
-    from swarm_runtime.messages import get_typestore
-
-    try:
-        with AnyReader([files.root], default_typestore=get_typestore()) as reader:
-            topics: dict[str, TopicSummary] = {}
-            for connection in reader.connections:
-                topics[connection.topic] = _summary(connection, topics.get(connection.topic))
-            count = reader.message_count
-            return BagInfo(
-                path=files.root,
-                storage_files=files.storage_files,
-                start_time_ns=reader.start_time if count else 0,
-                end_time_ns=reader.end_time - 1 if count else 0,
-                message_count=count,
-                topics=topics,
-            )
-    except _READ_ERRORS as err:
-        msg = f'{_describe_files(files)}: cannot open the bag: {_error_text(err)}'
-        raise CorruptBagError(msg) from err
-
-
-def _summary(connection: Connection, previous: TopicSummary | None) -> TopicSummary:
-    ext = connection.ext
-    qos = tuple(ext.offered_qos_profiles) if isinstance(ext, ConnectionExtRosbag2) else ()
-    if previous is not None:
-        return TopicSummary(
-            previous.topic,
-            previous.typename,
-            previous.message_count + connection.msgcount,
-            previous.type_hash,
-            previous.offered_qos_profiles + qos,
+    with warnings.catch_warnings():
+        warnings.simplefilter('ignore', TruncatedBagWarning)
+        source = _open_source(files, recover=allow_truncated)
+        if not allow_truncated:
+            return _info_from_summaries(files, source)
+        counts: dict[str, int] = {}
+        start: int | None = None
+        end = 0
+        for key, log_time, _ in source.raw(set(source.channels), lambda damage: None):
+            topic = source.channels[key].topic
+            counts[topic] = counts.get(topic, 0) + 1
+            start = log_time if start is None else min(start, log_time)
+            end = max(end, log_time)
+    topics: dict[str, TopicSummary] = {}
+    for channel in source.channels.values():
+        topics.setdefault(
+            channel.topic,
+            TopicSummary(
+                channel.topic,
+                channel.typename,
+                counts.get(channel.topic, 0),
+                channel.type_hash,
+                channel.offered_qos_profiles,
+            ),
         )
-    return TopicSummary(
-        connection.topic, connection.msgtype, connection.msgcount, connection.digest, qos
+    metadata = files.metadata
+    if metadata is not None:
+        for name, meta in metadata.topics.items():
+            summary = topics.get(name)
+            if summary is None:
+                topics[name] = TopicSummary(
+                    name, meta.typename, 0, meta.type_hash, meta.offered_qos_profiles, None
+                )
+                summary = topics[name]
+            if meta.message_count != summary.message_count:
+                topics[name] = TopicSummary(
+                    summary.topic,
+                    summary.typename,
+                    summary.message_count,
+                    summary.type_hash,
+                    summary.offered_qos_profiles,
+                    meta.message_count,
+                )
+    total = sum(counts.values())
+    return BagInfo(
+        path=files.root,
+        storage_files=files.storage_files,
+        start_time_ns=start if start is not None else 0,
+        end_time_ns=end,
+        message_count=total,
+        topics=topics,
+        damage=tuple(source.damage),
+        recorded_message_count=metadata.message_count if metadata is not None else None,
+        problems=((files.problem,) if files.problem else ()) + tuple(source.notes),
+    )
+
+
+def _info_from_summaries(files: _BagFiles, source: _Source) -> BagInfo:
+    counts: dict[str, int] = {}
+    topics: dict[str, TopicSummary] = {}
+    start: int | None = None
+    end = 0
+    for (file_index, channel_id), channel in source.channels.items():
+        layout = source.layouts[file_index]
+        counts[channel.topic] = counts.get(channel.topic, 0) + layout.channel_counts.get(
+            channel_id, 0
+        )
+        topics.setdefault(
+            channel.topic,
+            TopicSummary(
+                channel.topic, channel.typename, 0, channel.type_hash, channel.offered_qos_profiles
+            ),
+        )
+    for layout in source.layouts:
+        for segment in layout.segments:
+            start = segment.start_ns if start is None else min(start, segment.start_ns)
+            end = max(end, segment.end_ns)
+    metadata = files.metadata
+    if metadata is not None:
+        for name, meta in metadata.topics.items():
+            counts[name] = meta.message_count
+            topics[name] = TopicSummary(
+                name, meta.typename, 0, meta.type_hash, meta.offered_qos_profiles
+            )
+        if metadata.message_count:
+            start = metadata.start_time_ns
+            end = metadata.start_time_ns + metadata.duration_ns
+    topics = {
+        name: TopicSummary(
+            s.topic, s.typename, counts.get(name, 0), s.type_hash, s.offered_qos_profiles
+        )
+        for name, s in topics.items()
+    }
+    total = sum(counts.values())
+    return BagInfo(
+        path=files.root,
+        storage_files=files.storage_files,
+        start_time_ns=start if (start is not None and total) else 0,
+        end_time_ns=end if total else 0,
+        message_count=total,
+        topics=topics,
     )

@@ -1,0 +1,187 @@
+"""What drivers share: status logging without a line per retry, timer gating, diagnostics text."""
+
+import pytest
+from hw_drivers.aoa_receiver_node import AoaReceiverNode
+from hw_drivers.errors import DeviceUnavailableError
+from hw_drivers.fakes.clock import FakeClock
+from hw_drivers.fakes.locator import FakeLocatorClient, ndjson_payload
+from hw_drivers.node_common import DeviceMonitor, StatusLog, TimerGate, driver_help
+from hw_drivers.rplidar_node import PARAMETERS as LIDAR_PARAMETERS
+from hw_drivers.worker import DeviceWorker, DiagnosticLevel
+from swarm_runtime.ros import Node, Parameter, SingleThreadedExecutor, message_module, rclpy
+from swarm_runtime.simulation import spin_until
+
+diagnostic_msgs = message_module('diagnostic_msgs')
+
+
+class Logger:
+    def __init__(self):
+        self.lines = []
+
+    def info(self, message):
+        self.lines.append(('INFO', message))
+
+    def warning(self, message):
+        self.lines.append(('WARN', message))
+
+    def error(self, message):
+        self.lines.append(('ERROR', message))
+
+
+def test_a_fault_that_persists_is_logged_once_then_every_30_s():
+    clock = FakeClock()
+    logger = Logger()
+    log = StatusLog(logger, clock=clock)
+    for _ in range(100):  # a retry every second for 100 s, always the same failure
+        log.report(DiagnosticLevel.ERROR, 'no port', 'lidar: error while opening: no port')
+        clock.advance(1.0)
+    assert [m for _, m in logger.lines] == [
+        'lidar: error while opening: no port',
+        'lidar: error while opening: no port (for 30 s)',
+        'lidar: error while opening: no port (for 60 s)',
+        'lidar: error while opening: no port (for 90 s)',
+    ]
+    log.report(DiagnosticLevel.OK, 'ok', 'lidar: connected')
+    log.report(DiagnosticLevel.OK, 'ok', 'lidar: connected')
+    clock.advance(100.0)
+    log.report(DiagnosticLevel.OK, 'ok', 'lidar: connected')
+    assert logger.lines[-1] == ('INFO', 'lidar: connected')
+    assert len(logger.lines) == 5  # an OK state gets no reminders
+
+
+def test_a_worker_retrying_with_back_off_logs_one_line_not_one_per_attempt():
+    clock = FakeClock()
+    logger = Logger()
+
+    def connect():
+        raise DeviceUnavailableError('could not open port /dev/rplidar')
+
+    worker = DeviceWorker('lidar', connect, clock=clock)
+    monitor = DeviceMonitor('lidar', '/dev/rplidar', 1.0, logger)
+    monitor.log = StatusLog(logger, clock=clock)
+    for second in range(20):
+        worker.run_once()
+        monitor.entry(second * 10**9, worker)
+        clock.advance(1.0)
+    assert worker.fault_count >= 5  # 1, 2, 4, 5, 5 ... s apart
+    assert len(logger.lines) == 1
+    assert logger.lines[0][1].startswith('lidar: error while opening: could not open port')
+
+
+def test_staleness_is_logged_once_although_its_age_grows():
+    clock = FakeClock()
+    logger = Logger()
+    worker = DeviceWorker('gas', lambda: object(), clock=clock)
+    worker.run_once()  # connected, but no data ever comes
+    monitor = DeviceMonitor('gas', 'fake', 1.0, logger)
+    monitor.log = StatusLog(logger, clock=clock)
+    messages = []
+    for second in range(1, 20):
+        clock.advance(1.0)
+        messages.append(monitor.entry(second * 10**9, worker).message)
+    assert messages[0] == 'stale: no data yet (gas: connected)'
+    assert len(logger.lines) == 1
+
+
+class FakeTimer:
+    def __init__(self):
+        self.canceled = False
+        self.resets = 0
+
+    def is_canceled(self):
+        return self.canceled
+
+    def cancel(self):
+        self.canceled = True
+
+    def reset(self):
+        self.canceled = False
+        self.resets += 1
+
+
+def test_the_timer_gate_stops_and_restarts_a_timer():
+    timer = FakeTimer()
+    gate = TimerGate(timer)
+    gate.update(True)
+    assert timer.resets == 0
+    assert gate.running
+    gate.update(False)
+    gate.update(False)
+    assert timer.canceled
+    gate.update(True)
+    assert gate.running
+    assert timer.resets == 1
+
+
+def test_help_lists_every_parameter_with_its_default():
+    text = driver_help('rplidar_node', 'RPLidar A1 driver node.', LIDAR_PARAMETERS)
+    assert text.startswith('usage: rplidar_node [--help] [--ros-args')
+    for name, default, _ in LIDAR_PARAMETERS:
+        assert f'  {name} ' in text
+        assert repr(default) in text
+
+
+@pytest.fixture
+def ros():
+    rclpy.init()
+    executor = SingleThreadedExecutor()
+    probe = Node('probe')
+    executor.add_node(probe)
+    diagnostics = []
+    probe.create_subscription(
+        diagnostic_msgs.DiagnosticArray, '/diagnostics', diagnostics.append, 10
+    )
+    nodes = []
+
+    def add(node):
+        nodes.append(node)
+        executor.add_node(node)
+        return node
+
+    yield executor, add, diagnostics
+    for node in nodes:
+        node.destroy_node()
+    probe.destroy_node()
+    rclpy.try_shutdown()
+
+
+def test_the_aoa_node_says_the_locator_is_missing_not_connected(ros):
+    executor, add, diagnostics = ros
+    node = add(
+        AoaReceiverNode(
+            parameter_overrides=[
+                Parameter('device_thread', value=False),
+                Parameter('listen_port', value=0),
+                Parameter('stale_timeout_s', value=1.0),
+            ]
+        )
+    )
+    spin_until(executor, lambda: False, max_wall_time_s=2.5)
+    status = diagnostics[-1].status[0]
+    assert status.level == diagnostic_msgs.DiagnosticStatus.ERROR
+    port = node.server.port
+    assert status.message == (
+        f'stale: no data yet (locator not connected (listening on 127.0.0.1:{port}))'
+    )
+    assert 'connected (' not in status.message.replace('not connected (', '')
+    client = FakeLocatorClient(port)
+    try:
+        for k in range(15):
+            client.send(ndjson_payload(k, 'AC', 10.0))
+            spin_until(executor, lambda: False, max_wall_time_s=0.1)
+        status = diagnostics[-1].status[0]
+        assert status.level == diagnostic_msgs.DiagnosticStatus.OK
+        assert status.message == f'locator connected (listening on 127.0.0.1:{port})'
+    finally:
+        client.close()
+    # Disconnected: first a warning, then, once the last bearing is too old, stale.
+    count = len(diagnostics)
+    spin_until(executor, lambda: len(diagnostics) > count, max_wall_time_s=1.1)
+    status = diagnostics[-1].status[0]
+    assert status.level == diagnostic_msgs.DiagnosticStatus.WARN
+    assert status.message == f'AoA locator not connected (listening on 127.0.0.1:{port})'
+    spin_until(executor, lambda: False, max_wall_time_s=2.5)
+    status = diagnostics[-1].status[0]
+    assert status.level == diagnostic_msgs.DiagnosticStatus.ERROR
+    assert status.message.startswith('stale: no data for ')
+    assert status.message.endswith(f'(locator not connected (listening on 127.0.0.1:{port}))')

@@ -1,0 +1,566 @@
+"""Scan features of many robots in one compiled call: what
+:meth:`oabug_robot.scan_features.ScanFeatureExtractor.extract` returns for each of them.
+
+numba is optional: the simulation install compiles these loops, a robot install (no numba)
+runs the same Python loops uncompiled, with the same results; the robots themselves run the
+numpy extractor, which stays the reference. The batch sweep path
+(:mod:`swarm_experiments.oabug_batch`) hands every scan of a physics step to :func:`extract_many`
+instead of calling the extractor once per robot. The features are bit-identical
+(``test_scan_features_kernel.py`` compares them on random scans with NaN and +-inf ranges,
+empty scans and peers with NaN bearings and distances):
+
+* the transcendental functions stay in numpy (``arctan2``, ``sin``, ``cos``), computed for
+  all robots at once: numpy's vectorised ``arctan2`` differs from the C library's in the last
+  place for about 1 % of arguments, and its value of an element does not depend on the
+  array around it;
+* the kernel does only comparisons, products, sums of two terms and minima, in the same
+  order as the numpy code: the ray selection, the peer mask, the front corridor and cone,
+  and the returns of the followed side's window (nearest band, abeam flag);
+* the line fit of the side wall
+  (:meth:`~oabug_robot.scan_features.ScanFeatureExtractor.wall_from_points`) is done here
+  too: its sums are numpy's pairwise sums (the extractor uses no BLAS dot product), which
+  :func:`pairwise_sum` reproduces addition by addition, and its ``atan2``, ``sin`` and
+  ``cos`` are the C library's (``math``) in both.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from typing import TypeVar
+
+import numpy as np
+
+from oabug_robot.errors import ScanError
+from oabug_robot.scan_features import (
+    MIN_FIT_SPREAD_M,
+    LaserScanData,
+    ScanFeatureExtractor,
+    ScanFeatures,
+    SideWall,
+)
+
+_F = TypeVar('_F', bound=Callable[..., object])
+
+try:
+    from numba import njit
+
+    HAVE_NUMBA = True
+except ImportError:  # a robot install: the same loops run uncompiled (slowly), same results
+    HAVE_NUMBA = False
+
+    def njit(*_args: object, **_kwargs: object) -> Callable[[_F], _F]:
+        """Stand-in for numba's decorator when numba is not installed: no compilation."""
+
+        def keep(function: _F) -> _F:
+            return function
+
+        return keep
+
+
+__all__ = [
+    'HAVE_NUMBA',
+    'extract_many',
+    'extract_many_flat',
+    'features_kernel',
+    'pairwise_sum',
+    'side_wall_fit',
+]
+
+_TWO_PI = 2.0 * math.pi
+
+
+@njit(cache=True)
+def _in_window(angle: float, direction: float, half_width: float) -> bool:  # pragma: no cover
+    """The ray at ``angle`` lies in the window of a peer bearing ``direction`` [rad]."""
+    offset = abs(angle - direction)
+    return min(offset, _TWO_PI - offset) <= half_width
+
+
+# numpy's pairwise summation: blocks up to this many elements are added with 8 accumulators.
+_PAIRWISE_BLOCK = 128
+
+
+@njit(cache=True)
+def _block_sum(a: np.ndarray, lo: int, n: int) -> float:  # pragma: no cover - compiled
+    """numpy's sum of ``a[lo:lo + n]`` for ``n <= 128``: fewer than 8 values one after the
+    other from 0.0, else 8 interleaved partial sums combined as
+    ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7)), then the rest one by one."""
+    if n < 8:
+        total = 0.0
+        for i in range(lo, lo + n):
+            total += a[i]
+        return total
+    r0, r1, r2, r3 = a[lo], a[lo + 1], a[lo + 2], a[lo + 3]
+    r4, r5, r6, r7 = a[lo + 4], a[lo + 5], a[lo + 6], a[lo + 7]
+    i = 8
+    while i < n - n % 8:
+        b = lo + i
+        r0 += a[b]
+        r1 += a[b + 1]
+        r2 += a[b + 2]
+        r3 += a[b + 3]
+        r4 += a[b + 4]
+        r5 += a[b + 5]
+        r6 += a[b + 6]
+        r7 += a[b + 7]
+        i += 8
+    total = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
+    for b in range(lo + i, lo + n):
+        total += a[b]
+    return total
+
+
+@njit(cache=True)
+def pairwise_sum(a: np.ndarray, lo: int, n: int) -> float:  # pragma: no cover - compiled
+    """``np.sum(a[lo:lo + n])`` of float64 values, added in numpy's order: blocks of up to
+    128 values as :func:`_block_sum`, longer runs split in two halves (the first a multiple
+    of 8 long) whose sums are added. numpy recurses; here the recursion runs on an explicit
+    stack (numba's on-disk cache does not load recursive functions reliably)."""
+    if n <= _PAIRWISE_BLOCK:
+        return _block_sum(a, lo, n)
+    # Pending ranges: start, length and how far they are (0 new, 1 left half pushed, 2 both).
+    depth = 2 * 64
+    starts = np.empty(depth, dtype=np.int64)
+    lengths = np.empty(depth, dtype=np.int64)
+    stages = np.empty(depth, dtype=np.int64)
+    sums = np.empty(depth)
+    top = 0
+    starts[0], lengths[0], stages[0] = lo, n, 0
+    done = 0
+    while top >= 0:
+        start, length, stage = starts[top], lengths[top], stages[top]
+        half = length // 2
+        half -= half % 8
+        if length <= _PAIRWISE_BLOCK:
+            sums[done] = _block_sum(a, start, length)
+            done += 1
+            top -= 1
+        elif stage == 0:
+            stages[top] = 1
+            top += 1
+            starts[top], lengths[top], stages[top] = start, half, 0
+        elif stage == 1:
+            stages[top] = 2
+            top += 1
+            starts[top], lengths[top], stages[top] = start + half, length - half, 0
+        else:
+            done -= 1
+            sums[done - 1] = sums[done - 1] + sums[done]
+            top -= 1
+    return sums[0]
+
+
+@njit(cache=True)
+def _fit_line(
+    xs: np.ndarray, ls: np.ndarray, n: int, dx: np.ndarray, dl: np.ndarray
+) -> tuple:  # pragma: no cover - compiled
+    """``oabug_robot.scan_features._fit_line`` of the first ``n`` points: (direction [rad],
+    distance [m]); ``dx`` and ``dl`` are scratch of at least ``n`` values."""
+    mx = pairwise_sum(xs, 0, n) / n
+    ml = pairwise_sum(ls, 0, n) / n
+    for m in range(n):
+        dx[m] = xs[m] - mx
+        dl[m] = ls[m] - ml
+    for m in range(n):
+        xs_m = dx[m]
+        dx[m] = xs_m * xs_m
+        dl[m] = xs_m * dl[m]
+    angle = math.atan2(pairwise_sum(dl, 0, n), pairwise_sum(dx, 0, n))
+    return angle, abs(mx * math.sin(angle) - ml * math.cos(angle))
+
+
+@njit(cache=True)
+def side_wall_fit(
+    xs: np.ndarray,
+    ls: np.ndarray,
+    n: int,
+    tolerance: float,
+    min_spread: float,
+    scratch: np.ndarray,
+) -> tuple:  # pragma: no cover - compiled
+    """:meth:`~oabug_robot.scan_features.ScanFeatureExtractor.wall_from_points` of the first
+    ``n >= 1`` points, without the abeam flag: (distance [m], angle [rad]). ``scratch`` is
+    (4, >= n) float64 work space."""
+    lo = xs[0]
+    hi = xs[0]
+    nearest = ls[0]
+    for m in range(1, n):
+        lo = min(lo, xs[m])
+        hi = max(hi, xs[m])
+        nearest = min(nearest, ls[m])
+    if n < 3 or hi - lo < min_spread:
+        return nearest, 0.0
+    angle, distance = _fit_line(xs, ls, n, scratch[0], scratch[1])
+    # Once more without the returns off that line, as the extractor does.
+    sa = math.sin(angle)
+    ca = math.cos(angle)
+    kept_x = scratch[2]
+    kept_l = scratch[3]
+    kept = 0
+    for m in range(n):
+        if abs(xs[m] * sa - ls[m] * ca + distance) <= tolerance:
+            kept_x[kept] = xs[m]
+            kept_l[kept] = ls[m]
+            kept += 1
+    if 3 <= kept < n:
+        angle, distance = _fit_line(kept_x, kept_l, kept, scratch[0], scratch[1])
+    return distance, angle
+
+
+@njit(cache=True)
+def features_kernel(
+    ranges: np.ndarray,
+    half_width: np.ndarray,
+    angles: np.ndarray,
+    cos_t: np.ndarray,
+    sin_t: np.ndarray,
+    bearing_start: np.ndarray,
+    bearing: np.ndarray,
+    bearing_distance: np.ndarray,
+    sides: np.ndarray,
+    params: tuple,
+    front_wall: np.ndarray,
+    front_robot: np.ndarray,
+    near_count: np.ndarray,
+    peer_count: np.ndarray,
+    side_count: np.ndarray,
+    side_x: np.ndarray,
+    side_l: np.ndarray,
+    abeam: np.ndarray,
+    wall_distance: np.ndarray,
+    wall_angle: np.ndarray,
+) -> None:  # pragma: no cover - compiled
+    """Features of K scans of B rays; the outputs are filled in place.
+
+    Args:
+        ranges: (K, B) ranges [m], -inf already replaced by range_min.
+        half_width: (K, B) angular half width of a peer's window at each range [rad], read
+            only where the range is within the peer mask range.
+        angles, cos_t, sin_t: (B,) ray directions in the robot frame.
+        bearing_start: (K + 1,) slice bounds of each scan's peers in ``bearing``.
+        bearing: (T,) peer bearings wrapped to [-pi, pi] [rad]; NaN to skip.
+        bearing_distance: (T,) their coarse distances [m]; NaN where unknown.
+        sides: (K,) the side whose wall is wanted: +1 left, -1 right, 0 none.
+        params: range_min, limit, front_half_width, follow_capture, cone_cos,
+            peer_mask_range, robot_radius, peer_distance_factor, side_lookahead,
+            side_window_behind, side_wall_band, abeam_behind, abeam_reach.
+        front_wall, front_robot: (K,) outputs [m].
+        near_count, peer_count: (K,) outputs: returns within range, those of peers.
+        side_count: (K,) number of returns of the wanted side's nearest band.
+        side_x, side_l: (K, B) their forward and lateral coordinates [m].
+        abeam: (K,) one of them lies abeam.
+        wall_distance, wall_angle: (K,) the side wall fitted to those returns (distance [m]
+            and angle [rad] as seen on the left; read only where ``side_count`` > 0).
+    """
+    (
+        range_min,
+        limit,
+        front_half_width,
+        follow_capture,
+        cone_cos,
+        peer_mask_range,
+        radius,
+        distance_factor,
+        lookahead,
+        behind,
+        band,
+        abeam_behind,
+        abeam_reach,
+        fit_tolerance,
+        min_spread,
+    ) = params
+    body = 2.0 * radius
+    num_scans, num_rays = ranges.shape
+    index = np.empty(num_rays, dtype=np.int64)
+    is_peer = np.empty(num_rays, dtype=np.bool_)
+    xs = np.empty(num_rays)
+    ls = np.empty(num_rays)
+    scratch = np.empty((4, num_rays))
+    for k in range(num_scans):
+        front_wall[k] = np.inf
+        front_robot[k] = np.inf
+        peer_count[k] = 0
+        side_count[k] = 0
+        abeam[k] = False
+        kept = 0
+        any_near = False
+        for j in range(num_rays):
+            r = ranges[k, j]
+            if r >= range_min and r <= limit:
+                index[kept] = j
+                is_peer[kept] = False
+                kept += 1
+                if r <= peer_mask_range:
+                    any_near = True
+        near_count[k] = kept
+        if kept == 0:
+            continue
+        # The peer mask, bearing by bearing.
+        if any_near:
+            for b in range(bearing_start[k], bearing_start[k + 1]):
+                direction = bearing[b]
+                if not math.isfinite(direction):
+                    continue
+                nearest = np.inf
+                for m in range(kept):
+                    j = index[m]
+                    r = ranges[k, j]
+                    if (
+                        r <= peer_mask_range
+                        and r < nearest
+                        and _in_window(angles[j], direction, half_width[k, j])
+                    ):
+                        nearest = r
+                if nearest == np.inf:
+                    continue
+                if bearing_distance[b] > distance_factor * (nearest + radius):
+                    continue  # heard far beyond its nearest return: behind a wall
+                reach = nearest + body
+                for m in range(kept):
+                    j = index[m]
+                    r = ranges[k, j]
+                    if (
+                        r <= peer_mask_range
+                        and r <= reach
+                        and _in_window(angles[j], direction, half_width[k, j])
+                    ):
+                        is_peer[m] = True
+        side = sides[k]
+        count = 0
+        for m in range(kept):
+            j = index[m]
+            r = ranges[k, j]
+            c = cos_t[j]
+            x = r * c
+            y = r * sin_t[j]
+            if is_peer[m]:
+                peer_count[k] += 1
+                if c >= cone_cos and r < front_robot[k]:
+                    front_robot[k] = r
+                continue
+            if x > 0.0 and abs(y) <= front_half_width and x < front_wall[k]:
+                front_wall[k] = x
+            if side == 0 or not (r <= follow_capture and x <= lookahead and x >= -behind):
+                continue
+            if side > 0 and y > 0.0:
+                xs[count] = x
+                ls[count] = y
+                count += 1
+            elif side < 0 and y < 0.0:
+                xs[count] = x
+                ls[count] = -y
+                count += 1
+        if count == 0:
+            continue
+        # Only the nearest wall: the returns within the band of the closest one.
+        closest = ls[0]
+        for m in range(1, count):
+            closest = min(closest, ls[m])
+        cut = closest + band
+        kept_side = 0
+        for m in range(count):
+            if ls[m] <= cut:
+                side_x[k, kept_side] = xs[m]
+                side_l[k, kept_side] = ls[m]
+                if xs[m] >= -abeam_behind and ls[m] <= abeam_reach:
+                    abeam[k] = True
+                kept_side += 1
+        side_count[k] = kept_side
+        wall_distance[k], wall_angle[k] = side_wall_fit(
+            side_x[k], side_l[k], kept_side, fit_tolerance, min_spread, scratch
+        )
+
+
+def _kernel_parameters(
+    extractor: ScanFeatureExtractor, range_min_m: float, range_max_m: float
+) -> tuple[float, ...]:
+    cfg = extractor.config
+    return tuple(
+        float(value)
+        for value in (
+            range_min_m,
+            min(range_max_m, extractor.feature_range_m),
+            cfg.front_half_width_m,
+            cfg.follow_capture_m,
+            math.cos(cfg.robot_cone_half_angle_rad),
+            cfg.peer_mask_range_m,
+            cfg.robot_radius_m,
+            cfg.peer_distance_factor,
+            cfg.side_lookahead_m,
+            cfg.side_window_behind_m,
+            cfg.side_wall_band_m,
+            cfg.abeam_behind_m,
+            cfg.abeam_reach_m,
+            cfg.side_wall_fit_tolerance_m,
+            MIN_FIT_SPREAD_M,
+        )
+    )
+
+
+def _frame(scan: LaserScanData) -> tuple[float, float, float, float]:
+    return (scan.angle_min_rad, scan.angle_increment_rad, scan.range_min_m, scan.range_max_m)
+
+
+def extract_many(
+    extractor: ScanFeatureExtractor,
+    scans: Sequence[LaserScanData],
+    peers: Sequence[tuple[np.ndarray, np.ndarray]],
+    sides: Sequence[int],
+) -> list[ScanFeatures]:
+    """The features ``extractor.extract`` gives for each scan, computed in one call.
+
+    Args:
+        extractor: the extractor whose configuration (and ray table) every robot shares.
+        scans: K scans with the same angles, limits and number of rays.
+        peers: per scan, the peers' bearings [rad] and coarse distances [m] (NaN where
+            unknown), as passed to ``extract``.
+        sides: per scan, the side whose wall is wanted (+1 left, -1 right, 0 none): the
+            same as ``extract(..., sides=(side,) if side else ())``.
+
+    Raises:
+        ScanError: the scans have no rays or their angles are not finite.
+        ValueError: the scans differ in angles, limits or number of rays, or the
+            argument lengths differ.
+    """
+    if not len(scans) == len(peers) == len(sides):
+        msg = f'{len(scans)} scans, {len(peers)} peer sets and {len(sides)} sides'
+        raise ValueError(msg)
+    counts = [len(azimuths) for azimuths, _ in peers]
+    bearing_start = np.zeros(len(scans) + 1, dtype=np.int64)
+    np.cumsum(counts, out=bearing_start[1:])
+    azimuths = distances = np.zeros(0)
+    if bearing_start[-1]:
+        azimuths = np.concatenate([np.asarray(a, dtype=float) for a, _ in peers])
+        distances = np.concatenate(
+            [
+                np.full(len(a), math.nan) if d is None else np.asarray(d, dtype=float)
+                for a, d in peers
+            ]
+        )
+    return extract_many_flat(extractor, scans, bearing_start, azimuths, distances, sides)
+
+
+def extract_many_flat(
+    extractor: ScanFeatureExtractor,
+    scans: Sequence[LaserScanData],
+    bearing_start: np.ndarray,
+    azimuths: np.ndarray,
+    distances: np.ndarray,
+    sides: Sequence[int],
+) -> list[ScanFeatures]:
+    """:func:`extract_many` with the peers of all scans in flat arrays.
+
+    Args:
+        extractor: as for :func:`extract_many`.
+        scans: K scans, as for :func:`extract_many`.
+        bearing_start: (K + 1,) int64 slice bounds of each scan's peers in the arrays below.
+        azimuths: (T,) the peers' bearings [rad] (NaN entries skipped).
+        distances: (T,) their coarse distances [m], NaN where unknown.
+        sides: per scan, the side whose wall is wanted (+1 left, -1 right, 0 none).
+
+    Raises:
+        ScanError: the scans have no rays or their angles are not finite.
+        ValueError: the scans differ in angles, limits or number of rays, or the
+            argument lengths differ.
+    """
+    if len(bearing_start) != len(scans) + 1 or len(sides) != len(scans):
+        msg = f'{len(scans)} scans, {len(bearing_start) - 1} peer sets and {len(sides)} sides'
+        raise ValueError(msg)
+    if len(azimuths) != bearing_start[-1] or len(distances) != bearing_start[-1]:
+        msg = f'{bearing_start[-1]} peers, {len(azimuths)} azimuths, {len(distances)} distances'
+        raise ValueError(msg)
+    if not scans:
+        return []
+    first = scans[0]
+    frame = _frame(first)
+    if any(_frame(scan) != frame for scan in scans[1:]):
+        raise ValueError('the scans must share their angles and range limits')
+    ranges = np.stack([np.asarray(scan.ranges_m, dtype=float) for scan in scans])
+    if ranges.ndim != 2 or ranges.shape[1] == 0:
+        msg = f'scans must have at least one range, got shape {ranges.shape[1:]}'
+        raise ScanError(msg)
+    angles, cos_t, sin_t = extractor.ray_directions(first, ranges.shape[1])
+    cfg = extractor.config
+    range_min = max(float(first.range_min_m), 0.0)
+    # REP 117: -inf means "too close to measure", i.e. an obstacle at range_min.
+    ranges[ranges == -math.inf] = range_min
+    if bearing_start[-1]:
+        azimuths = np.asarray(azimuths, dtype=float)
+        distances = np.asarray(distances, dtype=float)
+        finite = np.isfinite(azimuths)
+        bearing = np.full(azimuths.size, math.nan)
+        bearing[finite] = np.arctan2(np.sin(azimuths[finite]), np.cos(azimuths[finite]))
+        # The kernel reads a ray's window only where it may be a peer's: within the peer
+        # mask range (numpy's arctan2 of an element does not depend on the array around it).
+        half_width = np.full(ranges.shape, math.nan)
+        maskable = ranges <= cfg.peer_mask_range_m
+        half_width[maskable] = cfg.peer_bearing_tolerance_rad + np.arctan2(
+            cfg.robot_radius_m, ranges[maskable]
+        )
+    else:
+        bearing = distances = np.zeros(0)
+        half_width = ranges  # not read: no scan has a peer
+    k, num_rays = ranges.shape
+    front_wall = np.empty(k)
+    front_robot = np.empty(k)
+    near_count = np.empty(k, dtype=np.int64)
+    peer_count = np.empty(k, dtype=np.int64)
+    side_count = np.empty(k, dtype=np.int64)
+    side_x = np.empty((k, num_rays))
+    side_l = np.empty((k, num_rays))
+    abeam = np.empty(k, dtype=np.bool_)
+    wall_distance = np.empty(k)
+    wall_angle = np.empty(k)
+    features_kernel(
+        ranges,
+        half_width,
+        angles,
+        cos_t,
+        sin_t,
+        np.asarray(bearing_start, dtype=np.int64),
+        bearing,
+        distances,
+        np.asarray(sides, dtype=np.int64),
+        _kernel_parameters(extractor, range_min, float(first.range_max_m)),
+        front_wall,
+        front_robot,
+        near_count,
+        peer_count,
+        side_count,
+        side_x,
+        side_l,
+        abeam,
+        wall_distance,
+        wall_angle,
+    )
+    # The outputs as Python numbers once (the same values), not element by element.
+    walls_ahead, robots_ahead = front_wall.tolist(), front_robot.tolist()
+    nears, peer_counts = near_count.tolist(), peer_count.tolist()
+    side_counts, abeams = side_count.tolist(), abeam.tolist()
+    wall_distances, wall_angles = wall_distance.tolist(), wall_angle.tolist()
+    result = []
+    for i, side in enumerate(sides):
+        if nears[i] == 0:
+            result.append(ScanFeatures())
+            continue
+        left = right = SideWall()
+        if side:
+            wall = SideWall()
+            if side_counts[i]:
+                wall = SideWall(wall_distances[i], wall_angles[i], abeams[i])
+            if side > 0:
+                left = wall
+            else:
+                right = SideWall(wall.distance_m, -wall.angle_rad, wall.abeam)
+        result.append(
+            ScanFeatures(
+                front_wall_m=walls_ahead[i],
+                front_robot_m=robots_ahead[i],
+                left=left,
+                right=right,
+                near_returns=nears[i],
+                peer_returns=peer_counts[i],
+            )
+        )
+    return result

@@ -1,0 +1,64 @@
+"""Planar angles: wrapping, and the yaw-only quaternions of REP 103 (rotation about +z)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+__all__ = [
+    'TWO_PI',
+    'wrap_angle',
+    'yaw_from_quaternion',
+    'yaw_from_unit_quaternion',
+    'yaw_to_quaternion',
+]
+
+TWO_PI = 2.0 * math.pi
+
+
+def wrap_angle(angle_rad: np.ndarray | float) -> np.ndarray | float:
+    """Wrap angles [rad] to (-pi, pi]: a float for a scalar, an array for an array.
+
+    Python floats take a ``math`` path (no array round trip); both paths give the same bits.
+    """
+    if isinstance(angle_rad, float | int):
+        wrapped = math.fmod(angle_rad + math.pi, TWO_PI)
+        if wrapped < 0.0:
+            wrapped += TWO_PI
+        wrapped -= math.pi
+        return wrapped + TWO_PI if wrapped <= -math.pi else wrapped
+    array = np.mod(np.asarray(angle_rad, dtype=float) + math.pi, TWO_PI) - math.pi
+    array = np.where(array <= -math.pi, array + TWO_PI, array)
+    if np.ndim(angle_rad) == 0:
+        return float(array)
+    return array
+
+
+def yaw_to_quaternion(yaw_rad: float) -> tuple[float, float, float, float]:
+    """(x, y, z, w) of a rotation by ``yaw_rad`` about +z."""
+    half = 0.5 * float(yaw_rad)
+    return (0.0, 0.0, math.sin(half), math.cos(half))
+
+
+def yaw_from_quaternion(x: float, y: float, z: float, w: float) -> float:
+    """Yaw [rad] (rotation about +z) of the quaternion (x, y, z, w), normalised or not.
+
+    Raises:
+        ValueError: a zero or non-finite quaternion, which has no orientation.
+    """
+    norm_sq = x * x + y * y + z * z + w * w
+    if not norm_sq > 0.0 or not math.isfinite(norm_sq):
+        msg = f'quaternion ({x}, {y}, {z}, {w}) has no orientation'
+        raise ValueError(msg)
+    return math.atan2(2.0 * (w * z + x * y), w * w + x * x - y * y - z * z)
+
+
+def yaw_from_unit_quaternion(x: float, y: float, z: float, w: float) -> float:
+    """Yaw [rad] of a unit quaternion (x, y, z, w), as ``atan2(2 (wz + xy), 1 - 2 (y^2 + z^2))``.
+
+    Equal to :func:`yaw_from_quaternion` for unit quaternions up to the last bit (the two
+    formulas round differently for about one yaw in five); the odometry readers of the
+    Bayes-Swarm and MSC nodes use this one.
+    """
+    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))

@@ -1,0 +1,52 @@
+"""ament_python packaging for swarm_experiments; also what the development install uses."""
+
+from setuptools import find_packages, setup
+
+PACKAGE_NAME = 'swarm_experiments'
+
+setup(
+    name=PACKAGE_NAME,
+    version='0.1.0',
+    packages=find_packages(exclude=['test']),
+    package_data={PACKAGE_NAME: ['py.typed']},
+    data_files=[
+        ('share/ament_index/resource_index/packages', [f'resource/{PACKAGE_NAME}']),
+        (f'share/{PACKAGE_NAME}', ['package.xml']),
+    ],
+    install_requires=[
+        'numpy',
+        'matplotlib',
+        'PyYAML',
+        # Studies: results as Parquet, the distributed engine, progress.
+        'pandas',
+        'pyarrow',
+        'dask',
+        'distributed',
+        'rich',
+        'swarm_common',
+        'swarm_runtime',
+        'swarm_analysis',
+        'swarm_sim',
+        'sim_bridge',
+        # The spawners and batch runners run these algorithms.
+        'oabug_robot',
+        'bayes_swarm',
+        'msc_pf',
+    ],
+    zip_safe=True,
+    maintainer='Swarm search maintainers',
+    maintainer_email='maintainers@swarm-search.org',
+    description=(
+        'Experiment harness: the launch-free spawners, the mission loop, the batch runners of '
+        'the benchmarks, the node parameter overrides and the studies (swarm_study).'
+    ),
+    license='Apache-2.0',
+    entry_points={
+        'console_scripts': [
+            'spawn = swarm_experiments.spawn:main',
+            'spawn_bayes_swarm = swarm_experiments.spawn_bayes_swarm:main',
+            'spawn_msc_pf = swarm_experiments.spawn_msc_pf:main',
+            'swarm_study = swarm_experiments.study.cli:main',
+        ],
+    },
+)

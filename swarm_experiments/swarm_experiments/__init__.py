@@ -1,0 +1,1 @@
+"""Experiment harness: the spawners, the mission loop, batch runners and benchmark helpers."""

@@ -1,0 +1,395 @@
+"""Headless mission runner shared by every spawner: bridge + N robot nodes on sim time.
+
+A mission is one simulated run: the sim bridge node (world, sensors, extensions), one
+algorithm node per robot in its namespace (``/r0``, ``/r1``, ...) with ``use_sim_time`` on,
+an optional rosbag2 recorder, all in one executor. :func:`run_mission` spins it until every
+room is covered, an extension reports its mission done, a caller's predicate says stop, or
+the sim-time budget ends, and returns a :class:`MissionResult` (coverage, trajectories,
+timing). The runner is the only place that knows how the pieces are wired, so the OA-Bug,
+Bayes-Swarm and MSC spawners are short scripts around it::
+
+    spec = MissionSpec(
+        site=site,
+        initial_poses=poses,
+        robots=[RobotNodeSpec(OABugNode, {'robot_index': i}) for i in range(n)],
+        max_sim_time_s=300.0,
+    )
+    result = run_mission(spec, progress=print)
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from sim_bridge.bridge_node import SimBridgeNode
+from sim_bridge.extensions import SimExtension
+from swarm_runtime.ros import (
+    Parameter,
+    QoSDurabilityPolicy,
+    QoSProfile,
+    SingleThreadedExecutor,
+    rclpy,
+    using_real_rclpy,
+)
+from swarm_sim.engine import EngineConfig, SimEngine, StepOutput
+from swarm_sim.errors import ConfigurationError
+from swarm_sim.ground_truth import RoomEntry
+
+from swarm_experiments.errors import MissionError
+
+__all__ = [
+    'MissionProgress',
+    'MissionResult',
+    'MissionSpec',
+    'RecordingSpec',
+    'RobotNodeSpec',
+    'StopReason',
+    'run_mission',
+]
+
+NodeFactory = Callable[..., Any]
+
+# Callbacks run per node after the stop, to deliver the messages of the last step.
+_DRAIN_CALLBACKS_PER_NODE = 20
+
+
+class StopReason:
+    """Why a mission ended (string constants, also used in reports)."""
+
+    ALL_ROOMS_COVERED = 'all_rooms_covered'
+    BUDGET = 'budget'
+    EXTENSION_DONE = 'extension_done'
+    PREDICATE = 'predicate'
+
+
+@dataclass(frozen=True)
+class RobotNodeSpec:
+    """How to build one robot's algorithm node.
+
+    Attributes:
+        factory: called as ``factory(namespace='/r0', parameter_overrides=[...])``; a Node
+            subclass whose constructor forwards keyword arguments to rclpy's Node works.
+        parameters: parameter overrides (name -> value); ``use_sim_time`` is set to True.
+    """
+
+    factory: NodeFactory
+    parameters: Mapping[str, Any] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class RecordingSpec:
+    """What to record into a rosbag2 directory (MCAP storage).
+
+    Attributes:
+        path: the bag directory to create; it must not exist yet.
+        topics: absolute topic names to record; None records every topic.
+        latched_topics: topics published once with transient-local durability (the site,
+            the coverage): the recorder subscribes to them transient-local so it gets the
+            message published before it started.
+    """
+
+    path: Path
+    topics: tuple[str, ...] | None = None
+    latched_topics: tuple[str, ...] = ('/sim/site', '/sim/coverage')
+
+
+@dataclass(frozen=True)
+class MissionSpec:
+    """Everything a mission needs.
+
+    Attributes:
+        site: a :class:`swarm_sim.sites.model.Site` (or an engine ``SiteGeometry``).
+        initial_poses: (N, 3) start poses x [m], y [m], yaw [rad]; robot i is ``r{i}``.
+        robots: N node specs, one per robot, in robot order.
+        max_sim_time_s: sim-time budget [s].
+        engine_config: world configuration (seed, rates, noise).
+        bridge_parameters: extra bridge parameters (e.g. peer relay: peer_msg_type,
+            comm_range_m, peer_loss_probability).
+        extensions: mission-specific world parts attached to the bridge.
+        stop_when_all_rooms_covered: end the run once every room is covered.
+        recording: optional bag recording.
+        progress_period_s: sim-time interval between progress reports [s].
+        trajectory_period_s: sim-time interval between stored true poses [s].
+    """
+
+    site: Any
+    initial_poses: np.ndarray
+    robots: Sequence[RobotNodeSpec]
+    max_sim_time_s: float
+    engine_config: EngineConfig = field(default_factory=EngineConfig)
+    bridge_parameters: Mapping[str, Any] = field(default_factory=dict)
+    extensions: Sequence[SimExtension] = ()
+    stop_when_all_rooms_covered: bool = True
+    recording: RecordingSpec | None = None
+    progress_period_s: float = 10.0
+    trajectory_period_s: float = 0.5
+
+    def __post_init__(self) -> None:
+        poses = np.asarray(self.initial_poses, dtype=float)
+        if poses.ndim != 2 or poses.shape[1] != 3:
+            msg = f'initial_poses must have shape (N, 3), got {poses.shape}'
+            raise ConfigurationError(msg)
+        if len(self.robots) != len(poses):
+            msg = f'{len(self.robots)} robot node specs for {len(poses)} start poses'
+            raise ConfigurationError(msg)
+        if not (math.isfinite(self.max_sim_time_s) and self.max_sim_time_s > 0.0):
+            msg = f'max_sim_time_s must be positive and finite, got {self.max_sim_time_s}'
+            raise ConfigurationError(msg)
+        if not (self.progress_period_s > 0.0 and self.trajectory_period_s > 0.0):
+            raise ConfigurationError('progress_period_s and trajectory_period_s must be > 0')
+
+
+@dataclass(frozen=True)
+class MissionProgress:
+    """A progress report.
+
+    Attributes:
+        sim_time_s: sim time [s].
+        wall_time_s: wall time since the run started [s].
+        rooms_covered: rooms entered so far.
+        rooms_total: rooms of the site.
+    """
+
+    sim_time_s: float
+    wall_time_s: float
+    rooms_covered: int
+    rooms_total: int
+
+    @property
+    def coverage(self) -> float:
+        """Covered fraction of the rooms."""
+        return self.rooms_covered / self.rooms_total if self.rooms_total else 1.0
+
+    @classmethod
+    def of_engine(cls, engine: SimEngine, wall_start_s: float) -> MissionProgress:
+        """The progress of ``engine`` now, for a run that started at ``wall_start_s``
+        (a :func:`time.perf_counter` reading)."""
+        return cls(
+            sim_time_s=engine.time_s,
+            wall_time_s=time.perf_counter() - wall_start_s,
+            rooms_covered=engine.coverage.rooms_covered,
+            rooms_total=engine.coverage.rooms_total,
+        )
+
+
+@dataclass(frozen=True)
+class MissionResult:
+    """Outcome of one mission.
+
+    Attributes:
+        robot_names: r0..r{N-1}.
+        site: the site simulated.
+        stop_reason: one of the :class:`StopReason` constants.
+        sim_time_s: sim time at the end [s].
+        wall_time_s: wall time of the run [s].
+        rooms_total: rooms of the site.
+        room_entries: first entries, in order.
+        trajectory_times_s: (T,) sim times of the stored poses [s].
+        trajectories: (T, N, 3) true poses at those times.
+        distance_travelled_m: (N,) path length of each robot [m].
+        bag_path: the recorded bag directory, if any.
+    """
+
+    robot_names: tuple[str, ...]
+    site: Any
+    stop_reason: str
+    sim_time_s: float
+    wall_time_s: float
+    rooms_total: int
+    room_entries: tuple[RoomEntry, ...]
+    trajectory_times_s: np.ndarray
+    trajectories: np.ndarray
+    distance_travelled_m: np.ndarray
+    bag_path: Path | None = None
+
+    @property
+    def rooms_covered(self) -> int:
+        """Rooms entered by the end."""
+        return len(self.room_entries)
+
+    @property
+    def coverage(self) -> float:
+        """Covered fraction of the rooms at the end."""
+        return self.rooms_covered / self.rooms_total if self.rooms_total else 1.0
+
+    def coverage_curve(self) -> tuple[np.ndarray, np.ndarray]:
+        """(times [s], covered fraction) step curve from t = 0 to the end of the run."""
+        times = [0.0, *(e.time_s for e in self.room_entries), self.sim_time_s]
+        counts = [0, *range(1, self.rooms_covered + 1), self.rooms_covered]
+        total = max(self.rooms_total, 1)
+        return np.array(times), np.array(counts, dtype=float) / total
+
+
+class _Observer:
+    """Collects progress and trajectories from the bridge's step listener."""
+
+    def __init__(self, bridge: SimBridgeNode, spec: MissionSpec) -> None:
+        self.bridge = bridge
+        self.spec = spec
+        self.times: list[float] = [0.0]
+        self.poses: list[np.ndarray] = [bridge.engine.world.poses]
+        self._next_sample_s = spec.trajectory_period_s
+        bridge.step_listeners.append(self.on_step)
+
+    def on_step(self, out: StepOutput) -> None:
+        if out.time_s + 1e-9 >= self._next_sample_s:
+            self.times.append(out.time_s)
+            self.poses.append(out.poses)
+            self._next_sample_s += self.spec.trajectory_period_s
+
+
+def _spin_until(executor: Any, predicate: Callable[[], bool]) -> None:
+    """Spin until ``predicate()``; sim-time aware with the built-in runtime."""
+    if not using_real_rclpy():
+        try:
+            from swarm_runtime.simulation import spin_until
+        except ImportError:
+            spin_until = None
+        if spin_until is not None:
+            spin_until(executor, predicate)
+            return
+    while not predicate():
+        executor.spin_once(timeout_sec=0.1)
+
+
+def _make_recorder(recording: RecordingSpec) -> Any:
+    """A bag recorder on sim time; built last, so it discovers every topic at once."""
+    try:
+        from swarm_runtime.bag import BagRecorder
+    except ImportError as err:
+        msg = f'bag recording needs swarm_runtime.bag: {err}'
+        raise MissionError(msg) from err
+    topics = list(recording.topics) if recording.topics is not None else None
+    latched = QoSProfile(depth=1, durability=QoSDurabilityPolicy.TRANSIENT_LOCAL)
+    return BagRecorder(
+        recording.path,
+        topics=topics,
+        offered_qos=dict.fromkeys(recording.latched_topics, latched),
+        use_sim_time=True,
+    )
+
+
+def run_mission(
+    spec: MissionSpec,
+    *,
+    progress: Callable[[MissionProgress], None] | None = None,
+    stop: Callable[[MissionProgress], bool] | None = None,
+) -> MissionResult:
+    """Run one mission to its stop condition.
+
+    Args:
+        spec: the mission.
+        progress: called every ``spec.progress_period_s`` of sim time and at the end.
+        stop: optional extra stop predicate, checked at every progress period.
+
+    Raises:
+        MissionError: a node could not be built or failed during the run.
+        ConfigurationError: the spec or a parameter is invalid.
+    """
+    owns_context = not rclpy.ok()
+    if owns_context:
+        rclpy.init(args=[])
+    nodes: list[Any] = []
+    executor = SingleThreadedExecutor()
+    wall_start = time.perf_counter()
+    try:
+        bridge_overrides = [Parameter(k, value=v) for k, v in spec.bridge_parameters.items()]
+        bridge = SimBridgeNode(
+            site=spec.site,
+            initial_poses=np.asarray(spec.initial_poses, dtype=float),
+            engine_config=spec.engine_config,
+            extensions=spec.extensions,
+            parameter_overrides=bridge_overrides,
+        )
+        nodes.append(bridge)
+        for i, robot in enumerate(spec.robots):
+            overrides = [Parameter('use_sim_time', value=True)]
+            overrides += [Parameter(k, value=v) for k, v in robot.parameters.items()]
+            try:
+                node = robot.factory(namespace=f'/r{i}', parameter_overrides=overrides)
+            except Exception as err:
+                msg = f'robot r{i}: its node could not be built: {err}'
+                raise MissionError(msg) from err
+            nodes.append(node)
+        if spec.recording is not None:
+            nodes.append(_make_recorder(spec.recording))
+        for node in nodes:
+            executor.add_node(node)
+        observer = _Observer(bridge, spec)
+        engine = bridge.engine
+        state: dict[str, Any] = {
+            'reason': StopReason.BUDGET,
+            'next_report_s': 0.0,
+            'checked_step': -1,
+        }
+
+        def snapshot() -> MissionProgress:
+            return MissionProgress.of_engine(engine, wall_start)
+
+        def finished() -> bool:
+            # The state only changes at physics steps; skip the checks between them.
+            if engine.step_index == state['checked_step']:
+                return False
+            state['checked_step'] = engine.step_index
+            if spec.stop_when_all_rooms_covered and engine.coverage.complete:
+                state['reason'] = StopReason.ALL_ROOMS_COVERED
+                return True
+            if bridge.extensions and bridge.extensions_done():
+                state['reason'] = StopReason.EXTENSION_DONE
+                return True
+            if engine.time_s + 1e-9 >= spec.max_sim_time_s:
+                state['reason'] = StopReason.BUDGET
+                return True
+            if engine.time_s + 1e-9 >= state['next_report_s']:
+                state['next_report_s'] += spec.progress_period_s
+                report = snapshot()
+                if progress is not None:
+                    progress(report)
+                if stop is not None and stop(report):
+                    state['reason'] = StopReason.PREDICATE
+                    return True
+            return False
+
+        try:
+            _spin_until(executor, finished)
+        except (MissionError, ConfigurationError):
+            raise
+        except Exception as err:
+            msg = f'the mission failed at sim time {engine.time_s:.2f} s: {err!r}'
+            raise MissionError(msg) from err
+        # Deliver what the last step published (e.g. to the bag) without stepping further.
+        bridge.pause()
+        for _ in range(_DRAIN_CALLBACKS_PER_NODE * len(nodes)):
+            executor.spin_once(timeout_sec=0.0)
+        final = snapshot()
+        if progress is not None:
+            progress(final)
+        if observer.times[-1] < engine.time_s:
+            observer.times.append(engine.time_s)
+            observer.poses.append(engine.world.poses)
+        return MissionResult(
+            robot_names=bridge.robot_names,
+            site=spec.site,
+            stop_reason=str(state['reason']),
+            sim_time_s=engine.time_s,
+            wall_time_s=final.wall_time_s,
+            rooms_total=engine.coverage.rooms_total,
+            room_entries=engine.coverage.entries,
+            trajectory_times_s=np.array(observer.times),
+            trajectories=np.stack(observer.poses),
+            distance_travelled_m=engine.distance_travelled_m.copy(),
+            bag_path=spec.recording.path if spec.recording is not None else None,
+        )
+    finally:
+        for node in reversed(nodes):
+            executor.remove_node(node)
+            node.destroy_node()
+        executor.shutdown()
+        if owns_context:
+            rclpy.try_shutdown()

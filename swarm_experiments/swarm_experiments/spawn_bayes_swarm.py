@@ -1,0 +1,505 @@
+"""Bayes-Swarm spawner: N robots seek the strongest source of a signal field.
+
+Plain script, no launch file (``ros2 run swarm_experiments spawn_bayes_swarm`` or
+``python -m swarm_experiments.spawn_bayes_swarm``). It builds an obstacle-free arena for the chosen
+case (the paper's Cases 1-3 or the avalanche field), starts the sim bridge with the signal
+extension and one ``bayes_swarm`` node per robot on sim time, relays peer messages within
+``--comm-range`` with ``--loss``, and runs until a robot is within eps of the source or T_max.
+It prints found or not, tau (Eq. 12) and decision-time statistics, and writes two PNGs: the
+signal field with every robot's path, and one robot's GP mean with its waypoints. With
+``--record`` it writes a rosbag2 (MCAP) bag from which ``swarm_analysis.tau.tau_from_bag``
+recomputes tau.
+
+Example: ``spawn_bayes_swarm --case case1 --robots 5 --seed 1 --out runs/case1``;
+``--param horizon_s=20`` changes any other bayes_swarm node parameter for every robot,
+including those the case sets.
+"""
+
+# ruff: noqa: T201  (main() is a command-line entry point that prints its report)
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+from collections.abc import Sequence
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from sim_bridge.signal_extension import SignalExtension
+from swarm_common.cli import EXIT_SUCCESS, fail
+from swarm_common.errors import SwarmError
+from swarm_sim.engine import EngineConfig, SiteGeometry
+from swarm_sim.errors import ConfigurationError
+from swarm_sim.signal_fields import CASE_NAMES, SignalCase, UnknownCaseError, get_case
+from swarm_sim.signal_mission import SignalMissionModel
+
+from swarm_experiments.bayes_batch import MissionSpec as BatchMissionSpec
+from swarm_experiments.bayes_batch import depot_fan
+from swarm_experiments.cli_args import points_argument
+from swarm_experiments.errors import ExperimentError
+from swarm_experiments.mission import MissionSpec, RecordingSpec, RobotNodeSpec, run_mission
+from swarm_experiments.node_overrides import parse_overrides
+from swarm_experiments.open_field import point_robot_engine_config
+
+__all__ = [
+    'ALGORITHMS',
+    'BayesSwarmRun',
+    'SpawnSettings',
+    'batch_mission_spec',
+    'main',
+    'node_parameter_overrides',
+    'run',
+]
+
+# bayes_swarm node parameters the spawner sets from its own options (see node_parameters);
+# the ones it takes from the case (arena, speed, horizon, ...) may be overridden.
+SPAWNER_PARAMETERS = (
+    'algorithm',
+    'robot_index',
+    'n_robots',
+    'seed',
+    'noise_std',
+    'outer_optimizer',
+)
+
+ALGORITHMS = ('bayes_swarm_p', 'bayes_swarm_o', 'glowworm', 'levy', 'exhaustive')
+DEFAULT_RECORD_TOPICS = (
+    '/clock',
+    '/sim/poses',
+    '/sim/source_search',
+    '/r*/state',
+    '/r*/peers/out',
+)
+GLOWWORM_RATE_HZ = 100.0
+
+
+@dataclass(frozen=True)
+class SpawnSettings:
+    """One run.
+
+    Attributes:
+        algorithm: one of :data:`ALGORITHMS`.
+        case: one of the signal-field cases.
+        robots: swarm size (None: the paper's size for the case).
+        depots: (d, 2) start points (None: the case's depots).
+        seed: seed of the world and of every robot.
+        comm_range_m: peer relay range [m] (inf: unlimited).
+        loss_probability: chance one relayed peer message is lost.
+        noise_std: additive Gaussian measurement noise std.
+        relative_noise: measurement noise std as a fraction of |f|.
+        max_mission_time_s: T_max (None: the case's).
+        outer_optimizer: Bayes-Swarm's Eq. 1 solver (grid, cobyla, pso).
+        record: bag directory to write, or None.
+        out_dir: where the PNGs go (None: no plots).
+        extra_parameters: further node parameters (name -> value).
+    """
+
+    algorithm: str = 'bayes_swarm_p'
+    case: str = 'case1'
+    robots: int | None = None
+    depots: np.ndarray | None = None
+    seed: int = 0
+    comm_range_m: float = math.inf
+    loss_probability: float = 0.0
+    noise_std: float = 0.0
+    relative_noise: float = 0.0
+    max_mission_time_s: float | None = None
+    outer_optimizer: str = 'grid'
+    record: Path | None = None
+    out_dir: Path | None = None
+    extra_parameters: dict[str, Any] = field(default_factory=dict)
+
+
+@dataclass
+class BayesSwarmRun:
+    """Outcome of a spawned run."""
+
+    case: SignalCase
+    settings: SpawnSettings
+    found: bool
+    found_time_s: float
+    finder: str
+    tau: float
+    decision_times_s: dict[str, list[float]]
+    robot_nodes: list[Any]
+    mission: Any
+    plots: list[Path]
+
+    def finder_decision_times_s(self) -> np.ndarray:
+        """Decision times of the finder (all robots if none found) [s]."""
+        if self.finder:
+            return np.array(self.decision_times_s[self.finder])
+        return np.array([t for ts in self.decision_times_s.values() for t in ts])
+
+
+def _check(settings: SpawnSettings) -> SignalCase:
+    if settings.algorithm not in ALGORITHMS:
+        msg = f'unknown algorithm {settings.algorithm!r}; choose one of {", ".join(ALGORITHMS)}'
+        raise ExperimentError(msg)
+    try:
+        case = get_case(settings.case)
+    except UnknownCaseError as err:
+        raise ExperimentError(str(err)) from err
+    if settings.robots is not None and settings.robots < 1:
+        msg = f'--robots must be >= 1, got {settings.robots}'
+        raise ExperimentError(msg)
+    for name in ('noise_std', 'relative_noise'):
+        if getattr(settings, name) < 0.0:
+            msg = f'{name} must be >= 0, got {getattr(settings, name)}'
+            raise ExperimentError(msg)
+    if not settings.comm_range_m > 0.0:
+        msg = f'comm range must be > 0 m, got {settings.comm_range_m}'
+        raise ExperimentError(msg)
+    if settings.max_mission_time_s is not None and not settings.max_mission_time_s > 0.0:
+        msg = f'T_max must be > 0 s, got {settings.max_mission_time_s}'
+        raise ExperimentError(msg)
+    if settings.depots is not None:
+        depots = np.asarray(settings.depots, dtype=float).reshape(-1, 2)
+        x0, x1, y0, y1 = case.arena_m
+        inside = (depots[:, 0] >= x0) & (depots[:, 0] <= x1)
+        inside &= (depots[:, 1] >= y0) & (depots[:, 1] <= y1)
+        if not np.all(inside):
+            msg = f'depots {depots.tolist()} must lie inside the arena {case.arena_m}'
+            raise ExperimentError(msg)
+        case = replace(case, depots_m=depots, depot_direction_offsets_deg=(0.0,))
+    if settings.max_mission_time_s is not None:
+        case = replace(case, max_mission_time_s=float(settings.max_mission_time_s))
+    return case
+
+
+def _arena_site(case: SignalCase) -> SiteGeometry:
+    x0, x1, y0, y1 = case.arena_m
+    return SiteGeometry(
+        walls=np.zeros((0, 2, 2)),
+        room_rects=(np.array([[x0, y0, x1, y1]]),),
+        name=f'{case.name} arena',
+    )
+
+
+def _engine_config(case: SignalCase, seed: int) -> EngineConfig:
+    return point_robot_engine_config(
+        physics_rate_hz=20.0, seed=seed, max_linear_speed_mps=1.05 * case.velocity_mps
+    )
+
+
+def _robot_layout(case: SignalCase, n: int) -> list[tuple[np.ndarray, int, int, float]]:
+    """Start, first-decision fan index (1-based), fan size and offset of every robot."""
+    return [depot_fan(case.depots_m, case.depot_direction_offsets_deg, n, i) for i in range(n)]
+
+
+def node_parameter_overrides(items: Sequence[str]) -> dict[str, Any]:
+    """bayes_swarm node parameters from ``NAME=VALUE`` items, typed and checked before a run.
+
+    Raises:
+        ConfigurationError: a malformed item, an unknown or spawner-set name
+            (:data:`SPAWNER_PARAMETERS`: use ``--algorithm``, ``--robots``, ``--seed``,
+            ``--noise``, ``--outer-optimizer``), a value of the wrong type, or one the node
+            rejects.
+    """
+    from bayes_swarm.node_settings import PARAMETERS, settings_from_values
+
+    declared = {spec.name: spec.default for spec in PARAMETERS}
+    return parse_overrides(items, declared, reserved=SPAWNER_PARAMETERS, check=settings_from_values)
+
+
+def node_parameters(case: SignalCase, settings: SpawnSettings, n: int, i: int) -> dict[str, Any]:
+    """Parameters of robot ``i``'s bayes_swarm node for this case."""
+    _, fan_index, fan_size, offset = _robot_layout(case, n)[i]
+    x0, x1, y0, y1 = case.arena_m
+    params: dict[str, Any] = {
+        'algorithm': settings.algorithm,
+        'robot_index': i,
+        'n_robots': n,
+        'seed': int(settings.seed * 1000 + i),
+        'arena_x_min_m': float(x0),
+        'arena_x_max_m': float(x1),
+        'arena_y_min_m': float(y0),
+        'arena_y_max_m': float(y1),
+        'velocity_mps': float(case.velocity_mps),
+        'horizon_s': float(case.horizon_s),
+        'observation_rate_hz': float(case.observation_rate_hz),
+        'detection_radius_m': float(case.detection_radius_m),
+        'max_mission_time_s': float(case.max_mission_time_s),
+        'initial_direction_range_deg': float(case.direction_range_deg),
+        'initial_direction_offset_deg': float(offset),
+        'fan_index': int(fan_index),
+        'fan_size': int(fan_size),
+        'max_signal': float(case.max_signal),
+        'lipschitz': float(case.lipschitz),
+        'noise_std': float(max(1e-3, settings.noise_std)),
+        'outer_optimizer': settings.outer_optimizer,
+        'dimensionless_acquisition': case.dimensionless_acquisition,
+    }
+    params.update(settings.extra_parameters)
+    return params
+
+
+def batch_mission_spec(
+    case: SignalCase,
+    *,
+    noise_std: float = 0.0,
+    comm_range_m: float | None = None,
+    partition: str = 'strips',
+    planner_options: dict[str, Any] | None = None,
+) -> Any:
+    """The case as a spec of the ROS-free batch simulator (:mod:`swarm_experiments.bayes_batch`).
+
+    The planners get the case's settings (arena, V, T, f_Hz, eps, T_max, delta theta, M, L),
+    never its source; ``planner_options`` override BayesSwarmConfig fields. With measurement
+    noise the GP noise term is raised to it unless ``planner_options`` sets ``gp``.
+    """
+    from bayes_swarm.settings import Arena, BayesSwarmConfig, ExhaustiveConfig
+
+    planner = BayesSwarmConfig(
+        arena=Arena(*case.arena_m),
+        velocity_mps=case.velocity_mps,
+        horizon_s=case.horizon_s,
+        observation_rate_hz=case.observation_rate_hz,
+        detection_radius_m=case.detection_radius_m,
+        max_mission_time_s=case.max_mission_time_s,
+        initial_direction_range_deg=case.direction_range_deg,
+        max_signal=case.max_signal,
+        lipschitz=case.lipschitz,
+        dimensionless_acquisition=case.dimensionless_acquisition,
+    )
+    options = dict(planner_options or {})
+    if noise_std > 0.0:
+        options.setdefault(
+            'gp', replace(planner.gp, noise_std=max(noise_std, planner.gp.noise_std))
+        )
+    return BatchMissionSpec(
+        field=case.field,
+        source_m=case.source_m,
+        depots_m=case.depots_m,
+        planner=replace(planner, **options),
+        depot_direction_offsets_deg=case.depot_direction_offsets_deg,
+        noise_std=noise_std,
+        comm_range_m=comm_range_m,
+        exhaustive=ExhaustiveConfig(partition=partition),
+    )
+
+
+def _initial_yaw(case: SignalCase, fan_index: int, fan_size: int, offset: float) -> float:
+    if math.isclose(case.direction_range_deg, 360.0):
+        theta = fan_index * case.direction_range_deg / fan_size
+    else:
+        theta = fan_index * case.direction_range_deg / (fan_size + 1)
+    return math.radians(theta + offset)
+
+
+def run(settings: SpawnSettings, progress: Any = None) -> BayesSwarmRun:
+    """Run one mission; raises a SwarmError on bad settings or a failed run."""
+    from bayes_swarm.node import BayesSwarmNode
+
+    case = _check(settings)
+    if settings.algorithm == 'glowworm':
+        # Glowworm decides at 100 Hz on fresh samples (the paper's observation frequency 100).
+        case = replace(case, observation_rate_hz=GLOWWORM_RATE_HZ)
+    n = settings.robots or case.default_robots
+    layout = _robot_layout(case, n)
+    poses = np.array(
+        [[s[0], s[1], _initial_yaw(case, fi, fs, off)] for s, fi, fs, off in layout], dtype=float
+    )
+    model = SignalMissionModel(
+        case,
+        noise_std=settings.noise_std,
+        relative_noise=settings.relative_noise,
+        seed=settings.seed,
+    )
+    nodes: list[Any] = []
+
+    def factory(**kwargs: Any) -> Any:
+        node = BayesSwarmNode(**kwargs)
+        nodes.append(node)
+        return node
+
+    peer_type = {
+        'bayes_swarm_p': 'swarm_interfaces/msg/BayesSwarmPeer',
+        'bayes_swarm_o': 'swarm_interfaces/msg/BayesSwarmPeer',
+        'glowworm': 'swarm_interfaces/msg/GlowwormPeer',
+    }.get(settings.algorithm, '')
+    bridge_parameters: dict[str, Any] = {'peer_msg_type': peer_type}
+    if peer_type:
+        bridge_parameters['comm_range_m'] = float(settings.comm_range_m)
+        bridge_parameters['peer_loss_probability'] = float(settings.loss_probability)
+    recording = None
+    if settings.record is not None:
+        recording = RecordingSpec(Path(settings.record), DEFAULT_RECORD_TOPICS)
+    spec = MissionSpec(
+        site=_arena_site(case),
+        initial_poses=poses,
+        robots=[RobotNodeSpec(factory, node_parameters(case, settings, n, i)) for i in range(n)],
+        max_sim_time_s=case.max_mission_time_s + 2.0,
+        engine_config=_engine_config(case, settings.seed),
+        bridge_parameters=bridge_parameters,
+        extensions=[SignalExtension(model)],
+        stop_when_all_rooms_covered=False,
+        recording=recording,
+        progress_period_s=max(1.0, case.max_mission_time_s / 20.0),
+    )
+    mission = run_mission(spec, progress=progress)
+    names = tuple(f'r{i}' for i in range(n))
+    times = {
+        name: [d.compute_time_s for d in node.decisions]
+        for name, node in zip(names, nodes, strict=True)
+    }
+    result = BayesSwarmRun(
+        case=case,
+        settings=settings,
+        found=model.found,
+        found_time_s=model.found_time_s,
+        finder=names[model.finder] if model.found else '',
+        tau=model.tau(),
+        decision_times_s=times,
+        robot_nodes=nodes,
+        mission=mission,
+        plots=[],
+    )
+    if settings.out_dir is not None:
+        result.plots = write_plots(result, Path(settings.out_dir))
+    return result
+
+
+def write_plots(result: BayesSwarmRun, out_dir: Path) -> list[Path]:
+    """Signal field with paths, and one robot's GP mean with its waypoints (PNG files)."""
+    import matplotlib
+
+    matplotlib.use('Agg')
+    import matplotlib.pyplot as plt
+
+    out_dir.mkdir(parents=True, exist_ok=True)
+    case = result.case
+    x0, x1, y0, y1 = case.arena_m
+    gx, gy = np.meshgrid(np.linspace(x0, x1, 120), np.linspace(y0, y1, 120))
+    grid = np.column_stack([gx.ravel(), gy.ravel()])
+    field_values = np.asarray(case.field(grid)).reshape(gx.shape)
+    paths: list[Path] = []
+
+    fig, ax = plt.subplots(figsize=(6, 5.4))
+    contour = ax.contourf(gx, gy, field_values, levels=30, cmap='viridis')
+    fig.colorbar(contour, ax=ax, label='signal')
+    traj = result.mission.trajectories
+    for i in range(traj.shape[1]):
+        ax.plot(traj[:, i, 0], traj[:, i, 1], lw=1.2, label=f'r{i}' if i < 10 else None)
+    ax.plot(*case.source_m, marker='*', color='red', ms=14, ls='none', label='source')
+    ax.plot(case.depots_m[:, 0], case.depots_m[:, 1], 'ks', ms=6, label='depot')
+    status = f'tau = {result.tau:.2f}' if result.found else 'not found'
+    ax.set_title(f'{case.name}, {result.settings.algorithm}, {traj.shape[1]} robots: {status}')
+    ax.set_xlabel('x [m]')
+    ax.set_ylabel('y [m]')
+    ax.set_aspect('equal')
+    ax.legend(fontsize=7, loc='lower right')
+    path = out_dir / 'field_paths.png'
+    fig.savefig(path, dpi=120, bbox_inches='tight')
+    plt.close(fig)
+    paths.append(path)
+
+    index = int(result.finder[1:]) if result.finder else 0
+    node = result.robot_nodes[index]
+    planner = getattr(node, 'planner', None)
+    if planner is not None and planner.gp.n_samples:
+        mean, _ = planner.gp.predict(grid)
+        fig, ax = plt.subplots(figsize=(6, 5.4))
+        contour = ax.contourf(gx, gy, mean.reshape(gx.shape), levels=30, cmap='magma')
+        fig.colorbar(contour, ax=ax, label='GP mean')
+        pts = planner.gp.training_inputs
+        ax.plot(pts[:, 0], pts[:, 1], 'k.', ms=2, label='observations')
+        wps = np.array([d.waypoint_m for d in node.decisions])
+        ax.plot(wps[:, 0], wps[:, 1], 'cs-', ms=5, lw=1, label='waypoints')
+        ax.plot(*case.source_m, marker='*', color='lime', ms=14, ls='none', label='source')
+        ax.set_title(f'r{index}: GP mean at its last decision')
+        ax.set_aspect('equal')
+        ax.legend(fontsize=7, loc='lower right')
+        path = out_dir / f'r{index}_gp_mean.png'
+        fig.savefig(path, dpi=120, bbox_inches='tight')
+        plt.close(fig)
+        paths.append(path)
+    return paths
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
+    parser.add_argument('--algorithm', choices=ALGORITHMS, default='bayes_swarm_p')
+    parser.add_argument('--case', choices=CASE_NAMES, default='case1')
+    parser.add_argument('--robots', type=int, default=None, help='swarm size (paper default)')
+    parser.add_argument(
+        '--depots', type=points_argument('--depots'), default=None, help="'x,y;x,y' [m]"
+    )
+    parser.add_argument('--seed', type=int, default=0)
+    parser.add_argument('--comm-range', type=float, default=math.inf, help='[m], default inf')
+    parser.add_argument('--loss', type=float, default=0.0, help='peer message loss probability')
+    parser.add_argument('--noise', type=float, default=0.0, help='measurement noise std')
+    parser.add_argument('--relative-noise', type=float, default=0.0, help='noise std / |f|')
+    parser.add_argument('--t-max', type=float, default=None, help='T_max [s] (case default)')
+    parser.add_argument('--outer-optimizer', choices=('grid', 'cobyla', 'pso'), default='grid')
+    parser.add_argument('--record', type=Path, default=None, help='bag directory to write')
+    parser.add_argument('--out', type=Path, default=Path('bayes_swarm_run'), help='plot dir')
+    parser.add_argument('--no-plots', action='store_true')
+    parser.add_argument(
+        '--param',
+        action='append',
+        default=[],
+        metavar='NAME=VALUE',
+        help='set a bayes_swarm node parameter for every robot (repeatable), e.g. '
+        'horizon_s=20; names and defaults: ros2 param describe, or bayes_swarm.node_settings',
+    )
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of ``spawn_bayes_swarm``; returns the exit status."""
+    args = build_parser().parse_args(argv)
+    try:
+        extra = node_parameter_overrides(args.param)
+    except ConfigurationError as err:
+        return fail('spawn_bayes_swarm', err)
+    settings = SpawnSettings(
+        extra_parameters=extra,
+        algorithm=args.algorithm,
+        case=args.case,
+        robots=args.robots,
+        depots=args.depots,
+        seed=args.seed,
+        comm_range_m=args.comm_range,
+        loss_probability=args.loss,
+        noise_std=args.noise,
+        relative_noise=args.relative_noise,
+        max_mission_time_s=args.t_max,
+        outer_optimizer=args.outer_optimizer,
+        record=args.record,
+        out_dir=None if args.no_plots else args.out,
+    )
+
+    def progress(report: Any) -> None:
+        print(f'  t = {report.sim_time_s:7.1f} s  (wall {report.wall_time_s:6.1f} s)', flush=True)
+
+    try:
+        result = run(settings, progress=progress)
+    except SwarmError as err:
+        return fail('spawn_bayes_swarm', err)
+    times = result.finder_decision_times_s()
+    print(f'case {result.case.name}, {result.settings.algorithm}, seed {settings.seed}')
+    if result.found:
+        print(
+            f'found by {result.finder} at t = {result.found_time_s:.2f} s, tau = {result.tau:.3f}'
+        )
+    else:
+        print(f'not found within T_max = {result.case.max_mission_time_s:g} s')
+    if times.size:
+        who = result.finder or 'all robots'
+        print(
+            f'decision time ({who}, {times.size} decisions): '
+            f'median {np.median(times) * 1e3:.1f} ms, mean {np.mean(times) * 1e3:.1f} ms, '
+            f'max {np.max(times) * 1e3:.1f} ms'
+        )
+    for path in result.plots:
+        print(f'wrote {path}')
+    if settings.record is not None:
+        print(f'recorded {settings.record}')
+    return EXIT_SUCCESS
+
+
+if __name__ == '__main__':
+    sys.exit(main())

@@ -1,0 +1,404 @@
+"""MSC + PF spawner: N robots search for and capture RSSI-emitting targets.
+
+Plain script, no launch file (``ros2 run swarm_experiments spawn_msc_pf`` or
+``python -m swarm_experiments.spawn_msc_pf``). It builds the paper's scenario (Sec. IV-A): an
+obstacle-free 2000 m x 2000 m field, targets placed uniformly, robots starting uniformly in a
+30 m disc at the centre; starts the sim bridge with the RSSI-target extension and one
+``msc_pf`` node per robot on sim time (scheme msc, msc_pf or proposed), relays peer messages
+within ``--comm-range`` with ``--loss``, and runs until every target is captured or T_max.
+It prints the capture completion time (CCT) and each target's capture time and writes PNGs:
+the field with every robot's path and the targets coloured by capture time, and the error of
+the robots' PF estimates over time. With ``--record`` it writes a rosbag2 (MCAP) bag from
+which ``swarm_analysis.cct.cct_from_bag`` recomputes the CCT.
+
+Example: ``spawn_msc_pf --scheme proposed --robots 15 --targets 10 --seed 1 --out runs/p1``;
+``--param msc.leader_rule=pbest --param phases.unheard_updates=true`` changes any other msc_pf
+node parameter for every robot (names: ``msc_pf/config/msc_pf.yaml``).
+"""
+
+# ruff: noqa: T201  (main() is a command-line entry point that prints its report)
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from sim_bridge.rssi_extension import RssiExtension
+from swarm_common.cli import EXIT_SUCCESS, EXIT_UNFINISHED, fail
+from swarm_common.errors import SwarmError
+from swarm_sim.engine import EngineConfig, SiteGeometry
+from swarm_sim.errors import ConfigurationError
+from swarm_sim.rssi_targets import RssiTargetConfig, RssiTargetField, place_robots
+
+from swarm_experiments.cli_args import points_argument
+from swarm_experiments.errors import ExperimentError
+from swarm_experiments.mission import (
+    MissionProgress,
+    MissionSpec,
+    RecordingSpec,
+    RobotNodeSpec,
+    run_mission,
+)
+from swarm_experiments.node_overrides import parse_overrides
+from swarm_experiments.open_field import point_robot_engine_config
+
+__all__ = ['SCHEMES', 'MscPfRun', 'SpawnSettings', 'controller_parameter_overrides', 'main', 'run']
+
+# msc_pf node parameters the spawner sets from its own options (see node_parameters).
+SPAWNER_PARAMETERS = ('scheme', 'seed', 'robot_id', 'field_size_m', 'swarm.comm_range_m')
+
+SCHEMES = ('proposed', 'msc_pf', 'msc')
+PEER_TYPE = 'swarm_interfaces/msg/MscPeer'
+DEFAULT_RECORD_TOPICS = ('/clock', '/sim/poses', '/sim/targets', '/r*/state', '/r*/peers/out')
+
+
+@dataclass(frozen=True)
+class SpawnSettings:
+    """One run.
+
+    Attributes:
+        scheme: proposed, msc_pf or msc.
+        robots: number of robots.
+        targets: number of targets (placed uniformly unless ``target_positions_m``).
+        seed: seed of targets, robot starts, receiver noise and every controller.
+        field_size_m: edge of the square field [m].
+        start_radius_m: robots start uniformly in this disc at the centre [m].
+        comm_range_m: peer relay range [m] (Table I: 150).
+        loss_probability: chance that one relayed peer message is lost.
+        max_time_s: T_max [s].
+        physics_rate_hz: simulation step rate [Hz].
+        target_positions_m: (targets, 2) fixed target positions, or None.
+        record: bag directory to write, or None.
+        out_dir: where the PNGs go (None: no plots).
+        extra_parameters: further msc_pf node parameters (name -> value).
+    """
+
+    scheme: str = 'proposed'
+    robots: int = 15
+    targets: int = 10
+    seed: int = 0
+    field_size_m: float = 2000.0
+    start_radius_m: float = 30.0
+    comm_range_m: float = 150.0
+    loss_probability: float = 0.0
+    max_time_s: float = 30000.0
+    physics_rate_hz: float = 10.0
+    target_positions_m: np.ndarray | None = None
+    record: Path | None = None
+    out_dir: Path | None = None
+    extra_parameters: dict[str, Any] = field(default_factory=dict)
+
+
+@dataclass
+class MscPfRun:
+    """Outcome of a spawned run.
+
+    Attributes:
+        settings: what was run.
+        cct_s: capture completion time [s] (NaN if not every target was captured).
+        capture_times_s: (targets,) capture time of each target [s] (NaN if not captured).
+        target_positions_m: (targets, 2) target positions [m].
+        estimate_log: rows (time [s], robot index, target ID, x, y, spread [m], converged).
+        mission: the mission runner's result (trajectories, timing).
+        robot_nodes: the msc_pf nodes (for inspection).
+        plots: PNG files written.
+    """
+
+    settings: SpawnSettings
+    cct_s: float
+    capture_times_s: np.ndarray
+    target_positions_m: np.ndarray
+    estimate_log: np.ndarray
+    mission: Any
+    robot_nodes: list[Any]
+    plots: list[Path]
+
+
+def _check(settings: SpawnSettings) -> None:
+    if settings.scheme not in SCHEMES:
+        msg = f'unknown scheme {settings.scheme!r}; choose one of {", ".join(SCHEMES)}'
+        raise ExperimentError(msg)
+    if settings.robots < 1 or settings.targets < 1:
+        msg = f'--robots and --targets must be >= 1, got {settings.robots}, {settings.targets}'
+        raise ExperimentError(msg)
+    for name in ('comm_range_m', 'max_time_s', 'field_size_m', 'physics_rate_hz'):
+        value = getattr(settings, name)
+        if not value > 0.0:
+            msg = f'{name} must be > 0, got {value}'
+            raise ExperimentError(msg)
+    if not 0.0 <= settings.loss_probability <= 1.0:
+        msg = f'loss probability must be in [0, 1], got {settings.loss_probability}'
+        raise ExperimentError(msg)
+
+
+def _engine_config(settings: SpawnSettings) -> EngineConfig:
+    return point_robot_engine_config(
+        physics_rate_hz=settings.physics_rate_hz, seed=settings.seed, max_linear_speed_mps=1.05
+    )
+
+
+def controller_parameter_overrides(items: Sequence[str]) -> dict[str, Any]:
+    """msc_pf controller parameters from ``NAME=VALUE`` items, typed and checked before a run.
+
+    Names are the node's flat ``<section>.<field>`` parameters (``msc.leader_rule``,
+    ``phases.unheard_updates``, ...) except those the spawner derives from its own options
+    (:data:`SPAWNER_PARAMETERS`: use ``--scheme``, ``--seed``, ``--comm-range``).
+
+    Raises:
+        ConfigurationError: a malformed item, an unknown or spawner-set name, a value of the
+            wrong type, or one the controller rejects.
+    """
+    from msc_pf.parameters import config_from_parameters, parameter_defaults
+
+    return parse_overrides(
+        items, parameter_defaults(), reserved=SPAWNER_PARAMETERS, check=config_from_parameters
+    )
+
+
+def node_parameters(settings: SpawnSettings, index: int) -> dict[str, Any]:
+    """Parameters of robot ``index``'s msc_pf node."""
+    params: dict[str, Any] = {
+        'scheme': settings.scheme,
+        'seed': int(settings.seed),
+        'robot_id': index,
+        'field_size_m': float(settings.field_size_m),
+        'swarm.comm_range_m': float(settings.comm_range_m),
+    }
+    params.update(settings.extra_parameters)
+    return params
+
+
+def scenario(settings: SpawnSettings) -> tuple[RssiTargetField, np.ndarray]:
+    """Targets and (robots, 3) start poses of a run; the same seed gives the same scenario."""
+    rng = np.random.default_rng([settings.seed, 0])
+    config = RssiTargetConfig(n_targets=settings.targets, field_size_m=settings.field_size_m)
+    if settings.target_positions_m is None:
+        targets = RssiTargetField.random(config, rng)
+    else:
+        targets = RssiTargetField(config, settings.target_positions_m)
+    centre = (settings.field_size_m / 2.0, settings.field_size_m / 2.0)
+    xy = place_robots(settings.robots, centre, settings.start_radius_m, rng)
+    yaw = rng.uniform(-math.pi, math.pi, settings.robots)
+    return targets, np.column_stack([xy, yaw])
+
+
+def run(settings: SpawnSettings, progress: Any = None) -> MscPfRun:
+    """Run one mission; raises a SwarmError on bad settings or a failed run."""
+    from msc_pf.node import MscPfNode
+
+    _check(settings)
+    targets, poses = scenario(settings)
+    extension = RssiExtension(targets, seed=settings.seed)
+    nodes: list[Any] = []
+    log: list[tuple[float, ...]] = []
+
+    def factory(**kwargs: Any) -> Any:
+        node = MscPfNode(**kwargs)
+        nodes.append(node)
+        return node
+
+    def on_progress(report: MissionProgress) -> None:
+        for index, node in enumerate(nodes):
+            out = node.last_output
+            if out is None:
+                continue
+            for e in out.status.estimates:
+                x, y = e.position_m
+                log.append((report.sim_time_s, index, e.target_id, x, y, e.spread_m, e.converged))
+        if progress is not None:
+            progress(report)
+
+    recording = None
+    if settings.record is not None:
+        recording = RecordingSpec(Path(settings.record), DEFAULT_RECORD_TOPICS)
+    site = SiteGeometry(
+        walls=np.zeros((0, 2, 2)),
+        room_rects=(np.array([[0.0, 0.0, settings.field_size_m, settings.field_size_m]]),),
+        name='msc_pf field',
+    )
+    spec = MissionSpec(
+        site=site,
+        initial_poses=poses,
+        robots=[RobotNodeSpec(factory, node_parameters(settings, i)) for i in range(len(poses))],
+        max_sim_time_s=settings.max_time_s,
+        engine_config=_engine_config(settings),
+        bridge_parameters={
+            'peer_msg_type': PEER_TYPE,
+            'comm_range_m': float(settings.comm_range_m),
+            'peer_loss_probability': float(settings.loss_probability),
+        },
+        extensions=[extension],
+        stop_when_all_rooms_covered=False,
+        recording=recording,
+        progress_period_s=10.0,
+    )
+    mission = run_mission(spec, progress=on_progress)
+    times = targets.capture_time_s.copy()
+    result = MscPfRun(
+        settings=settings,
+        cct_s=float(np.max(times)) if targets.all_captured else math.nan,
+        capture_times_s=times,
+        target_positions_m=targets.positions_m.copy(),
+        estimate_log=np.array(log, dtype=float).reshape(-1, 7),
+        mission=mission,
+        robot_nodes=nodes,
+        plots=[],
+    )
+    if settings.out_dir is not None:
+        result.plots = write_plots(result, Path(settings.out_dir))
+    return result
+
+
+def write_plots(result: MscPfRun, out_dir: Path) -> list[Path]:
+    """Field with paths and targets coloured by capture time; PF estimate errors over time."""
+    import matplotlib
+
+    matplotlib.use('Agg')
+    import matplotlib.pyplot as plt
+
+    out_dir.mkdir(parents=True, exist_ok=True)
+    settings = result.settings
+    paths: list[Path] = []
+
+    fig, ax = plt.subplots(figsize=(6.4, 5.6))
+    traj = result.mission.trajectories
+    for i in range(traj.shape[1]):
+        ax.plot(traj[:, i, 0], traj[:, i, 1], lw=0.7, alpha=0.8)
+    times = result.capture_times_s
+    end = result.mission.sim_time_s
+    colours = np.where(np.isnan(times), end, times)
+    dots = ax.scatter(
+        result.target_positions_m[:, 0],
+        result.target_positions_m[:, 1],
+        c=colours,
+        cmap='plasma',
+        vmin=0.0,
+        vmax=max(end, 1.0),
+        marker='*',
+        s=160,
+        edgecolors='k',
+        zorder=3,
+    )
+    missed = np.isnan(times)
+    if missed.any():
+        ax.plot(*result.target_positions_m[missed].T, 'kx', ms=12, label='not captured')
+        ax.legend(loc='lower right', fontsize=7)
+    fig.colorbar(dots, ax=ax, label='capture time [s]')
+    cct = f'CCT {result.cct_s:.0f} s' if not math.isnan(result.cct_s) else 'not all captured'
+    ax.set_title(f'{settings.scheme}, {traj.shape[1]} robots, {len(times)} targets: {cct}')
+    ax.set_xlim(0.0, settings.field_size_m)
+    ax.set_ylim(0.0, settings.field_size_m)
+    ax.set_xlabel('x [m]')
+    ax.set_ylabel('y [m]')
+    ax.set_aspect('equal')
+    path = out_dir / 'field_paths.png'
+    fig.savefig(path, dpi=120, bbox_inches='tight')
+    plt.close(fig)
+    paths.append(path)
+
+    log = result.estimate_log
+    if len(log):
+        fig, ax = plt.subplots(figsize=(6.4, 4.0))
+        for target in np.unique(log[:, 2]).astype(int):
+            rows = log[log[:, 2] == target]
+            truth = result.target_positions_m[target]
+            error = np.hypot(rows[:, 3] - truth[0], rows[:, 4] - truth[1])
+            ax.plot(rows[:, 0], error, '.', ms=2, label=f'target {target}')
+        ax.set_yscale('log')
+        ax.set_xlabel('time [s]')
+        ax.set_ylabel('estimate error [m] (every robot)')
+        ax.set_title('PF estimates over time')
+        ax.legend(fontsize=6, ncol=2)
+        path = out_dir / 'pf_estimates.png'
+        fig.savefig(path, dpi=120, bbox_inches='tight')
+        plt.close(fig)
+        paths.append(path)
+    return paths
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """Command-line options of ``spawn_msc_pf``."""
+    parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
+    parser.add_argument('--scheme', choices=SCHEMES, default='proposed')
+    parser.add_argument('--robots', type=int, default=15)
+    parser.add_argument('--targets', type=int, default=10)
+    parser.add_argument(
+        '--target-positions',
+        type=points_argument('--target-positions'),
+        default=None,
+        help="'x,y;x,y' [m]",
+    )
+    parser.add_argument('--seed', type=int, default=0)
+    parser.add_argument('--comm-range', type=float, default=150.0, help='[m]')
+    parser.add_argument('--loss', type=float, default=0.0, help='peer message loss probability')
+    parser.add_argument('--t-max', type=float, default=30000.0, help='T_max [s]')
+    parser.add_argument('--record', type=Path, default=None, help='bag directory to write')
+    parser.add_argument('--out', type=Path, default=Path('msc_pf_run'), help='plot directory')
+    parser.add_argument('--no-plots', action='store_true')
+    parser.add_argument(
+        '--param',
+        action='append',
+        default=[],
+        metavar='NAME=VALUE',
+        help='set an msc_pf controller parameter for every robot (repeatable), e.g. '
+        'msc.leader_rule=pbest; names and defaults: msc_pf/config/msc_pf.yaml',
+    )
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of ``spawn_msc_pf``; returns the exit status."""
+    args = build_parser().parse_args(argv)
+    targets = args.targets if args.target_positions is None else len(args.target_positions)
+    try:
+        extra = controller_parameter_overrides(args.param)
+    except ConfigurationError as err:
+        return fail('spawn_msc_pf', err)
+    settings = SpawnSettings(
+        extra_parameters=extra,
+        scheme=args.scheme,
+        robots=args.robots,
+        targets=targets,
+        seed=args.seed,
+        comm_range_m=args.comm_range,
+        loss_probability=args.loss,
+        max_time_s=args.t_max,
+        target_positions_m=args.target_positions,
+        record=args.record,
+        out_dir=None if args.no_plots else args.out,
+    )
+
+    def report(p: MissionProgress) -> None:
+        if int(p.sim_time_s) % 500 == 0:
+            print(f'  t = {p.sim_time_s:7.0f} s  (wall {p.wall_time_s:6.1f} s)', flush=True)
+
+    try:
+        result = run(settings, progress=report)
+    except SwarmError as err:
+        return fail('spawn_msc_pf', err)
+    print(
+        f'scheme {settings.scheme}, {settings.robots} robots, {targets} targets, seed {args.seed}'
+    )
+    for target, (pos, t) in enumerate(
+        zip(result.target_positions_m, result.capture_times_s, strict=True)
+    ):
+        when = f'{t:8.0f} s' if not math.isnan(t) else 'not captured'
+        print(f'  target {target:2d} at ({pos[0]:6.0f}, {pos[1]:6.0f}) m: {when}')
+    if math.isnan(result.cct_s):
+        print(f'CCT: not every target captured by T_max = {settings.max_time_s:.0f} s')
+    else:
+        print(f'CCT: {result.cct_s:.0f} s  (wall {result.mission.wall_time_s:.1f} s)')
+    for path in result.plots:
+        print(f'wrote {path}')
+    if settings.record is not None:
+        print(f'bag: {settings.record}')
+    return EXIT_UNFINISHED if math.isnan(result.cct_s) else EXIT_SUCCESS
+
+
+if __name__ == '__main__':
+    sys.exit(main())

@@ -1,0 +1,484 @@
+"""Reports from stored rows: a markdown page per study with tables and PNG plots.
+
+The generic page has the run counts, failures, and per metric a table of mean, standard
+deviation and count per configuration with a plot; per time series the mean curve per
+configuration. A study's ``report`` hook then adds its own sections through the
+:class:`ReportPage` it is given, e.g. its paper's numbers beside ours
+(:func:`reference_table`) and paired comparisons (:func:`paired_differences`).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import re
+import sys
+from collections.abc import Callable, Mapping, Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import pandas as pd
+
+from .errors import ResultsError, UsageError
+from .results import MANIFEST_NAME, read_manifest, read_rows
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
+    from .definition import StudyRegistry
+
+__all__ = [
+    'ReportPage',
+    'markdown_table',
+    'paired_differences',
+    'reference_table',
+    'study_directories',
+    'summary_table',
+    'write_reports',
+]
+
+#: Most lines (configurations) one plot draws; more are left to the tables.
+MAX_LINES = 12
+MAX_BARS = 40
+
+
+def _short(column: str) -> str:
+    for prefix in ('config.', 'metric.', 'series.', 'param.'):
+        if column.startswith(prefix):
+            return column[len(prefix) :]
+    return column
+
+
+def _format(value: Any, digits: int) -> str:
+    if value is None:
+        return ''
+    if isinstance(value, (float, np.floating)):
+        if math.isnan(value):
+            return ''
+        if value != 0 and (abs(value) >= 10**6 or abs(value) < 10 ** (-digits)):
+            return f'{value:.{digits}g}'
+        return f'{value:.{digits}f}'
+    if isinstance(value, (list, tuple, np.ndarray)):
+        return '[' + ', '.join(_format(item, digits) for item in value) + ']'
+    return str(value).replace('|', '\\|').replace('\n', ' ')
+
+
+def markdown_table(frame: pd.DataFrame, *, digits: int = 3) -> str:
+    """``frame`` as a GitHub markdown table (index dropped; numbers right-aligned)."""
+    if frame.empty:
+        return '_no rows_'
+    names = [_short(str(name)) for name in frame.columns]
+    numeric = [pd.api.types.is_numeric_dtype(frame[name]) for name in frame.columns]
+    lines = [
+        '| ' + ' | '.join(names) + ' |',
+        '| ' + ' | '.join('---:' if flag else '---' for flag in numeric) + ' |',
+    ]
+    for row in frame.itertuples(index=False):
+        lines.append('| ' + ' | '.join(_format(value, digits) for value in row) + ' |')
+    return '\n'.join(lines)
+
+
+def _axes_columns(rows: pd.DataFrame, axes: Sequence[str]) -> list[str]:
+    return [f'config.{axis}' for axis in axes if f'config.{axis}' in rows.columns]
+
+
+def _numeric_metrics(rows: pd.DataFrame) -> list[str]:
+    names = []
+    for column in rows.columns:
+        if column.startswith('metric.') and (
+            pd.api.types.is_numeric_dtype(rows[column]) or pd.api.types.is_bool_dtype(rows[column])
+        ):
+            names.append(column)
+    return names
+
+
+def summary_table(
+    rows: pd.DataFrame,
+    metric: str,
+    by: Sequence[str],
+    *,
+    order: Mapping[str, Sequence[Any]] | None = None,
+) -> pd.DataFrame:
+    """Mean, standard deviation (n - 1) and count of ``metric`` per combination of ``by``.
+
+    Rows come sorted by ``by``, each column in the order of its values in ``order`` when
+    given (e.g. the study's declared axis values), else by value.
+    """
+    values = rows[metric].astype(float)
+    if not by:
+        return pd.DataFrame(
+            {'mean': [values.mean()], 'std': [values.std()], 'count': [int(values.count())]}
+        )
+    grouped = rows.assign(_value=values).groupby(list(by), sort=True, dropna=False)['_value']
+    table = grouped.agg(['mean', 'std', 'count']).reset_index()
+    table['count'] = table['count'].astype(int)
+    if order:
+        ranks = {
+            column: {repr(_plain(v)): i for i, v in enumerate(order[column])}
+            for column in by
+            if column in order
+        }
+        if ranks:
+            keys = [
+                table[column].map(lambda v, r=rank: r.get(repr(_plain(v)), len(r)))
+                for column, rank in ranks.items()
+            ]
+            table = (
+                table.assign(**{f'_rank{i}': key for i, key in enumerate(keys)})
+                .sort_values([f'_rank{i}' for i in range(len(keys))], kind='stable')
+                .drop(columns=[f'_rank{i}' for i in range(len(keys))])
+                .reset_index(drop=True)
+            )
+    return table
+
+
+def _plain(value: Any) -> Any:
+    if hasattr(value, 'tolist'):
+        value = value.tolist()
+    if isinstance(value, (list, tuple)):
+        return tuple(_plain(item) for item in value)
+    return value
+
+
+def reference_table(
+    rows: pd.DataFrame,
+    metric: str,
+    reference: Mapping[Any, float],
+    *,
+    by: Sequence[str],
+    label: str = 'paper',
+) -> pd.DataFrame:
+    """Our mean, std and count of ``metric`` per configuration beside reference numbers.
+
+    ``reference`` maps a configuration (a tuple of values in ``by`` order, or one value when
+    ``by`` has one column) to the reference's figure; configurations we have but the
+    reference lacks get an empty cell, and those the reference has but we lack a row with
+    count 0.
+    """
+    ours = summary_table(rows, metric, by)
+    ours['_key'] = [
+        tuple(row) if len(by) > 1 else row[0] for row in ours[list(by)].itertuples(index=False)
+    ]
+    extra = [key for key in reference if key not in set(ours['_key'])]
+    if extra:
+        additions = pd.DataFrame(
+            [
+                dict(zip(by, key if len(by) > 1 else (key,), strict=True))
+                | {'mean': np.nan, 'std': np.nan, 'count': 0, '_key': key}
+                for key in extra
+            ]
+        )
+        ours = pd.concat([ours, additions], ignore_index=True)
+    ours[label] = [reference.get(key, np.nan) for key in ours['_key']]
+    ours[f'ours - {label}'] = ours['mean'] - ours[label]
+    return ours.drop(columns=['_key'])
+
+
+def paired_differences(
+    rows: pd.DataFrame,
+    metric: str,
+    *,
+    by: str,
+    baseline: Any,
+    pair_on: Sequence[str] = ('seed',),
+    group_by: Sequence[str] = (),
+) -> pd.DataFrame:
+    """Paired differences ``metric(other) - metric(baseline)`` for each other value of ``by``.
+
+    Runs pair when they agree on every column of ``pair_on`` (the seed, i.e. the site, and
+    any axes to hold equal) and of ``group_by`` (one output row per combination). Columns:
+    ``by`` (the compared value), the ``group_by`` columns, ``pairs``, ``mean_diff``,
+    ``se_diff`` (standard error), ``wins`` / ``ties`` / ``losses`` (other above, equal to,
+    below the baseline) and ``p_wilcoxon`` (two-sided signed-rank test; empty with fewer
+    than 2 non-zero differences).
+    """
+    from scipy.stats import wilcoxon
+
+    for column in (metric, by, *pair_on, *group_by):
+        if column not in rows.columns:
+            raise UsageError(f'paired_differences: no column {column!r}')
+    keys = [*group_by, *pair_on]
+    if rows.duplicated([*keys, by]).any():
+        raise UsageError(
+            f'paired_differences: several runs per {", ".join([*keys, by])}; '
+            'add the axes that tell them apart to pair_on or group_by'
+        )
+    base = rows[rows[by] == baseline][[*keys, metric]].rename(columns={metric: '_base'})
+    records = []
+    others = [value for value in pd.unique(rows[by]) if value != baseline]
+    for other in others:
+        mine = rows[rows[by] == other][[*keys, metric]]
+        paired = mine.merge(base, on=keys, how='inner')
+        groups = paired.groupby(list(group_by), sort=True) if group_by else [((), paired)]
+        for group_key, group in groups:
+            diff = (group[metric].astype(float) - group['_base'].astype(float)).to_numpy()
+            record = {by: other}
+            group_values = group_key if isinstance(group_key, tuple) else (group_key,)
+            record.update(dict(zip(group_by, group_values, strict=True)))
+            n = len(diff)
+            nonzero = int(np.count_nonzero(diff))
+            p_value = np.nan
+            if nonzero >= 2:
+                p_value = float(wilcoxon(diff, zero_method='wilcox').pvalue)
+            record.update(
+                pairs=n,
+                mean_diff=float(diff.mean()) if n else np.nan,
+                se_diff=float(diff.std(ddof=1) / math.sqrt(n)) if n > 1 else np.nan,
+                wins=int((diff > 0).sum()),
+                ties=int((diff == 0).sum()),
+                losses=int((diff < 0).sum()),
+                p_wilcoxon=p_value,
+            )
+            records.append(record)
+    columns = [by, *group_by, 'pairs', 'mean_diff', 'se_diff', 'wins', 'ties', 'losses']
+    return pd.DataFrame(records, columns=[*columns, 'p_wilcoxon'])
+
+
+def _slug(text: str) -> str:
+    return re.sub(r'[^A-Za-z0-9_.-]+', '_', text).strip('_') or 'plot'
+
+
+class ReportPage:
+    """The markdown page of one study being written; hooks add sections to it.
+
+    ``rows`` holds the ``ok`` rows, ``all_rows`` the failed ones too; ``axes`` the axis
+    columns (``config.<axis>``), ``metrics`` and ``series`` the numeric metric and series
+    columns present.
+    """
+
+    def __init__(
+        self,
+        directory: Path,
+        manifest: Mapping[str, Any],
+        all_rows: pd.DataFrame,
+    ) -> None:
+        self.directory = directory
+        self.manifest = dict(manifest)
+        self.all_rows = all_rows
+        if 'status' in all_rows.columns:
+            self.rows = all_rows[all_rows['status'] == 'ok'].reset_index(drop=True)
+        else:
+            self.rows = all_rows
+        declared = dict(self.manifest.get('axes', {}))
+        self.axes = _axes_columns(self.rows, list(declared))
+        #: Declared values of each axis column, in the study's order.
+        self.axis_order = {f'config.{axis}': list(values) for axis, values in declared.items()}
+        self.metrics = _numeric_metrics(self.rows)
+        self.series = [column for column in self.rows.columns if column.startswith('series.')]
+        self.figure_dir = directory / 'figures'
+        self._blocks: list[str] = []
+        self._figures: list[Path] = []
+
+    @property
+    def study(self) -> str:
+        return str(self.manifest.get('study', self.directory.name))
+
+    def add_heading(self, text: str, level: int = 2) -> None:
+        self._blocks.append(f'{"#" * level} {text}')
+
+    def add_text(self, text: str) -> None:
+        self._blocks.append(text.strip())
+
+    def add_table(self, frame: pd.DataFrame, *, title: str | None = None, digits: int = 3) -> None:
+        if title:
+            self.add_heading(title, 3)
+        self._blocks.append(markdown_table(frame, digits=digits))
+
+    def add_figure(self, figure: Figure, name: str, *, caption: str = '') -> Path:
+        """Save ``figure`` as PNG beside the page, link it, and close it if pyplot made it."""
+        self.figure_dir.mkdir(parents=True, exist_ok=True)
+        path = self.figure_dir / f'{_slug(name)}.png'
+        figure.savefig(path, dpi=110, bbox_inches='tight')
+        if 'matplotlib.pyplot' in sys.modules:
+            sys.modules['matplotlib.pyplot'].close(figure)
+        self._figures.append(path)
+        self._blocks.append(f'![{caption or name}](figures/{path.name})')
+        return path
+
+    def markdown(self) -> str:
+        return '\n\n'.join(self._blocks) + '\n'
+
+    @property
+    def figures(self) -> list[Path]:
+        return list(self._figures)
+
+
+def _figure() -> tuple[Figure, Any]:
+    from matplotlib.figure import Figure  # no pyplot: works without a display
+
+    figure = Figure(figsize=(6.4, 4.0))
+    return figure, figure.add_subplot()
+
+
+def _label(columns: Sequence[str], values: Any) -> str:
+    values = values if isinstance(values, tuple) else (values,)
+    return ', '.join(f'{_short(c)}={v}' for c, v in zip(columns, values, strict=True))
+
+
+def _metric_plot(page: ReportPage, metric: str, table: pd.DataFrame) -> None:
+    axes = page.axes
+    numeric_axes = [
+        axis
+        for axis in axes
+        if pd.api.types.is_numeric_dtype(table[axis]) and table[axis].nunique() > 1
+    ]
+    figure, ax = _figure()
+    if numeric_axes:
+        x_axis = numeric_axes[0]
+        others = [axis for axis in axes if axis != x_axis]
+        groups = list(table.groupby(others, sort=False)) if others else [((), table)]
+        if len(groups) > MAX_LINES:
+            return
+        for key, group in groups:
+            group = group.sort_values(x_axis)
+            ax.errorbar(
+                group[x_axis],
+                group['mean'],
+                yerr=group['std'].fillna(0.0),
+                marker='o',
+                capsize=3,
+                label=_label(others, key) if others else None,
+            )
+        ax.set_xlabel(_short(x_axis))
+        if others:
+            ax.legend(fontsize='small')
+    else:
+        if len(table) > MAX_BARS:
+            return
+        labels = (
+            [_label(axes, tuple(row)) for row in table[axes].itertuples(index=False)]
+            if axes
+            else ['all']
+        )
+        ax.bar(range(len(table)), table['mean'], yerr=table['std'].fillna(0.0), capsize=3)
+        ax.set_xticks(range(len(table)), labels, rotation=30, ha='right', fontsize='small')
+    ax.set_ylabel(_short(metric))
+    ax.set_title(f'{page.study}: {_short(metric)} (mean ± std)')
+    page.add_figure(figure, f'metric-{_short(metric)}', caption=_short(metric))
+
+
+def _series_plot(page: ReportPage, column: str) -> None:
+    rows = page.rows[page.rows[column].notna()]
+    if rows.empty:
+        return
+    groups = list(rows.groupby(page.axes, sort=True)) if page.axes else [((), rows)]
+    if len(groups) > MAX_LINES:
+        return
+    figure, ax = _figure()
+    for key, group in groups:
+        curves = [np.asarray(values, dtype=float) for values in group[column]]
+        length = max(len(curve) for curve in curves)
+        padded = np.full((len(curves), length), np.nan)
+        for index, curve in enumerate(curves):
+            padded[index, : len(curve)] = curve
+        with np.errstate(all='ignore'):
+            mean = np.nanmean(padded, axis=0)
+        ax.plot(np.arange(length), mean, label=_label(page.axes, key) if page.axes else None)
+    ax.set_xlabel('sample')
+    ax.set_ylabel(_short(column))
+    ax.set_title(f'{page.study}: {_short(column)} (mean over runs)')
+    if page.axes:
+        ax.legend(fontsize='small')
+    page.add_figure(figure, f'series-{_short(column)}', caption=_short(column))
+
+
+def _generic_sections(page: ReportPage) -> None:
+    manifest = page.manifest
+    all_rows = page.all_rows
+    planned = int(manifest.get('runs', 0))
+    ok = len(page.rows)
+    failed = int((all_rows['status'] != 'ok').sum()) if 'status' in all_rows else 0
+    page.add_heading(f'Study {page.study}' + (' (smoke)' if manifest.get('smoke') else ''), 1)
+    if manifest.get('description'):
+        page.add_text(str(manifest['description']))
+    lines = [
+        f'- runs: {ok} ok, {failed} failed, {max(planned - ok - failed, 0)} not run '
+        f'of {planned} planned',
+    ]
+    if ok:
+        lines.append(
+            f'- CPU time of the ok runs: {page.rows["cpu_s"].sum():.1f} s '
+            f'(mean {page.rows["cpu_s"].mean():.3f} s per run)'
+        )
+        for column, label in (
+            ('code_version', 'code versions'),
+            ('engine', 'engines'),
+            ('host', 'hosts'),
+        ):
+            if column in page.rows:
+                values = sorted(str(v) for v in page.rows[column].dropna().unique())
+                lines.append(f'- {label}: {", ".join(values)}')
+    axes = manifest.get('axes', {})
+    if axes:
+        lines.append('- axes: ' + '; '.join(f'{k} = {v}' for k, v in axes.items()))
+    seeds = manifest.get('seeds', [])
+    if seeds:
+        label = manifest.get('seed_label', 'seed')
+        lines.append(f'- {label}s: {len(seeds)} ({seeds[0]}..{seeds[-1]})')
+    page.add_text('\n'.join(lines))
+    if failed:
+        failures = all_rows[all_rows['status'] != 'ok']
+        columns = ['run_id', *page.axes, 'seed', 'error']
+        columns = [column for column in columns if column in failures.columns]
+        page.add_table(failures[columns].head(20), title='Failed runs (first 20)')
+    if not ok:
+        return
+    page.add_heading('Metrics per configuration')
+    for metric in page.metrics:
+        table = summary_table(page.rows, metric, page.axes, order=page.axis_order)
+        page.add_table(table, title=_short(metric))
+        _metric_plot(page, metric, table)
+    if page.series:
+        page.add_heading('Time series')
+        for column in page.series:
+            _series_plot(page, column)
+
+
+def study_directories(directory: Path) -> list[Path]:
+    """``directory`` itself if it is a study directory, else its study subdirectories."""
+    directory = Path(directory)
+    if not directory.is_dir():
+        raise UsageError(f'{directory}: no such directory')
+    if (directory / MANIFEST_NAME).is_file():
+        return [directory]
+    found = sorted(path.parent for path in directory.glob(f'*/{MANIFEST_NAME}'))
+    if not found:
+        raise UsageError(f'{directory}: no study results here (no */{MANIFEST_NAME})')
+    return found
+
+
+def write_reports(
+    directory: str | os.PathLike[str],
+    registry: StudyRegistry | None = None,
+    *,
+    on_hook_error: Callable[[str, Exception], None] | None = None,
+) -> list[Path]:
+    """Write ``report.md`` (and ``figures/*.png``) in each study directory under ``directory``.
+
+    A study found in ``registry`` adds its ``report`` hook's sections. A hook that raises is
+    reported through ``on_hook_error`` (and the page notes it) when given, else re-raised.
+    Returns the pages written.
+    """
+    pages = []
+    for study_dir in study_directories(Path(directory)):
+        manifest = read_manifest(study_dir)
+        rows = read_rows(study_dir)
+        page = ReportPage(study_dir, manifest, rows)
+        _generic_sections(page)
+        study = registry.find(page.study) if registry is not None else None
+        if study is not None and study.report is not None and len(page.rows):
+            try:
+                study.report(page)
+            except Exception as exc:
+                if on_hook_error is None:
+                    raise
+                on_hook_error(page.study, exc)
+                page.add_text(f"_The study's report hook failed: {type(exc).__name__}: {exc}_")
+        path = study_dir / 'report.md'
+        try:
+            path.write_text(page.markdown())
+        except OSError as exc:
+            raise ResultsError(f'{path}: cannot write ({exc})') from exc
+        pages.append(path)
+    return pages

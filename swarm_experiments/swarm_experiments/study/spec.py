@@ -1,0 +1,233 @@
+"""Run specifications: one configuration and seed of a study, with a stable run id.
+
+The run id is the first 16 hex digits of the SHA-256 of the canonical JSON of
+``{study, config, seed}`` (keys sorted, no whitespace), where ``config`` is the run's whole
+parameter set (axis values and fixed parameters). It is the same on every machine and every
+run of the command, so a stored row marks its run as done; changing any parameter gives new
+run ids.
+"""
+
+from __future__ import annotations
+
+import copy
+import hashlib
+import itertools
+import json
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import yaml
+
+from .definition import Study
+from .errors import StudyDefinitionError, UsageError
+
+__all__ = ['RunSpec', 'StudyPlan', 'flatten', 'make_specs', 'parse_overrides', 'run_id']
+
+
+@dataclass(frozen=True)
+class RunSpec:
+    """One run: the study's name, the run's full parameters, its seed and run id.
+
+    ``config`` holds every parameter (axis values and fixed ones, nested as the study
+    declared them); ``axes`` names the keys of ``config`` that are the study's axes.
+    """
+
+    study: str
+    config: Mapping[str, Any]
+    seed: int
+    run_id: str
+    axes: tuple[str, ...] = ()
+
+    @property
+    def configuration(self) -> dict[str, Any]:
+        """The axis values of this run (what identifies its configuration)."""
+        return {axis: self.config[axis] for axis in self.axes}
+
+
+@dataclass(frozen=True)
+class StudyPlan:
+    """The runs a study definition produces for one command line."""
+
+    study: Study
+    directory_name: str
+    axes: Mapping[str, tuple[Any, ...]]
+    params: Mapping[str, Any]
+    seeds: tuple[int, ...]
+    smoke: bool
+    specs: tuple[RunSpec, ...] = field(repr=False)
+
+    def manifest(self) -> dict[str, Any]:
+        return {
+            'study': self.study.name,
+            'description': self.study.description,
+            'smoke': self.smoke,
+            'seed_label': self.study.seed_label,
+            'axes': {axis: list(values) for axis, values in self.axes.items()},
+            'params': _jsonable(self.params, 'params'),
+            'seeds': list(self.seeds),
+            'runs': len(self.specs),
+        }
+
+
+def _canonical_float(value: float) -> float | str:
+    if math.isfinite(value):
+        return value
+    return repr(value)
+
+
+def _jsonable(value: Any, where: str) -> Any:
+    """``value`` as plain JSON types (tuples as lists); anything else is an error."""
+    if isinstance(value, Mapping):
+        out = {}
+        for key, item in value.items():
+            if not isinstance(key, str):
+                raise StudyDefinitionError(f'{where}: key {key!r} is not a string')
+            out[key] = _jsonable(item, f'{where}.{key}')
+        return out
+    if isinstance(value, (list, tuple)):
+        return [_jsonable(item, f'{where}[]') for item in value]
+    if isinstance(value, bool) or value is None or isinstance(value, (int, str)):
+        return value
+    if isinstance(value, float):
+        return _canonical_float(value)
+    if hasattr(value, 'item') and callable(value.item):  # numpy scalar
+        return _jsonable(value.item(), where)
+    raise StudyDefinitionError(
+        f'{where}: {type(value).__name__} is not a JSON value (use numbers, strings, '
+        'booleans, lists and mappings)'
+    )
+
+
+def run_id(study: str, config: Mapping[str, Any], seed: int) -> str:
+    """Stable id of one run: hash of the study name, the full parameters and the seed."""
+    payload = json.dumps(
+        {'study': study, 'config': _jsonable(config, 'config'), 'seed': int(seed)},
+        sort_keys=True,
+        separators=(',', ':'),
+        allow_nan=False,
+    )
+    return hashlib.sha256(payload.encode()).hexdigest()[:16]
+
+
+def flatten(mapping: Mapping[str, Any], prefix: str = '') -> dict[str, Any]:
+    """Nested mappings as one level with dotted keys (``{'a': {'b': 1}}`` -> ``{'a.b': 1}``)."""
+    flat: dict[str, Any] = {}
+    for key, value in mapping.items():
+        name = f'{prefix}{key}'
+        if isinstance(value, Mapping):
+            flat.update(flatten(value, f'{name}.'))
+        else:
+            flat[name] = value
+    return flat
+
+
+def _parse_value(text: str) -> Any:
+    try:
+        return yaml.safe_load(text) if text.strip() else ''
+    except yaml.YAMLError:
+        return text
+
+
+def parse_overrides(items: Sequence[str]) -> dict[str, str]:
+    """``['a.b=1', 'robots=2,4']`` -> ``{'a.b': '1', 'robots': '2,4'}`` (values unparsed)."""
+    overrides: dict[str, str] = {}
+    for item in items:
+        key, sep, value = item.partition('=')
+        key = key.strip()
+        if not sep or not key:
+            raise UsageError(f'--set {item!r}: expected PARAM=VALUE')
+        if key in overrides:
+            raise UsageError(f'--set {key} given twice')
+        overrides[key] = value
+    return overrides
+
+
+def _set_nested(params: dict[str, Any], dotted: str, text: str) -> None:
+    keys = dotted.split('.')
+    node = params
+    for depth, key in enumerate(keys[:-1]):
+        child = node.get(key)
+        if not isinstance(child, dict):
+            where = '.'.join(keys[: depth + 1])
+            raise UsageError(f'--set {dotted}: the study has no parameter group {where!r}')
+        node = child
+    leaf = keys[-1]
+    if leaf not in node:
+        raise UsageError(f'--set {dotted}: the study has no parameter {dotted!r}')
+    if isinstance(node[leaf], dict):
+        raise UsageError(f'--set {dotted}: is a parameter group; set one of its parameters')
+    node[leaf] = _parse_value(text)
+
+
+def _axis_values(axis: str, text: str) -> tuple[Any, ...]:
+    parsed = _parse_value(text)
+    if isinstance(parsed, list):
+        values = tuple(parsed)
+    elif isinstance(parsed, str) and ',' in parsed:
+        values = tuple(_parse_value(part) for part in parsed.split(','))
+    else:
+        values = (parsed,)
+    if not values:
+        raise UsageError(f'--set {axis}: give at least one value')
+    return values
+
+
+def make_specs(
+    study: Study,
+    *,
+    runs: int | None = None,
+    overrides: Mapping[str, str] | None = None,
+    smoke: bool = False,
+) -> StudyPlan:
+    """Expand ``study`` into its run specs, in axis order then seed order.
+
+    ``runs`` replaces the seeds per configuration; ``overrides`` (``PARAM -> VALUE`` text,
+    values read as YAML) set fixed parameters (dotted names reach nested ones) or restrict an
+    axis to the given comma-separated values; ``smoke`` applies the study's :class:`Smoke`
+    first.
+    """
+    axes: dict[str, tuple[Any, ...]] = {axis: tuple(values) for axis, values in study.axes.items()}
+    params: dict[str, Any] = copy.deepcopy(dict(study.params))
+    count = study.runs
+    if smoke:
+        for axis, values in study.smoke.axes.items():
+            axes[axis] = tuple(values)
+        for key, value in flatten(study.smoke.params).items():
+            _set_nested(params, key, json.dumps(_jsonable(value, key)))
+        count = study.smoke.runs
+    for key, text in (overrides or {}).items():
+        if key in axes:
+            axes[key] = _axis_values(key, text)
+        else:
+            _set_nested(params, key, text)
+    if runs is not None:
+        if runs < 1:
+            raise UsageError(f'the number of runs must be >= 1, not {runs}')
+        count = runs
+    _jsonable(params, 'params')
+    seeds = tuple(range(study.first_seed, study.first_seed + count))
+    names = tuple(axes)
+    specs = []
+    for values in itertools.product(*(axes[name] for name in names)):
+        config = {**copy.deepcopy(params), **dict(zip(names, values, strict=True))}
+        for seed in seeds:
+            specs.append(
+                RunSpec(
+                    study=study.name,
+                    config=config,
+                    seed=seed,
+                    run_id=run_id(study.name, config, seed),
+                    axes=names,
+                )
+            )
+    return StudyPlan(
+        study=study,
+        directory_name=f'{study.name}-smoke' if smoke else study.name,
+        axes=axes,
+        params=params,
+        seeds=seeds,
+        smoke=smoke,
+        specs=tuple(specs),
+    )

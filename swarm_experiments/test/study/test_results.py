@@ -1,0 +1,157 @@
+"""A run becomes one row; rows are stored as whole Parquet parts and read back."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+from study_fixtures import search_study
+from swarm_experiments.study import ResultsError, RunSpec, make_specs, read_rows
+from swarm_experiments.study.results import PartWriter, done_run_ids, execute, study_lock
+
+
+def _spec(**config_changes: object) -> RunSpec:
+    spec = make_specs(search_study(), runs=1).specs[0]
+    if not config_changes:
+        return spec
+    return RunSpec(spec.study, {**spec.config, **config_changes}, spec.seed, 'x', spec.axes)
+
+
+def test_a_row_has_the_config_params_metrics_series_and_bookkeeping() -> None:
+    spec = _spec()
+    row = execute(search_study().run, spec, 'v1', 'serial')
+    assert row['run_id'] == spec.run_id
+    assert row['study'] == 'synthetic-search'
+    assert row['seed'] == 0
+    assert row['config.variant'] == 'gas'
+    assert row['config.robots'] == 2
+    assert row['param.sim.steps'] == 60
+    assert row['param.fail_seeds'] == []
+    assert isinstance(row['metric.coverage'], float)
+    assert row['metric.found'] is False
+    assert row['metric.actions'] == 120
+    assert row['metric.first_90_step'] is None
+    assert row['metric.energy.total_j'] > 0
+    assert len(row['series.coverage_every_10']) == 6
+    assert all(isinstance(v, float) for v in row['series.coverage_every_10'])
+    assert row['status'] == 'ok'
+    assert row['error'] is None
+    assert row['code_version'] == 'v1'
+    assert row['engine'] == 'serial'
+    assert row['pid'] == os.getpid()
+    assert row['cpu_s'] >= 0
+    assert row['wall_s'] >= 0
+
+
+def test_an_exception_in_the_run_gives_a_failed_row_with_one_line() -> None:
+    spec = _spec(fail_seeds=[0])
+    row = execute(search_study().run, spec, 'v1', 'serial')
+    assert row['status'] == 'failed'
+    assert row['error'] == 'ValueError: seed 0 fails on purpose'
+    assert 'Traceback' in row['traceback']
+    assert 'metric.coverage' not in row
+
+
+@pytest.mark.parametrize(
+    ('returned', 'message'),
+    [
+        ([1, 2], 'returned list, expected a mapping'),
+        ({'grid': np.zeros((2, 2))}, 'non-numeric items'),
+        ({'what': object()}, "returned 'what' as object"),
+    ],
+)
+def test_a_run_returning_something_unstorable_fails_with_the_reason(
+    returned: object, message: str
+) -> None:
+    row = execute(lambda spec: returned, _spec(), 'v1', 'serial')
+    assert row['status'] == 'failed'
+    assert message in row['error']
+
+
+def test_numpy_scalars_and_arrays_become_plain_values() -> None:
+    row = execute(
+        lambda spec: {'a': np.float32(0.5), 'b': np.int64(3), 'c': np.arange(3)},
+        _spec(),
+        'v',
+        'serial',
+    )
+    assert row['metric.a'] == 0.5
+    assert type(row['metric.a']) is float
+    assert row['metric.b'] == 3
+    assert type(row['metric.b']) is int
+    assert row['series.c'] == [0.0, 1.0, 2.0]
+
+
+def test_parts_are_written_whole_and_read_back_with_mixed_columns(tmp_path: Path) -> None:
+    writer = PartWriter(tmp_path, batch_rows=2, batch_s=1e9)
+    base = {'study': 's', 'seed': 0, 'status': 'ok'}
+    writer.add({**base, 'run_id': 'a', 'metric.m': 1, 'series.s': [1.0, 2.0]})
+    assert not list(tmp_path.iterdir()), 'nothing written before the batch is full'
+    writer.add({**base, 'run_id': 'b', 'metric.m': 2.5, 'series.s': [3.0]})
+    writer.add({**base, 'run_id': 'c', 'metric.other': 'x'})
+    writer.flush()
+    assert writer.parts_written == 2
+    assert writer.rows_written == 3
+    names = sorted(path.name for path in tmp_path.iterdir())
+    assert all(name.startswith('part-') and name.endswith('.parquet') for name in names)
+    rows = read_rows(tmp_path).set_index('run_id')
+    assert rows.loc['a', 'metric.m'] == 1.0
+    assert rows.loc['b', 'metric.m'] == 2.5
+    assert pd.isna(rows.loc['c', 'metric.m'])
+    assert rows.loc['c', 'metric.other'] == 'x'
+    assert list(rows.loc['a', 'series.s']) == [1.0, 2.0]
+    assert done_run_ids(tmp_path) == {'a', 'b', 'c'}
+
+
+def test_reading_keeps_the_ok_row_of_a_run_that_failed_before(tmp_path: Path) -> None:
+    writer = PartWriter(tmp_path, batch_rows=1)
+    base = {'study': 's', 'seed': 0}
+    writer.add({**base, 'run_id': 'a', 'status': 'failed', 'error': 'boom'})
+    writer.add({**base, 'run_id': 'a', 'status': 'ok', 'metric.m': 1.0})
+    writer.add({**base, 'run_id': 'b', 'status': 'ok', 'metric.m': 2.0})
+    writer.add({**base, 'run_id': 'b', 'status': 'failed', 'error': 'later'})
+    writer.add({**base, 'run_id': 'c', 'status': 'failed', 'error': 'first'})
+    writer.add({**base, 'run_id': 'c', 'status': 'failed', 'error': 'second'})
+    rows = read_rows(tmp_path).set_index('run_id')
+    assert rows.loc['a', 'status'] == 'ok'
+    assert rows.loc['b', 'status'] == 'ok'
+    assert rows.loc['c', 'error'] == 'second'
+    assert len(read_rows(tmp_path, all_attempts=True)) == 6
+    assert done_run_ids(tmp_path) == {'a', 'b'}
+
+
+def test_a_leftover_temporary_file_is_not_read(tmp_path: Path) -> None:
+    (tmp_path / '.part-1.parquet.tmp').write_bytes(b'half a file')
+    assert read_rows(tmp_path).empty
+
+
+def test_a_corrupt_part_is_a_one_line_results_error(tmp_path: Path) -> None:
+    (tmp_path / 'part-1.parquet').write_bytes(b'not parquet')
+    with pytest.raises(ResultsError, match='unreadable part file'):
+        read_rows(tmp_path)
+
+
+def test_the_directory_lock_admits_one_writer(tmp_path: Path) -> None:
+    with study_lock(tmp_path), pytest.raises(ResultsError, match='another run'):  # noqa: SIM117
+        with study_lock(tmp_path):
+            pass
+    with study_lock(tmp_path):
+        pass
+
+
+def test_parts_that_disagree_on_a_type_still_read(tmp_path: Path) -> None:
+    writer = PartWriter(tmp_path, batch_rows=1)
+    base = {'study': 's', 'seed': 0, 'status': 'ok'}
+    writer.add({**base, 'run_id': 'a', 'param.f': [], 'metric.x': None})
+    writer.add({**base, 'run_id': 'b', 'param.f': [1, 2], 'metric.x': 2})
+    writer.add({**base, 'run_id': 'c', 'param.f': [1.5], 'metric.x': 3.5})
+    rows = read_rows(tmp_path).set_index('run_id')
+    assert rows['metric.x'].dtype == float
+    assert list(rows.loc['b', 'param.f']) == [1.0, 2.0]
+    writer.add({**base, 'run_id': 'd', 'metric.x': 'text'})
+    rows = read_rows(tmp_path).set_index('run_id')
+    assert rows.loc['d', 'metric.x'] == 'text'
+    assert rows.loc['c', 'metric.x'] == 3.5

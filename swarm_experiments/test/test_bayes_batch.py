@@ -1,0 +1,99 @@
+"""End-to-end runs of the Bayes-Swarm batch runner."""
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+from bayes_swarm.errors import ConfigError
+from swarm_common.segments import first_entry_fraction
+from swarm_experiments.bayes_batch import run_mission
+
+
+def test_detection_happens_at_the_first_entry_into_the_epsilon_disc():
+    frac = first_entry_fraction(
+        np.array([0.0, 0.0]), np.array([2.0, 0.0]), np.array([1.0, 0.0]), 0.5
+    )
+    assert frac == pytest.approx(0.25)
+    assert (
+        first_entry_fraction(np.zeros(2), np.array([2.0, 0.0]), np.array([1.0, 1.0]), 0.5) is None
+    )
+
+
+def test_case_1_run_finds_the_source_within_t_max_deterministically(case1_spec):
+    first = run_mission(case1_spec, 'bayes_swarm_p', 5, seed=7)
+    second = run_mission(case1_spec, 'bayes_swarm_p', 5, seed=7)
+    assert first.found
+    assert first.found_time_s < case1_spec.planner.max_mission_time_s
+    assert np.hypot(*(first.trajectories[first.finder][-1] - [1.0, 2.0])) <= 0.05 + 1e-9
+    assert first.found_time_s == second.found_time_s
+    assert first.tau == pytest.approx((first.found_time_s - np.sqrt(5) / 0.1) / (np.sqrt(5) / 0.1))
+    waypoints = [[d.waypoint_m.tolist() for d in ds] for ds in first.decisions]
+    assert waypoints == [[d.waypoint_m.tolist() for d in ds] for ds in second.decisions]
+
+
+def _waypoints(result):
+    return [[d.waypoint_m.tolist() for d in ds] for ds in result.decisions]
+
+
+def test_the_robots_decide_from_their_samples_never_from_the_true_source(case1_spec):
+    """Moving only the ground-truth source (same field) changes nothing the robots do."""
+    run = run_mission(case1_spec, 'bayes_swarm_p', 5, seed=3)
+    assert run.found
+    # The decoy mission runs a little longer than the original one, then stops.
+    planner = replace(case1_spec.planner, max_mission_time_s=run.found_time_s + 1.0)
+    decoy_spec = replace(case1_spec, source_m=np.array([2.3, 0.1]), planner=planner)
+    decoy = run_mission(decoy_spec, 'bayes_swarm_p', 5, seed=3)
+    assert not decoy.found
+    # Every decision taken before the original run ended is taken identically.
+    for original, moved in zip(_waypoints(run), _waypoints(decoy), strict=True):
+        assert moved[: len(original)] == original
+
+
+def test_moving_the_field_changes_every_decision_after_the_first(case1_spec):
+    """The first decision is a fixed fan; the later ones follow the sampled field."""
+    offset = np.array([0.15, -0.1])
+    # Both missions stop after the second decisions (at t = 10 s, end of the first legs).
+    spec = replace(case1_spec, planner=replace(case1_spec.planner, max_mission_time_s=12.0))
+    moved_spec = replace(
+        spec,
+        field=lambda p: spec.field(np.asarray(p, dtype=float).reshape(-1, 2) - offset),
+        source_m=spec.source_m + offset,
+    )
+    run = run_mission(spec, 'bayes_swarm_p', 5, seed=3)
+    moved = run_mission(moved_spec, 'bayes_swarm_p', 5, seed=3)
+    for original, shifted in zip(_waypoints(run), _waypoints(moved), strict=True):
+        assert shifted[0] == original[0]
+        assert np.hypot(*np.subtract(shifted[1], original[1])) > 0.01
+
+
+def test_out_of_range_robots_hear_only_the_broadcasts_made_at_the_common_depot(case1_spec):
+    spec = replace(case1_spec, comm_range_m=0.0)
+    result = run_mission(spec, 'bayes_swarm_p', 3, seed=1, keep_planners=True)
+    full = run_mission(case1_spec, 'bayes_swarm_p', 3, seed=1, keep_planners=True)
+    for isolated in result.planners:
+        # Only the first plans (1 m legs from the depot) were heard, at distance 0.
+        for waypoint in isolated.peer_waypoints.values():
+            assert np.hypot(*waypoint) == pytest.approx(1.0)
+    assert result.planners[0].n_observations < full.planners[0].n_observations
+
+
+def test_failures_within_t_max_are_reported_not_dropped(case1_spec):
+    short = replace(case1_spec, planner=replace(case1_spec.planner, max_mission_time_s=3.0))
+    for algorithm in ('levy', 'exhaustive', 'bayes_swarm_o', 'glowworm'):
+        result = run_mission(short, algorithm, 2, seed=0)
+        assert not result.found
+        assert np.isnan(result.tau)
+        assert result.end_time_s == pytest.approx(3.0)
+
+
+def test_exhaustive_sweep_finds_the_source_with_a_long_enough_horizon(case1_spec):
+    long = replace(case1_spec, planner=replace(case1_spec.planner, max_mission_time_s=3000.0))
+    result = run_mission(long, 'exhaustive', 5, seed=0)
+    again = run_mission(long, 'exhaustive', 5, seed=99)
+    assert result.found
+    assert result.found_time_s == again.found_time_s  # no randomness in a sweep
+
+
+def test_unknown_algorithm_is_rejected(case1_spec):
+    with pytest.raises(ConfigError, match='unknown algorithm'):
+        run_mission(case1_spec, 'ant_colony', 3, seed=0)

@@ -1,0 +1,163 @@
+"""The batch path reproduces the ROS path's OA-Bug missions exactly."""
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+from oabug_robot.fsm import Command
+from oabug_robot.sound import PeerBearings
+from swarm_experiments.mission import RecordingSpec, StopReason, run_mission
+from swarm_experiments.oabug_batch import (
+    BatchRobot,
+    _deliver_bearings,
+    _near_peers,
+    run_oabug_batch,
+    run_spawn_batch,
+)
+from swarm_experiments.spawn import SpawnSettings, build_mission
+from swarm_sim.errors import ConfigurationError
+from swarm_sim.sensors.bearings import BearingConfig, BearingModel
+from swarm_sim.sensors.lidar import LidarConfig
+
+FIVE_ROOMS = Path(__file__).parent / 'data' / 'five_rooms.lay'
+
+
+@pytest.mark.parametrize(
+    ('site', 'robots', 'variant', 'departure', 'actions'),
+    [
+        ('small', 10, 'gas_sound', 'center', 120),
+        (str(FIVE_ROOMS), 4, 'gas', 'edge', 300),
+    ],
+    ids=['small-10-robots', 'five-rooms-all-covered'],
+)
+def test_batch_and_ros_paths_give_the_same_poses_and_first_entries(
+    site, robots, variant, departure, actions
+):
+    config = SpawnSettings(
+        site=site, robots=robots, variant=variant, departure=departure, actions=actions
+    )
+    spec, _ = build_mission(config)
+    ros = run_mission(spec)
+    batch = run_oabug_batch(spec)
+    # The robots did something worth comparing: they drove and entered rooms.
+    assert ros.distance_travelled_m.min() > 2.0
+    assert ros.rooms_covered >= 2
+    assert batch.stop_reason == ros.stop_reason
+    if site == str(FIVE_ROOMS):
+        assert ros.stop_reason == StopReason.ALL_ROOMS_COVERED
+    assert batch.sim_time_s == ros.sim_time_s
+    np.testing.assert_array_equal(batch.trajectory_times_s, ros.trajectory_times_s)
+    np.testing.assert_array_equal(batch.trajectories, ros.trajectories)
+    assert batch.room_entries == ros.room_entries
+    np.testing.assert_array_equal(batch.distance_travelled_m, ros.distance_travelled_m)
+
+
+def test_batch_spawn_run_matches_its_config():
+    config = SpawnSettings(site=str(FIVE_ROOMS), robots=3, departure='edge', actions=60)
+    result = run_spawn_batch(config)
+    assert result.mission.sim_time_s == pytest.approx(config.budget_s, abs=0.11)
+    assert result.mission.trajectories.shape[1:] == (3, 3)
+    assert result.plots == ()
+
+
+def test_batch_path_refuses_what_it_cannot_do(tmp_path):
+    spec, _ = build_mission(SpawnSettings(site=str(FIVE_ROOMS), robots=2, departure='edge'))
+    recorded = type(spec)(**{**spec.__dict__, 'recording': RecordingSpec(tmp_path / 'bag')})
+    with pytest.raises(ConfigurationError, match='bag'):
+        run_oabug_batch(recorded)
+    relayed = type(spec)(**{**spec.__dict__, 'bridge_parameters': {'comm_range_m': 5.0}})
+    with pytest.raises(ConfigurationError, match='bridge'):
+        run_oabug_batch(relayed)
+    with pytest.raises(ConfigurationError, match='no_such_parameter'):
+        BatchRobot({'no_such_parameter': 1}, LidarConfig())
+
+
+def test_a_robot_holds_still_until_scan_and_imu_arrive_and_when_they_go_stale():
+    robot = BatchRobot({'variant': 'minimum'}, LidarConfig())
+    stop = Command(0.0, 0.0, False)
+    assert robot.control(0.1) == stop
+    robot.receive_imu(0.5, 0.1)
+    assert robot.control(0.1) == stop
+    robot.receive_scan(np.full(360, math.inf), 0.2)
+    moving = robot.control(0.2)
+    assert moving != stop
+    # Nothing new for longer than stale_timeout_s: the node's fail safe.
+    assert robot.control(0.2 + robot.stale_timeout_s + 0.1) == stop
+
+
+def test_without_the_cdr_round_trip_both_paths_still_agree(monkeypatch):
+    # In-process messages then keep Python floats in their float32 fields; the batch path
+    # follows the runtime's setting.
+    monkeypatch.setenv('SWARM_RUNTIME_CDR_ROUNDTRIP', '0')
+    config = SpawnSettings(
+        site=str(FIVE_ROOMS), robots=4, variant='gas', departure='edge', actions=150
+    )
+    spec, _ = build_mission(config)
+    ros = run_mission(spec)
+    batch = run_oabug_batch(spec)
+    assert ros.distance_travelled_m.min() > 2.0
+    np.testing.assert_array_equal(batch.trajectories, ros.trajectories)
+    assert batch.room_entries == ros.room_entries
+    # Rounding the bearings and scan angles as serialization does changes the run.
+    rounded = run_oabug_batch(spec, float32_fields=True)
+    assert not np.array_equal(rounded.trajectories, ros.trajectories)
+
+
+def test_near_peers_of_many_robots_equal_each_robots_own_selection():
+    """The batch path's one-call near-peer selection gives, robot by robot, the bearings and
+    distances PeerBearings.near_peers_now gives (bit for bit, NaN and inf included)."""
+    rng = np.random.default_rng(5)
+    for _ in range(200):
+        held, expected = [], []
+        for _ in range(int(rng.integers(1, 11))):
+            if rng.random() < 0.2:
+                held.append(None)
+                expected.append((np.zeros(0), np.zeros(0)))
+                continue
+            count = int(rng.integers(0, 9))
+            azimuths = rng.uniform(-4.0, 4.0, count)
+            distances = rng.uniform(0.0, 4.0, count)
+            distances[rng.random(count) < 0.2] = math.nan
+            distances[rng.random(count) < 0.1] = math.inf
+            azimuths[rng.random(count) < 0.1] = math.nan
+            stamp_yaw, yaw = rng.uniform(-math.pi, math.pi, 2)
+            bearings = PeerBearings(azimuths, distances, 0.0, float(stamp_yaw))
+            held.append((azimuths, distances, float(stamp_yaw) - float(yaw)))
+            expected.append(bearings.near_peers_now(float(yaw), 2.0))
+        bounds, azimuths, distances = _near_peers(held, 2.0)
+        for i, (want_azimuths, want_distances) in enumerate(expected):
+            lo, hi = bounds[i], bounds[i + 1]
+            assert azimuths[lo:hi].tobytes() == want_azimuths.tobytes()
+            assert distances[lo:hi].tobytes() == want_distances.tobytes()
+        assert bounds[-1] == len(azimuths) == len(distances)
+
+
+@pytest.mark.parametrize('float32_fields', [True, False])
+def test_a_bearing_cycle_is_held_as_each_robots_report_would_be(float32_fields):
+    """_deliver_bearings on one flat BearingCycle gives every robot the bearings its own
+    receive_bearings gives from its report (own tags dropped, fields rounded), bit for bit."""
+    rng = np.random.default_rng(8)
+    lidar = LidarConfig()
+    for _ in range(50):
+        n = int(rng.integers(1, 8))
+        model = BearingModel(n, BearingConfig(range_m=20.0), np.random.default_rng(1))
+        cycle = model.measure_cycle(np.column_stack((rng.uniform(0, 5, (n, 2)), np.zeros(n))))
+        # A robot may carry a tag another robot's id names (it keeps that tag's bearings
+        # out), or a tag nobody has (-1).
+        tag_ids = tuple(f'R{i}' for i in range(n))
+        own = [str(rng.choice([*tag_ids, 'X'])) for _ in range(n)]
+        batch = [
+            BatchRobot({'own_tag_id': tag}, lidar, float32_fields=float32_fields) for tag in own
+        ]
+        single = [
+            BatchRobot({'own_tag_id': tag}, lidar, float32_fields=float32_fields) for tag in own
+        ]
+        own_tags = np.array([robot.own_tag_index(tag_ids) for robot in batch], dtype=np.int64)
+        _deliver_bearings(batch, cycle, own_tags, 1.5)
+        for robot, report in zip(single, cycle.reports(), strict=True):
+            robot.receive_bearings(report, tag_ids, 1.5)
+        for got, want in zip(batch, single, strict=True):
+            a, b = got.peer_bearings(1.5), want.peer_bearings(1.5)
+            assert a[0].tobytes() == b[0].tobytes()
+            assert a[1].tobytes() == b[1].tobytes()

@@ -1,0 +1,1 @@
+"""The ROS-free simulator: world, geometry, ray casting, sensor models, sites and signal fields."""

@@ -1,0 +1,116 @@
+"""RPLidar A1 model: 360 one-degree bins, 0.15-12 m, range noise and dropouts.
+
+Figures from the A1 datasheet and HARDWARE.md §2.7: range 0.15-12 m, angular resolution about
+1 degree, 5.5 Hz rotation in standard mode, distance resolution better than 1 % of the range.
+Following REP 117 as the RPLidar driver does: no return within range_max_m and dropped
+samples are ``+inf``, returns closer than range_min_m are ``-inf``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from swarm_sim.errors import ConfigurationError
+from swarm_sim.geometry import RayCaster
+from swarm_sim.raycast_kernel import lidar_noise_kernel
+
+__all__ = ['LidarConfig', 'LidarModel']
+
+
+@dataclass(frozen=True)
+class LidarConfig:
+    """Parameters of the simulated 2D lidar.
+
+    Attributes:
+        num_bins: samples per revolution (360 = one per degree).
+        range_min_m: shortest measurable range [m]; closer returns read ``-inf``.
+        range_max_m: longest measurable range [m]; no return beyond reads ``inf``.
+        rate_hz: revolutions per second (A1 standard mode: 5.5 Hz).
+        range_noise_fraction: standard deviation of the range noise as a fraction of the range.
+        range_noise_min_m: floor of that standard deviation [m].
+        dropout_probability: chance that a sample is lost (reads ``inf``).
+    """
+
+    num_bins: int = 360
+    range_min_m: float = 0.15
+    range_max_m: float = 12.0
+    rate_hz: float = 5.5
+    range_noise_fraction: float = 0.01
+    range_noise_min_m: float = 0.002
+    dropout_probability: float = 0.005
+
+    def __post_init__(self) -> None:
+        if self.num_bins < 4:
+            msg = f'num_bins must be >= 4, got {self.num_bins}'
+            raise ConfigurationError(msg)
+        if not (0.0 <= self.range_min_m < self.range_max_m and math.isfinite(self.range_max_m)):
+            msg = f'need 0 <= range_min_m < range_max_m, got {self.range_min_m}, {self.range_max_m}'
+            raise ConfigurationError(msg)
+        if not self.rate_hz > 0.0:
+            msg = f'rate_hz must be positive, got {self.rate_hz}'
+            raise ConfigurationError(msg)
+        if self.range_noise_fraction < 0.0 or self.range_noise_min_m < 0.0:
+            raise ConfigurationError('range noise must be >= 0')
+        if not 0.0 <= self.dropout_probability < 1.0:
+            msg = f'dropout_probability must be in [0, 1), got {self.dropout_probability}'
+            raise ConfigurationError(msg)
+
+    @property
+    def angle_increment_rad(self) -> float:
+        """Angle between consecutive bins [rad]."""
+        return 2.0 * math.pi / self.num_bins
+
+
+class LidarModel:
+    """Noisy 360-degree scans of every robot from exact ray-cast ranges."""
+
+    def __init__(self, caster: RayCaster, config: LidarConfig, rng: np.random.Generator) -> None:
+        if caster.num_bins != config.num_bins:
+            msg = f'caster has {caster.num_bins} bins, config {config.num_bins}'
+            raise ConfigurationError(msg)
+        self.config = config
+        self._caster = caster
+        self._rng = rng
+
+    def measure(self, poses: np.ndarray) -> np.ndarray:
+        """Scan from every robot.
+
+        Args:
+            poses: (N, 3) true x [m], y [m], yaw [rad].
+
+        Returns:
+            (N, num_bins) ranges [m]; bin k at robot-frame angle -pi + k * angle_increment.
+        """
+        cfg = self.config
+        exact = self._caster.scan(poses, cfg.range_max_m)
+        # The same draws as measure_reference, in the same order.
+        normal = self._rng.normal(0.0, 1.0, int(np.count_nonzero(np.isfinite(exact))))
+        uniform = self._rng.random(exact.shape) if cfg.dropout_probability > 0.0 else exact
+        return lidar_noise_kernel(
+            exact,
+            normal,
+            uniform,
+            cfg.range_noise_fraction,
+            cfg.range_noise_min_m,
+            cfg.dropout_probability,
+            cfg.range_min_m,
+            cfg.range_max_m,
+        )
+
+    def measure_reference(self, poses: np.ndarray) -> np.ndarray:
+        """:meth:`measure` in numpy, the reference of the compiled noise kernel (the same
+        ranges from the same random state)."""
+        cfg = self.config
+        exact = self._caster.scan(poses, cfg.range_max_m)
+        noise_std = np.maximum(cfg.range_noise_fraction * exact, cfg.range_noise_min_m)
+        finite = np.isfinite(exact)
+        noisy = exact.copy()
+        noisy[finite] += self._rng.normal(0.0, 1.0, int(finite.sum())) * noise_std[finite]
+        if cfg.dropout_probability > 0.0:
+            noisy[self._rng.random(noisy.shape) < cfg.dropout_probability] = np.inf
+        noisy[noisy > cfg.range_max_m] = np.inf
+        noisy[noisy < cfg.range_min_m] = -np.inf
+        return noisy

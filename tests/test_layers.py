@@ -1,0 +1,186 @@
+"""The rule of the layers, read from the imports: each package imports only the layers below it.
+
+Every module of every package is parsed (``ast``, nothing is imported) and its absolute
+imports, including those inside functions, are checked against the layer table:
+
+| package | may import of the project |
+|---|---|
+| swarm_common | nothing |
+| swarm_runtime | swarm_common |
+| algorithm cores | swarm_common; no ROS, no swarm_runtime (their node.py / conversions.py may) |
+| hw_drivers, swarm_analysis | swarm_common, swarm_runtime |
+| swarm_sim | swarm_common; no ROS |
+| sim_bridge | swarm_common, swarm_runtime, swarm_sim; no algorithm |
+| swarm_experiments | all of the above |
+
+Nothing but swarm_experiments itself (and the scripts in benchmarks/, which are not a
+package) imports swarm_experiments. Each package's package.xml also declares every project
+package it imports.
+"""
+
+from __future__ import annotations
+
+import ast
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parents[1]
+
+PACKAGE_DIRS = {
+    'swarm_common': REPO / 'swarm_common',
+    'swarm_runtime': REPO / 'src' / 'swarm_runtime',
+    'swarm_analysis': REPO / 'src' / 'swarm_analysis',
+    'oabug_robot': REPO / 'oabug_robot',
+    'bayes_swarm': REPO / 'bayes_swarm',
+    'msc_pf': REPO / 'msc_pf',
+    'hw_drivers': REPO / 'hw_drivers',
+    'swarm_sim': REPO / 'swarm_sim',
+    'sim_bridge': REPO / 'sim_bridge',
+    'swarm_experiments': REPO / 'swarm_experiments',
+}
+ALGORITHMS = frozenset({'oabug_robot', 'bayes_swarm', 'msc_pf'})
+# The modules of an algorithm package that translate messages; everything else is the core.
+ALGORITHM_ROS_MODULES = frozenset({'node.py', 'conversions.py'})
+# Top-level modules that are ROS: rclpy, the message packages, the project's ROS indirection.
+ROS_MODULES = frozenset(
+    {
+        'rclpy',
+        'builtin_interfaces',
+        'diagnostic_msgs',
+        'geometry_msgs',
+        'nav_msgs',
+        'rcl_interfaces',
+        'rosgraph_msgs',
+        'sensor_msgs',
+        'std_msgs',
+        'swarm_interfaces',
+        'swarm_runtime',
+    }
+)
+ALLOWED = {
+    'swarm_common': frozenset(),
+    'swarm_runtime': frozenset({'swarm_common'}),
+    'swarm_analysis': frozenset({'swarm_common', 'swarm_runtime'}),
+    'oabug_robot': frozenset({'swarm_common', 'swarm_runtime'}),
+    'bayes_swarm': frozenset({'swarm_common', 'swarm_runtime'}),
+    'msc_pf': frozenset({'swarm_common', 'swarm_runtime'}),
+    'hw_drivers': frozenset({'swarm_common', 'swarm_runtime'}),
+    'swarm_sim': frozenset({'swarm_common'}),
+    'sim_bridge': frozenset({'swarm_common', 'swarm_runtime', 'swarm_sim'}),
+    'swarm_experiments': frozenset(PACKAGE_DIRS) - {'hw_drivers', 'swarm_experiments'},
+}
+
+
+def _modules(package: str) -> list[Path]:
+    return sorted((PACKAGE_DIRS[package] / package).rglob('*.py'))
+
+
+def _imports(path: Path) -> set[str]:
+    """Absolute module names imported anywhere in ``path``."""
+    names: set[str] = set()
+    for node in ast.walk(ast.parse(path.read_text(), filename=str(path))):
+        if isinstance(node, ast.Import):
+            names.update(alias.name for alias in node.names)
+        elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
+            names.add(node.module)
+    return names
+
+
+def _top_levels(path: Path) -> set[str]:
+    return {name.split('.')[0] for name in _imports(path)}
+
+
+def _relative(path: Path) -> str:
+    return str(path.relative_to(REPO))
+
+
+def test_imports_are_found_at_any_depth_and_relative_ones_skipped(tmp_path: Path) -> None:
+    module = tmp_path / 'module.py'
+    module.write_text(
+        'import numpy as np\n'
+        'from swarm_sim.engine import SimEngine\n'
+        'from . import sibling\n'
+        'def later():\n'
+        '    import rclpy.node\n'
+        '    from bayes_swarm import planner\n'
+    )
+    assert _imports(module) == {'numpy', 'swarm_sim.engine', 'rclpy.node', 'bayes_swarm'}
+    assert _top_levels(module) == {'numpy', 'swarm_sim', 'rclpy', 'bayes_swarm'}
+
+
+def test_the_table_names_every_package_of_the_workspace() -> None:
+    found = {p.parent.name for p in [*REPO.glob('*/setup.py'), *REPO.glob('src/*/setup.py')]}
+    assert found == set(PACKAGE_DIRS)
+    assert set(ALLOWED) == set(PACKAGE_DIRS)
+
+
+def test_every_algorithm_package_has_its_ros_modules() -> None:
+    for package in ALGORITHMS:
+        names = {path.name for path in _modules(package)}
+        assert 'node.py' in names, package
+
+
+@pytest.mark.parametrize('package', sorted(PACKAGE_DIRS))
+def test_packages_import_only_the_layers_below_them(package: str) -> None:
+    project = set(PACKAGE_DIRS)
+    wrong = [
+        f'{_relative(path)} imports {name}'
+        for path in _modules(package)
+        for name in sorted(_top_levels(path) & project - {package} - ALLOWED[package])
+    ]
+    assert not wrong, '\n'.join(wrong)
+
+
+@pytest.mark.parametrize('package', sorted(ALGORITHMS))
+def test_algorithm_cores_import_no_ros(package: str) -> None:
+    cores = [path for path in _modules(package) if path.name not in ALGORITHM_ROS_MODULES]
+    assert len(cores) > 5
+    wrong = [
+        f'{_relative(path)} imports {name}'
+        for path in cores
+        for name in sorted(_imports(path))
+        if name.split('.')[0] in ROS_MODULES
+    ]
+    assert not wrong, '\n'.join(wrong)
+
+
+def test_the_simulator_imports_no_ros_and_no_algorithm() -> None:
+    wrong = [
+        f'{_relative(path)} imports {name}'
+        for path in _modules('swarm_sim')
+        for name in sorted(_top_levels(path) & (ROS_MODULES | ALGORITHMS))
+    ]
+    assert not wrong, '\n'.join(wrong)
+
+
+def test_the_bridge_imports_no_algorithm() -> None:
+    wrong = [
+        f'{_relative(path)} imports {name}'
+        for path in _modules('sim_bridge')
+        for name in sorted(_top_levels(path) & ALGORITHMS)
+    ]
+    assert not wrong, '\n'.join(wrong)
+
+
+def test_only_benchmarks_import_the_experiments() -> None:
+    users = [
+        _relative(path)
+        for package in sorted(set(PACKAGE_DIRS) - {'swarm_experiments'})
+        for path in _modules(package)
+        if 'swarm_experiments' in _top_levels(path)
+    ]
+    assert not users
+    assert any(
+        'swarm_experiments' in _top_levels(path) for path in (REPO / 'benchmarks').glob('*.py')
+    )
+
+
+@pytest.mark.parametrize('package', sorted(PACKAGE_DIRS))
+def test_package_xml_declares_every_project_package_imported(package: str) -> None:
+    root = ET.parse(PACKAGE_DIRS[package] / 'package.xml').getroot()
+    declared = {element.text for element in root.iter('exec_depend')}
+    imported = set().union(*(_top_levels(path) for path in _modules(package)))
+    missing = sorted((imported & set(PACKAGE_DIRS)) - {package} - declared)
+    assert not missing, f'{package}/package.xml lacks exec_depend {missing}'
