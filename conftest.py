@@ -7,10 +7,11 @@ robot could not serialize fails here. Both are set before any test module import
 message class; an explicit setting in the environment wins.
 
 The same tests run on either ROS runtime (``SWARM_RUNTIME=builtin`` or ``rclpy``, see
-docs/runtime.md). On real rclpy every test process (each pytest-xdist worker) gets a DDS
-domain of its own, held through a lock file so that concurrent test sessions on the machine
-never share one, and discovery stays on this host (ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST);
-both are set before rclpy is imported, and child processes that tests start inherit them.
+docs/runtime.md). Every test process (each pytest-xdist worker) gets a DDS domain
+of its own (``ROS_DOMAIN_ID``: ``SWARM_TEST_DOMAIN_BASE``, default 40, plus the worker
+number, or the next id no other test process on the machine holds) and discovery stays on
+this host (``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST``); both are set before rclpy is
+imported, and child processes that tests start inherit them (swarm_runtime.dds_isolation).
 Tests marked ``builtin_only(reason)`` hold only on the built-in runtime (bit-exact
 determinism, virtual wall time) and are skipped on real rclpy with their reason; tests listed
 in tests/rclpy_pending.txt are not ported to real rclpy yet and are skipped there too.
@@ -28,14 +29,13 @@ on a busy machine).
 
 from __future__ import annotations
 
-import fcntl
+import atexit
 import importlib
 import os
-import tempfile
 from pathlib import Path
-from typing import Any
 
 import pytest
+from swarm_runtime.dds_isolation import isolate_test_process  # imports nothing of ROS
 
 os.environ.setdefault('ROS_PYTHON_CHECK_FIELDS', '1')
 os.environ.setdefault('SWARM_RUNTIME_CDR_ROUNDTRIP', '1')
@@ -43,37 +43,11 @@ os.environ.setdefault('MPLBACKEND', 'Agg')
 for _blas_threads in ('OPENBLAS_NUM_THREADS', 'OMP_NUM_THREADS', 'MKL_NUM_THREADS'):
     os.environ.setdefault(_blas_threads, '1')
 
-# Domains 1..200 for tests (0 is every ROS installation's default); Fast DDS derives its
-# ports from the domain and accepts at most 232.
-_FIRST_TEST_DOMAIN = 1
-_TEST_DOMAINS = 200
-# Open for the life of this process: the lock on it reserves the domain.
-_domain_lock: Any = None
 
-
-def _reserve_ros_domain() -> int:
-    """Take the first free test domain, starting from one chosen by the process id."""
-    global _domain_lock  # one reservation per process, held until it exits
-    lock_dir = Path(tempfile.gettempdir()) / 'swarm-search-ros-domains'
-    lock_dir.mkdir(exist_ok=True)
-    start = os.getpid() % _TEST_DOMAINS
-    for offset in range(_TEST_DOMAINS):
-        domain = _FIRST_TEST_DOMAIN + (start + offset) % _TEST_DOMAINS
-        handle = (lock_dir / f'{domain}.lock').open('a')
-        try:
-            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError:
-            handle.close()
-            continue
-        _domain_lock = handle
-        return domain
-    msg = f'all {_TEST_DOMAINS} test ROS domains are taken by other test processes'
-    raise RuntimeError(msg)
-
-
-os.environ['ROS_DOMAIN_ID'] = str(_reserve_ros_domain())
-os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
-os.environ.pop('ROS_STATIC_PEERS', None)
+# Before anything imports rclpy: a DDS domain of this process's own, discovery on this host
+# (swarm_runtime.dds_isolation). The reservation lives as long as this process.
+_DOMAIN = isolate_test_process()
+atexit.register(_DOMAIN.release)
 
 
 def _import_workspace_packages() -> None:
