@@ -202,10 +202,12 @@ class RPLidarNode(Node):
         super().destroy_node()
 
 
-def main(args: list[str] | None = None) -> None:
+def main(args: list[str] | None = None) -> int:
     """Entry point of ``ros2 run hw_drivers rplidar_node``."""
-    run_driver_node(RPLidarNode, 'rplidar_node', args, summary=__doc__ or '', parameters=PARAMETERS)
+    return run_driver_node(
+        RPLidarNode, 'rplidar_node', args, summary=__doc__ or '', parameters=PARAMETERS
+    )
 
 
 if __name__ == '__main__':
-    main()
+    raise SystemExit(main())

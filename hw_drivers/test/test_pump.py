@@ -19,6 +19,7 @@ from swarm_runtime.ros import (
     SingleThreadedExecutor,
     message_module,
     rclpy,
+    using_real_rclpy,
 )
 from swarm_runtime.simulation import spin_until, wall_time_s
 
@@ -302,31 +303,34 @@ def test_a_busy_line_is_retried_slowly(flaky_pump):
 
 _CHILD = textwrap.dedent(
     """
-    import sys, time
-    from swarm_runtime.ros import rclpy, Parameter
+    import sys
+    from hw_drivers import pump_node
     from hw_drivers.fakes.gpio import FakePumpOutput
-    from hw_drivers.pump_node import PumpNode, install_signal_handlers
 
     class Reporting(FakePumpOutput):
         def set(self, on):
             super().set(on)
             print('LEVEL', int(on), flush=True)
 
-    rclpy.init()
-    node = PumpNode(output=Reporting())
-    node._controller.command(True, node._now_s())
-    node._apply(node._controller.update)
+    class OnAtStart(pump_node.PumpNode):
+        # The pump_node executable with a line that reports its level, commanded on.
+        def __init__(self, **kwargs):
+            super().__init__(output=Reporting(), **kwargs)
+            self._controller.command(True, self._now_s())
+            self._apply(self._controller.update)
+            print('READY', flush=True)
+
     mode = sys.argv[1]
     if mode == 'signal':
-        install_signal_handlers(node.shutdown_pump)
-        try:
-            print('READY', flush=True)
-            while True:
-                time.sleep(0.01)
-        except KeyboardInterrupt:
-            print('INTERRUPTED', flush=True)
+        pump_node.PumpNode = OnAtStart
+        # Long limits: only the signal may turn the pump off.
+        limits = ['-p', 'max_on_s:=60.0', '-p', 'command_timeout_s:=60.0']
+        status = pump_node.main(['--ros-args', *limits])
+        print('EXIT', status, flush=True)
     elif mode == 'atexit':
-        print('READY', flush=True)
+        from swarm_runtime.ros import rclpy
+        rclpy.init()
+        node = OnAtStart()
         sys.exit(3)
     """
 )
@@ -335,9 +339,14 @@ _CHILD = textwrap.dedent(
 def _child(mode, tmp_path):
     script = tmp_path / 'pump_child.py'
     script.write_text(_CHILD)
-    env = {**os.environ, 'PYTHONUNBUFFERED': '1'}
+    runtime = 'rclpy' if using_real_rclpy() else 'builtin'
+    env = {**os.environ, 'PYTHONUNBUFFERED': '1', 'SWARM_RUNTIME': runtime}
     return subprocess.Popen(
-        [sys.executable, str(script), mode], stdout=subprocess.PIPE, text=True, env=env
+        [sys.executable, str(script), mode],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=env,
     )
 
 
@@ -349,17 +358,21 @@ def test_signals_turn_the_pump_off_before_the_process_exits(tmp_path, signum):
     for line in child.stdout:
         lines.append(line.strip())
         if line.startswith('READY'):
+            time.sleep(0.3)  # spinning
             child.send_signal(signum)
-    child.wait(10)
-    assert lines[0] == 'LEVEL 1'
-    assert 'LEVEL 0' in lines
-    assert lines.index('LEVEL 0') < lines.index('INTERRUPTED')
+    stderr = child.stderr.read()
+    assert child.wait(30) == 0, stderr
+    assert 'Traceback' not in stderr, stderr
+    assert lines[:2] == ['LEVEL 1', 'READY']
+    assert lines[-1] == 'EXIT 0'
+    assert lines[2:-1], 'the pump went off'
+    assert set(lines[2:-1]) == {'LEVEL 0'}, 'and never on again'
 
 
 @pytest.mark.slow
 def test_atexit_turns_the_pump_off_on_an_unplanned_exit(tmp_path):
     child = _child('atexit', tmp_path)
-    out, _ = child.communicate(timeout=10)
+    out, _ = child.communicate(timeout=30)
     assert child.returncode == 3
     lines = out.splitlines()
     assert lines[:2] == ['LEVEL 1', 'READY']

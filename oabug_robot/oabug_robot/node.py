@@ -254,17 +254,21 @@ class OABugNode(Node):
         for name, default, description in PARAMETERS:
             descriptor = rcl_interfaces.ParameterDescriptor(description=description, read_only=True)
             values[name] = self.declare_parameter(name, default, descriptor).value
-        self._config = config_from_parameters(values)
-        rate_hz = float(values['control_rate_hz'])
-        self._stale_timeout_s = float(values['stale_timeout_s'])
-        if not (math.isfinite(rate_hz) and rate_hz > 0.0):
-            raise ConfigError(f'control_rate_hz must be > 0, got {rate_hz}')
-        if not (math.isfinite(self._stale_timeout_s) and self._stale_timeout_s > 0.0):
-            raise ConfigError(f'stale_timeout_s must be > 0, got {self._stale_timeout_s}')
-        state_rate_hz = float(values['state_rate_hz'])
-        if not (math.isfinite(state_rate_hz) and state_rate_hz > 0.0):
-            raise ConfigError(f'state_rate_hz must be > 0, got {state_rate_hz}')
-        self._state_period_s = 1.0 / state_rate_hz
+        try:
+            self._config = config_from_parameters(values)
+            rate_hz = float(values['control_rate_hz'])
+            self._stale_timeout_s = float(values['stale_timeout_s'])
+            if not (math.isfinite(rate_hz) and rate_hz > 0.0):
+                raise ConfigError(f'control_rate_hz must be > 0, got {rate_hz}')
+            if not (math.isfinite(self._stale_timeout_s) and self._stale_timeout_s > 0.0):
+                raise ConfigError(f'stale_timeout_s must be > 0, got {self._stale_timeout_s}')
+            state_rate_hz = float(values['state_rate_hz'])
+            if not (math.isfinite(state_rate_hz) and state_rate_hz > 0.0):
+                raise ConfigError(f'state_rate_hz must be > 0, got {state_rate_hz}')
+            self._state_period_s = 1.0 / state_rate_hz
+        except ConfigError as err:
+            self.get_logger().fatal(f'invalid configuration: {err}')
+            raise
         self._own_tag_id = str(values['own_tag_id'])
         self._fsm = OABugFsm(self._config)
         self._extractor = ScanFeatureExtractor(self._config.perception)
@@ -447,7 +451,10 @@ class OABugNode(Node):
 
 def main(args: list[str] | None = None) -> int:
     """Console entry point: ``ros2 run oabug_robot oabug``."""
-    return run_node(OABugNode, args, name='oabug', fatal_errors=(ConfigError,))
+    # The node logs its configuration errors itself (describe_fatal None: no second line).
+    return run_node(
+        OABugNode, args, name='oabug', fatal_errors=(ConfigError,), describe_fatal=lambda _: None
+    )
 
 
 if __name__ == '__main__':

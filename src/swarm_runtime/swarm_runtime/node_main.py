@@ -1,68 +1,89 @@
 """The ``main()`` of a node executable, as on ROS 2 Jazzy, with a clean exit on every stop.
 
-Every node's console entry point is one line::
+Every node's console entry point is one call::
 
     def main(args: list[str] | None = None) -> int:
         return run_node(OABugNode, args, name='oabug', fatal_errors=(ConfigError,))
 
-:func:`run_node` does the Jazzy boilerplate (``rclpy.init``, build the node, ``rclpy.spin``,
-``destroy_node``, ``rclpy.try_shutdown``) and makes a stop by Ctrl-C (SIGINT) or SIGTERM exit
-with status 0 and no traceback. Catching KeyboardInterrupt and ExternalShutdownException is
-not enough on real rclpy:
+:func:`run_node` does the Jazzy boilerplate (``rclpy.init``, build the node, spin it,
+``destroy_node``, ``rclpy.try_shutdown``) and makes a stop by Ctrl-C (SIGINT) or SIGTERM
+exit with status 0 and no traceback, on real rclpy and on the built-in runtime. Catching
+KeyboardInterrupt and ExternalShutdownException is not enough on real rclpy:
 
 - rclpy's signal handler shuts the context down from another thread, so a callback that is
   running at that moment fails (a timer that publishes gets ``RCLError: publisher's context
-  is invalid``). A failure raised while the context is no longer ok is the stop itself and is
-  not reported; a failure while the context is still ok is a real error and propagates.
+  is invalid``; a node still being built, ``rcl node's context is invalid``). A failure
+  raised while the context is no longer ok is the stop itself and is not reported; a
+  failure while the context is still ok is a real error and propagates.
 - For SIGINT rclpy also calls Python's handler, whose KeyboardInterrupt can land anywhere,
-  even inside rclpy's executor half-way through building a task, which then prints "Exception
-  ignored ... Traceback" when it is collected. So while rclpy's handler is installed, the
-  first SIGINT raises nothing in Python: the context shutdown stops the spin. A second
-  SIGINT (a stop that hangs), and any SIGINT before ``rclpy.init`` finished or on the built-in
-  runtime (which installs no signal handler), raise KeyboardInterrupt as usual.
+  even inside rclpy's executor half-way through building a task, which then prints
+  "Exception ignored ... Traceback" when it is collected.
+
+So Python-level handlers for SIGINT and SIGTERM are installed before ``rclpy.init`` (which
+chains its own handlers to them). Each first calls ``on_signal(node)`` if given (e.g. the
+pump driver turns its pump off at once, before anything else). Then, if rclpy handles that
+signal, the first stop raises nothing in Python: the context shutdown ends the spin. A
+second stop signal (a stop that hangs), a signal before ``rclpy.init`` finished, and any
+signal on the built-in runtime (which installs no handlers) raise KeyboardInterrupt, which
+unwinds into the same teardown.
 """
 
 from __future__ import annotations
 
+import contextlib
 import importlib
 import signal
 from collections.abc import Callable, Sequence
 from types import FrameType
-from typing import Any
+from typing import Any, TypeVar
 
 from swarm_runtime.ros import ExternalShutdownException, rclpy, using_real_rclpy
 
-__all__ = ['EXIT_FATAL_ERROR', 'run_node']
+__all__ = ['EXIT_FATAL_ERROR', 'STOP_SIGNALS', 'run_node']
 
-# Exit status after one of the ``fatal_errors`` (as the spawners exit on bad arguments).
+NodeT = TypeVar('NodeT')
+
+#: Exit status after one of the ``fatal_errors`` (bad parameters, an unusable device).
 EXIT_FATAL_ERROR = 2
+#: The signals that stop a node cleanly.
+STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
 
 
-class _SigintGuard:
-    """Python's SIGINT handler while run_node runs: silent for the first SIGINT rclpy handles."""
+class _StopSignals:
+    """Python's SIGINT / SIGTERM handlers while run_node runs (see the module docstring)."""
 
-    def __init__(self) -> None:
-        self.rclpy_handles_sigint = False
-        self._seen = False
-        self._previous = signal.signal(signal.SIGINT, self._on_sigint)
+    def __init__(self, on_signal: Callable[[], None]) -> None:
+        self._on_signal = on_signal
+        self._rclpy_handles: set[int] = set()
+        self._stopping = False
+        self._previous = {signum: signal.signal(signum, self._handle) for signum in STOP_SIGNALS}
 
-    def check_rclpy_handler(self) -> None:
-        """Call after ``rclpy.init``: is rclpy's SIGINT handler (chained to this one) in place?"""
+    def check_rclpy_handlers(self) -> None:
+        """Call after ``rclpy.init``: which of the signals do rclpy's handlers (chained) take?"""
         if not using_real_rclpy():
             return  # the built-in runtime installs no signal handlers
         signals = importlib.import_module('rclpy.signals')
+        options = signals.SignalHandlerOptions
         current = signals.get_current_signal_handlers_options()
-        handled = (signals.SignalHandlerOptions.SIGINT, signals.SignalHandlerOptions.ALL)
-        self.rclpy_handles_sigint = current in handled
+        if current in (options.SIGINT, options.ALL):
+            self._rclpy_handles.add(signal.SIGINT)
+        if current in (options.SIGTERM, options.ALL):
+            self._rclpy_handles.add(signal.SIGTERM)
 
-    def _on_sigint(self, signum: int, frame: FrameType | None) -> None:
-        if self.rclpy_handles_sigint and not self._seen:
-            self._seen = True
+    def _handle(self, signum: int, _frame: FrameType | None) -> None:
+        # The teardown runs the same hook again and reports its failures; here it must not
+        # raise into whatever code the signal interrupted.
+        with contextlib.suppress(Exception):
+            self._on_signal()
+        first = not self._stopping
+        self._stopping = True
+        if first and signum in self._rclpy_handles:
             return  # rclpy's handler, which called this one, is shutting the context down
-        raise KeyboardInterrupt
+        raise KeyboardInterrupt(f'signal {signum}')
 
     def restore(self) -> None:
-        signal.signal(signal.SIGINT, self._previous)
+        for signum, handler in self._previous.items():
+            signal.signal(signum, handler)
 
 
 class _Teardown:
@@ -84,15 +105,18 @@ class _Teardown:
                     rclpy.try_shutdown()
                 return
             except KeyboardInterrupt:
-                continue  # the SIGINT that stopped the node arrived late: go on
+                continue  # a second stop signal arrived during the teardown: go on
 
 
 def run_node(
-    node_factory: Callable[[], Any],
+    node_factory: Callable[[], NodeT],
     args: Sequence[str] | None = None,
     *,
     name: str,
     fatal_errors: tuple[type[Exception], ...] = (),
+    describe_fatal: Callable[[Exception], str | None] = str,
+    on_signal: Callable[[NodeT], None] | None = None,
+    spin: Callable[[NodeT], None] | None = None,
 ) -> int:
     """Initialise rclpy with ``args``, build the node, spin it until stopped; return the status.
 
@@ -100,8 +124,13 @@ def run_node(
         node_factory: builds the node (its class, or a function returning it).
         args: command-line arguments (``None``: the process's own, as rclpy reads them).
         name: logger name for errors raised before the node exists (the executable's).
-        fatal_errors: the node's own errors that end it with a one-line message instead of a
-            traceback (bad parameters, an unusable device): logged, status 2.
+        fatal_errors: the node's own errors that end it with a one-line fatal log instead of
+            a traceback (bad parameters, an unusable device), with status 2.
+        describe_fatal: the log line for one of ``fatal_errors`` (None: the node has logged
+            it already).
+        on_signal: called with the node (once it exists) as soon as SIGINT or SIGTERM
+            arrives, before the stop begins; e.g. to switch an actuator off.
+        spin: runs the node until the context shuts down (default ``rclpy.spin``).
 
     Returns:
         0 after a stop (Ctrl-C, SIGTERM, shutdown by a callback or another thread),
@@ -110,25 +139,32 @@ def run_node(
     Raises:
         Exception: whatever the node or a callback raised while the context was still ok.
     """
-    guard = _SigintGuard()
     teardown = _Teardown()
+
+    def signalled() -> None:
+        if on_signal is not None and teardown.node is not None:
+            on_signal(teardown.node)
+
+    stop_signals = _StopSignals(signalled)
     status = 0
     started = False
     try:
         try:
             rclpy.init(args=None if args is None else list(args))
             started = True
-            guard.check_rclpy_handler()
+            stop_signals.check_rclpy_handlers()
             teardown.node = node_factory()
-            rclpy.spin(teardown.node)
+            (spin or rclpy.spin)(teardown.node)
         except (KeyboardInterrupt, ExternalShutdownException):
             pass
         except fatal_errors as err:
             if rclpy.ok():
-                node = teardown.node
-                logger = node.get_logger() if node is not None else None
-                (logger or rclpy.logging.get_logger(name)).fatal(str(err))
                 status = EXIT_FATAL_ERROR
+                line = describe_fatal(err)
+                if line is not None:
+                    node = teardown.node
+                    logger = node.get_logger() if node is not None else None
+                    (logger or rclpy.logging.get_logger(name)).fatal(line)
         except Exception:
             if not started or rclpy.ok():
                 raise
@@ -138,5 +174,5 @@ def run_node(
     except KeyboardInterrupt:
         teardown.run()
     finally:
-        guard.restore()
+        stop_signals.restore()
     return status
