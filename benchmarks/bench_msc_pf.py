@@ -41,7 +41,7 @@ from pathlib import Path  # noqa: E402
 from typing import TypeVar  # noqa: E402
 
 import numpy as np  # noqa: E402
-from msc_pf.parameters import config_from_parameters, parameter_defaults  # noqa: E402
+from msc_pf.parameters import MSC_PF_PARAMETERS  # noqa: E402
 from msc_pf.particle_filter import ParticleFilterBank, resolve_backend  # noqa: E402
 from msc_pf.schemes import Scheme  # noqa: E402
 from msc_pf.settings import MscPfConfig, ParticleFilterConfig, RadioConfig  # noqa: E402
@@ -102,15 +102,15 @@ def controller_overrides(items: Sequence[str]) -> Overrides:
         ConfigurationError: a malformed item, an unknown name, ``scheme``, a value of the
             wrong type, or one the controller rejects.
     """
-    values = parse_overrides(
-        items, parameter_defaults(), reserved=('scheme',), check=config_from_parameters
-    )
+    # The node's own parameters (robot_id, seed, steering) do not reach the batch controller.
+    node_only = [p.name for p in MSC_PF_PARAMETERS.parameters if p.path[0] != 'controller']
+    values = parse_overrides(items, MSC_PF_PARAMETERS, reserved=('scheme', *node_only))
     return tuple(sorted(values.items()))
 
 
 def controller_config(overrides: Overrides) -> MscPfConfig:
     """The default controller configuration with typed ``overrides`` applied."""
-    return config_from_parameters(dict(overrides))
+    return MSC_PF_PARAMETERS.build(dict(overrides)).controller
 
 
 def _run_one(job: Job) -> RunOutcome:

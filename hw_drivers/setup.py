@@ -49,6 +49,7 @@ setup(
             'mpu6050_node = hw_drivers.mpu6050_node:main',
             'aoa_receiver_node = hw_drivers.aoa_receiver_node:main',
             'pump_node = hw_drivers.pump_node:main',
+            'static_frames_node = hw_drivers.static_frames_node:main',
             'pump_off = hw_drivers.pump_off:main',
             'robot_bringup = hw_drivers.robot_bringup.cli:main',
         ],

@@ -5,11 +5,14 @@ Library code raises these; nodes and scripts catch them and log or print the mes
 
 from __future__ import annotations
 
+from swarm_common import params
+
 __all__ = [
     'BayesSwarmError',
     'ConfigError',
     'GpFitError',
     'ObservationError',
+    'ParameterError',
     'PlanningError',
 ]
 
@@ -20,6 +23,10 @@ class BayesSwarmError(Exception):
 
 class ConfigError(BayesSwarmError, ValueError):
     """A configuration value is invalid (negative range, N_max < 1, unknown case, ...)."""
+
+
+class ParameterError(ConfigError, params.ParameterError):
+    """A node parameter is unknown, of the wrong type, out of range or not one of its choices."""
 
 
 class ObservationError(BayesSwarmError, ValueError):

@@ -22,6 +22,7 @@ from typing import Any
 
 import numpy as np
 from swarm_runtime.node_main import run_node
+from swarm_runtime.parameters import declare_config
 from swarm_runtime.ros import (
     Node,
     message_module,
@@ -35,12 +36,11 @@ from bayes_swarm.baselines.levy import LevyWalk
 from bayes_swarm.errors import BayesSwarmError
 from bayes_swarm.follower import WaypointFollower
 from bayes_swarm.messages import Decision, DecisionKind
-from bayes_swarm.node_settings import PARAMETERS, NodeSettings, settings_from_values
+from bayes_swarm.node_settings import BAYES_SWARM_PARAMETERS, NODE_NAME, NodeSettings
 from bayes_swarm.planner import BayesSwarmPlanner, first_waypoint
 
 __all__ = ['BayesSwarmNode', 'main']
 
-_rcl = message_module('rcl_interfaces')
 _nav = message_module('nav_msgs')
 _geometry = message_module('geometry_msgs')
 _swarm = message_module('swarm_interfaces')
@@ -50,17 +50,12 @@ class BayesSwarmNode(Node):
     """One robot running a source-seeking algorithm of the Bayes-Swarm-P study."""
 
     def __init__(self, **node_kwargs: Any) -> None:
-        super().__init__('bayes_swarm', **node_kwargs)
-        for spec in PARAMETERS:
-            self.declare_parameter(
-                spec.name, spec.default, _rcl.ParameterDescriptor(description=spec.description)
-            )
-        values = {spec.name: self.get_parameter(spec.name).value for spec in PARAMETERS}
-        self.settings: NodeSettings = settings_from_values(values)
+        super().__init__(NODE_NAME, **node_kwargs)
+        self._declared = declare_config(self, BAYES_SWARM_PARAMETERS, on_change=self._configure)
+        self._configure(self._declared.config)
         s = self.settings
         namespace = self.get_namespace().strip('/')
         self.robot_name = namespace.split('/')[-1] if namespace else f'r{s.planner.robot_index}'
-        self._follower = WaypointFollower(s.follower)
         self._pose: tuple[float, float, float] | None = None
         self._pose_time_s = -math.inf
         self._waypoint: np.ndarray | None = None
@@ -83,7 +78,7 @@ class BayesSwarmNode(Node):
                 seed=s.seed,
                 fan_index=s.fan_index,
                 fan_size=s.fan_size,
-                direction_offset_deg=s.direction_offset_deg,
+                direction_offset_deg=s.initial_direction_offset_deg,
             )
             peer_type = _swarm.BayesSwarmPeer
         elif s.algorithm == 'levy':
@@ -111,6 +106,12 @@ class BayesSwarmNode(Node):
             f'{s.algorithm} robot {self.robot_name} ({s.planner.robot_index + 1} of '
             f'{s.planner.n_robots}), V {s.planner.velocity_mps:g} m/s, T {s.planner.horizon_s:g} s'
         )
+
+    def _configure(self, settings: NodeSettings) -> None:
+        """Take the settings (at start, and the follower's after an accepted change)."""
+        self.settings = settings
+        self._follower_config = settings.follower
+        self._follower = WaypointFollower(self._follower_config)
 
     @property
     def planner(self) -> BayesSwarmPlanner | None:
@@ -205,7 +206,7 @@ class BayesSwarmNode(Node):
                     fan_index=s.fan_index or s.planner.robot_index + 1,
                     fan_size=s.fan_size or s.planner.n_robots,
                     direction_range_deg=s.planner.initial_direction_range_deg,
-                    direction_offset_deg=s.direction_offset_deg,
+                    direction_offset_deg=s.initial_direction_offset_deg,
                     leg_m=s.planner.max_leg_m,
                 )
             )
@@ -223,7 +224,7 @@ class BayesSwarmNode(Node):
             return
         position = np.array(self._pose[:2])
         if self._decisions == 1 and np.hypot(*(self._waypoint - position)) > (
-            self.settings.follower.arrival_tolerance_m
+            self._follower_config.arrival_tolerance_m
         ):
             return  # still on the first dispersal leg
         if self._last_signal is None:
@@ -246,7 +247,7 @@ class BayesSwarmNode(Node):
         else:
             # A GSO step (mm at 100 Hz) is below the follower's arrival tolerance: steer toward
             # a point a few control periods ahead on the same heading, so the robot moves at V.
-            follower = self.settings.follower
+            follower = self._follower_config
             lookahead = max(
                 2.0 * follower.arrival_tolerance_m,
                 2.0 * follower.speed_mps / self.settings.control_rate_hz,
@@ -257,7 +258,13 @@ class BayesSwarmNode(Node):
 
 def main(args: list[str] | None = None) -> int:
     """Entry point of ``ros2 run bayes_swarm bayes_swarm_node``."""
-    return run_node(BayesSwarmNode, args, name='bayes_swarm', fatal_errors=(BayesSwarmError,))
+    return run_node(
+        BayesSwarmNode,
+        args,
+        name=NODE_NAME,
+        fatal_errors=(BayesSwarmError,),
+        parameters=BAYES_SWARM_PARAMETERS,
+    )
 
 
 if __name__ == '__main__':

@@ -17,10 +17,11 @@ from the paper in a few places; those departures are available as switches, all 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
+from swarm_common.params import parameter, section
 
 from bayes_swarm.errors import ConfigError
 
@@ -58,10 +59,10 @@ def _positive(name: str, value: float) -> None:
 class Arena:
     """Axis-aligned rectangular search area in the world frame [m]."""
 
-    x_min_m: float
-    x_max_m: float
-    y_min_m: float
-    y_max_m: float
+    x_min_m: float = parameter(description='arena lower x bound', unit='m')
+    x_max_m: float = parameter(description='arena upper x bound', unit='m')
+    y_min_m: float = parameter(description='arena lower y bound', unit='m')
+    y_max_m: float = parameter(description='arena upper y bound', unit='m')
 
     def __post_init__(self) -> None:
         for name in ('x_min_m', 'x_max_m', 'y_min_m', 'y_max_m'):
@@ -105,7 +106,7 @@ class GpConfig:
     most ``max_fit_iterations`` likelihood evaluations.
     """
 
-    noise_std: float = 1e-3
+    noise_std: float = parameter(1e-3, 'GP observation noise std (signal units)', gt=0.0)
     length_scale_bounds_m: tuple[float, float] = (1e-3, 500.0)
     signal_variance_bounds: tuple[float, float] = (1e-5, 1e5)
     initial_length_scale_m: float = 1.0
@@ -143,24 +144,42 @@ class BayesSwarmConfig:
     Omega is flat far from the expected source on a large arena.
     """
 
-    arena: Arena = field(default_factory=lambda: Arena(0.0, 2.4, 0.0, 2.4))
-    robot_index: int = 0
-    n_robots: int = 5
-    velocity_mps: float = 0.1
-    horizon_s: float = 10.0
-    observation_rate_hz: float = 1.0
-    detection_radius_m: float = 0.05
-    max_mission_time_s: float = 100.0
-    initial_direction_range_deg: float = 90.0
-    max_signal: float = 1.2
-    lipschitz: float = 2.0
+    arena: Arena = section(lambda: Arena(0.0, 2.4, 0.0, 2.4), prefix='arena_')
+    robot_index: int = parameter(0, '0-based index of this robot in the swarm', ge=0)
+    n_robots: int = parameter(5, 'Swarm size m', ge=1)
+    velocity_mps: float = parameter(0.1, 'nominal speed V', unit='m/s', gt=0.0)
+    horizon_s: float = parameter(
+        10.0, 'decision horizon T; legs are at most V T long', unit='s', gt=0.0
+    )
+    observation_rate_hz: float = parameter(
+        1.0, 'signal observation frequency f_Hz', unit='Hz', gt=0.0
+    )
+    detection_radius_m: float = parameter(0.05, 'detection radius eps', unit='m', gt=0.0)
+    max_mission_time_s: float = parameter(100.0, 'T_max of the alpha schedule', unit='s', gt=0.0)
+    initial_direction_range_deg: float = parameter(
+        90.0, 'Delta theta of the first decision', unit='deg', gt=0.0, le=360.0
+    )
+    max_signal: float = parameter(1.2, 'M, the maximum signal strength of the penalty')
+    lipschitz: float = parameter(
+        2.0, 'L, the Lipschitz constant of the penalty', unit='signal/m', gt=0.0
+    )
     penalty_enabled: bool = True
-    robot_size_m: float = 0.1
-    n_max: int = 1000
-    alpha_time_scale: float = 1.0
-    fixed_alpha: float | None = None
-    dimensionless_acquisition: bool = False
-    outer_optimizer: OuterOptimizer = 'grid'
+    robot_size_m: float = parameter(0.1, 'l_robot of Algorithm 2', unit='m', gt=0.0)
+    n_max: int = parameter(1000, 'N_max: observations kept for the GP after downsampling', ge=1)
+    alpha_time_scale: float = parameter(
+        1.0, 'Factor on T_max in the alpha schedule (code: 0.1)', gt=0.0
+    )
+    fixed_alpha: float | None = parameter(
+        None,
+        'constant alpha in [0, 1] instead of Algorithm 2 (-1.0: Algorithm 2)',
+        ge=0.0,
+        le=1.0,
+        none=-1.0,
+    )
+    dimensionless_acquisition: bool = parameter(
+        False, 'Omega in leg lengths and Sigma over prior std x leg (not in the paper)'
+    )
+    outer_optimizer: OuterOptimizer = parameter('grid', 'solver of Eq. 1')
     inner_optimizer: Literal['newton', 'lbfgsb'] = 'newton'
     n_candidate_headings: int = 24
     n_inner_starts: int = 2
@@ -169,10 +188,10 @@ class BayesSwarmConfig:
     pso_iterations: int = 40
     max_peer_path_points: int = 400
     penalty_std_floor: float = 1e-3
-    gp: GpConfig = field(default_factory=GpConfig)
-    authors_negated_m: bool = False
-    authors_origin_paths: bool = False
-    authors_floor_downsampling: bool = False
+    gp: GpConfig = section(GpConfig, prefix='')
+    authors_negated_m: bool = parameter(False, "Authors' defect: M = -max(mu) (inert penalty)")
+    authors_origin_paths: bool = parameter(False, "Authors' defect: paths measured from (0, 0)")
+    authors_floor_downsampling: bool = parameter(False, "Authors' defect: floor(n / N_max)")
 
     def __post_init__(self) -> None:
         _require(self.n_robots >= 1, f'n_robots must be >= 1, got {self.n_robots}')
@@ -238,11 +257,11 @@ class GlowwormConfig:
     luciferin_decay: float = 0.4
     luciferin_enhancement: float = 0.6
     range_gain: float = 0.08
-    sensor_range_m: float = 20.0
+    sensor_range_m: float = parameter(20.0, 'Glowworm sensor range r_s', unit='m', gt=0.0)
     step_m: float = 0.03
     desired_neighbours: int = 5
     initial_luciferin: float = 5.0
-    decision_rate_hz: float = 100.0
+    decision_rate_hz: float = parameter(100.0, 'Glowworm decisions per second', unit='Hz', gt=0.0)
     deterministic: bool = False
 
     def __post_init__(self) -> None:
@@ -265,8 +284,8 @@ class LevyConfig:
     around the direction of rising signal with concentration ``turning_concentration``.
     """
 
-    mu: float = 2.0
-    min_step_m: float = 0.5
+    mu: float = parameter(2.0, 'Levy walk exponent mu', gt=1.0, le=3.0)
+    min_step_m: float = parameter(0.5, 'Levy walk minimum step l0', unit='m', gt=0.0)
     max_step_m: float | None = None
     turning_concentration: float = 0.2
     taxis: bool = False
@@ -291,7 +310,7 @@ class ExhaustiveConfig:
     """
 
     lane_spacing_m: float | None = None
-    partition: Literal['strips', 'quadrants'] = 'strips'
+    partition: Literal['strips', 'quadrants'] = parameter('strips', 'sweep partition of the arena')
 
     def __post_init__(self) -> None:
         if self.lane_spacing_m is not None:

@@ -18,7 +18,7 @@ from bayes_swarm.conversions import (
 from bayes_swarm.errors import ConfigError, ObservationError
 from bayes_swarm.follower import FollowerConfig, WaypointFollower
 from bayes_swarm.messages import Decision, DecisionKind, PeerUpdate
-from bayes_swarm.node_settings import PARAMETERS, settings_from_values
+from bayes_swarm.node_settings import settings_from_values
 from swarm_runtime.ros import message_module
 from swarm_runtime.testing import cdr_roundtrip
 
@@ -119,17 +119,18 @@ def test_parameter_defaults_give_the_papers_case_1_settings():
     assert settings.planner.max_leg_m == pytest.approx(1.0)
     assert settings.planner.penalty_enabled
     assert not settings_from_values({'algorithm': 'bayes_swarm_o'}).planner.penalty_enabled
-    assert len({p.name for p in PARAMETERS}) == len(PARAMETERS)
+    follower = settings_from_values({'velocity_mps': 0.2}).follower
+    assert (follower.speed_mps, follower.slow_down_m) == (0.2, pytest.approx(0.02))
 
 
 @pytest.mark.parametrize(
     ('values', 'match'),
     [
         ({'algorithm': 'ants'}, 'algorithm'),
-        ({'n_max': 0}, 'N_max'),
+        ({'n_max': 0}, 'n_max: must be >= 1'),
         ({'detection_radius_m': -0.05}, 'detection_radius_m'),
         ({'control_rate_hz': 0.0}, 'control_rate_hz'),
-        ({'speed': 1.0}, 'unknown parameters'),
+        ({'speed': 1.0}, "unknown parameter 'speed'"),
     ],
 )
 def test_invalid_parameters_are_rejected_at_start(values, match):

@@ -17,6 +17,7 @@ import time
 from collections.abc import Callable
 from typing import Any
 
+from swarm_runtime.parameters import declare_config
 from swarm_runtime.ros import (
     Node,
     message_module,
@@ -33,32 +34,18 @@ from hw_drivers.node_common import (
     DIAGNOSTICS_TOPIC,
     DeviceMonitor,
     DevicePoller,
-    ParamSpec,
     TimerGate,
-    declare_parameter_table,
     publish_diagnostics,
     run_driver_node,
     seconds_clock,
 )
+from hw_drivers.parameters import AOA_RECEIVER_PARAMETERS
 from hw_drivers.worker import DeviceWorker, DiagnosticLevel
 
-__all__ = ['PARAMETERS', 'AoaReceiverNode', 'main']
+__all__ = ['AoaReceiverNode', 'main']
 
 swarm_interfaces = message_module('swarm_interfaces')
 diagnostic_msgs = message_module('diagnostic_msgs')
-
-PARAMETERS: list[ParamSpec] = [
-    ('listen_host', '127.0.0.1', 'address the locator connects to (keep loopback)'),
-    ('listen_port', 8080, 'TCP port the locator connects to (authors: 8080)'),
-    ('own_tag_id', '', "this robot's own tag id (e.g. D2), never reported as a peer"),
-    ('azimuth_sign', 1, 'robot azimuth = sign * locator azimuth + offset; -1 flips handedness'),
-    ('azimuth_offset_rad', 0.0, "robot-frame azimuth of the array's 0 deg direction [rad]"),
-    ('publish_rate_hz', 10.0, 'rate of bearing publishes [Hz]'),
-    ('max_buffer_bytes', 16384, 'undecoded JSON beyond this is dropped [bytes]'),
-    ('frame_id', 'base_link', 'frame of the published bearings (robot frame)'),
-    ('stale_timeout_s', 2.0, 'no bearing published for this long is reported stale [s]'),
-    ('device_thread', True, 'run the server loop in its own thread (false: from a timer)'),
-]
 
 
 class AoaReceiverNode(Node):
@@ -66,9 +53,9 @@ class AoaReceiverNode(Node):
 
     def __init__(self, **kwargs: Any) -> None:
         super().__init__('aoa_receiver_node', **kwargs)
-        values = declare_parameter_table(self, PARAMETERS)
-        self._host = str(values['listen_host'])
-        self._port = int(values['listen_port'])
+        config = declare_config(self, AOA_RECEIVER_PARAMETERS).config
+        self._host = config.listen_host
+        self._port = config.listen_port
         if not 0 <= self._port <= 65535:
             raise ConfigurationError(f'listen_port must be 0..65535, got {self._port}')
         if not _is_loopback(self._host):
@@ -76,14 +63,12 @@ class AoaReceiverNode(Node):
                 f'listening on {self._host}: the locator input is reachable from the network'
             )
         self._collector = BearingCollector(
-            own_tag_id=str(values['own_tag_id']),
-            mapping=AzimuthMapping(
-                sign=int(values['azimuth_sign']), offset_rad=float(values['azimuth_offset_rad'])
-            ),
+            own_tag_id=config.own_tag_id,
+            mapping=AzimuthMapping(sign=config.azimuth_sign, offset_rad=config.azimuth_offset_rad),
         )
-        self._max_buffer_bytes = int(values['max_buffer_bytes'])
-        self._frame_id = str(values['frame_id'])
-        threaded = bool(values['device_thread'])
+        self._max_buffer_bytes = config.max_buffer_bytes
+        self._frame_id = config.frame_id
+        threaded = config.device_thread
         self._threaded = threaded
         self._device_clock: Callable[[], float] = (
             time.monotonic if threaded else seconds_clock(self)
@@ -101,7 +86,7 @@ class AoaReceiverNode(Node):
         self._monitor = DeviceMonitor(
             f'{self.get_fully_qualified_name()}: aoa locator',
             f'tcp://{self._host}:{self._port}',
-            float(values['stale_timeout_s']),
+            config.stale_timeout_s,
             self.get_logger(),
         )
         worker = DeviceWorker(
@@ -109,7 +94,7 @@ class AoaReceiverNode(Node):
         )
         self._poller = DevicePoller(self, worker, threaded=threaded)
         self._bearing_gate = TimerGate(
-            self.create_timer(1.0 / float(values['publish_rate_hz']), self._publish_bearings)
+            self.create_timer(1.0 / config.publish_rate_hz, self._publish_bearings)
         )
         self.create_timer(1.0, self._publish_diagnostics)
 
@@ -198,7 +183,11 @@ def _is_loopback(host: str) -> bool:
 def main(args: list[str] | None = None) -> int:
     """Entry point of ``ros2 run hw_drivers aoa_receiver_node``."""
     return run_driver_node(
-        AoaReceiverNode, 'aoa_receiver_node', args, summary=__doc__ or '', parameters=PARAMETERS
+        AoaReceiverNode,
+        'aoa_receiver_node',
+        args,
+        summary=__doc__ or '',
+        parameters=AOA_RECEIVER_PARAMETERS,
     )
 
 

@@ -15,6 +15,7 @@ from collections import deque
 from collections.abc import Callable
 from typing import Any
 
+from swarm_runtime.parameters import declare_config
 from swarm_runtime.ros import (
     Node,
     message_module,
@@ -41,41 +42,21 @@ from hw_drivers.node_common import (
     DIAGNOSTICS_TOPIC,
     DeviceMonitor,
     DevicePoller,
-    ParamSpec,
     TimerGate,
-    declare_parameter_table,
     no_sleep,
     publish_diagnostics,
     run_driver_node,
     seconds_clock,
 )
+from hw_drivers.parameters import GAS_PARAMETERS
 from hw_drivers.serial_transport import SerialPort, open_serial_port
 from hw_drivers.worker import DeviceWorker, DiagnosticLevel
 
-__all__ = ['BACKENDS', 'PARAMETERS', 'GasNode', 'main']
+__all__ = ['GasNode', 'main']
 
 swarm_interfaces = message_module('swarm_interfaces')
 diagnostic_msgs = message_module('diagnostic_msgs')
 
-BACKENDS = ('ads1115', 'ads1015', 'grove_hat', 'xiao_serial')
-
-PARAMETERS: list[ParamSpec] = [
-    ('backend', 'ads1115', 'ADC backend: ads1115, ads1015, grove_hat or xiao_serial'),
-    ('i2c_bus', 1, 'I2C bus number (/dev/i2c-N)'),
-    ('i2c_address', -1, 'I2C address; -1 = backend default (ADS1x15 0x48, Grove Base Hat 0x04)'),
-    ('channel', 0, 'ADC input channel the sensor signal is wired to'),
-    ('full_scale_v', 4.096, 'ADS1x15 PGA full-scale range [V]'),
-    ('data_rate_sps', 128, 'ADS1x15 conversion rate [samples/s]'),
-    ('averaging', 4, 'ADS1x15 conversions averaged per reading'),
-    ('supply_v', 3.3, 'sensor supply voltage [V] for raw = 1023 * V_signal / V_supply'),
-    ('serial_port', '/dev/gas_mcu', 'serial device of the gas microcontroller (xiao_serial)'),
-    ('rate_hz', 10.0, 'readings per second [Hz] (authors: 10)'),
-    ('warmup_s', 120.0, 'heater warm-up: readings are flagged warming_up this long [s]'),
-    ('frame_id', 'gas_sensor', 'frame of the published readings'),
-    ('stale_timeout_s', 1.0, 'no reading published for this long is reported stale [s]'),
-    ('device_thread', True, 'run the device loop in its own thread (false: from a timer)'),
-    ('fake_device', False, 'use a simulated ADC reading a clean-air background'),
-]
 
 _DEFAULT_ADDRESS = {'ads1115': 0x48, 'ads1015': 0x48, 'grove_hat': 0x04}
 FAKE_BACKGROUND_V = 0.26  # about 80 on the 10-bit scale: clean air after warm-up
@@ -86,33 +67,31 @@ class GasNode(Node):
 
     def __init__(self, **kwargs: Any) -> None:
         super().__init__('gas_adc_node', **kwargs)
-        values = declare_parameter_table(self, PARAMETERS)
-        self._values = values
-        backend = str(values['backend'])
-        if backend not in BACKENDS:
-            raise ConfigurationError(f'backend must be one of {", ".join(BACKENDS)}, got {backend}')
+        config = declare_config(self, GAS_PARAMETERS).config
+        self._config = config
+        backend = config.backend
         self._backend_name = backend
-        self._threaded = bool(values['device_thread'])
+        self._threaded = config.device_thread
         self._device_clock: Callable[[], float] = (
             time.monotonic if self._threaded else seconds_clock(self)
         )
         self._sleep: Callable[[float], None] = time.sleep if self._threaded else no_sleep
-        self._fake = bool(values['fake_device'])
+        self._fake = config.fake_device
         self._ads_config: AdsConfig | None = None
         if backend.startswith('ads'):
             self._ads_config = AdsConfig(
                 chip=AdsChip(backend),
-                channel=int(values['channel']),
-                full_scale_v=float(values['full_scale_v']),
-                data_rate_sps=int(values['data_rate_sps']),
+                channel=config.channel,
+                full_scale_v=config.full_scale_v,
+                data_rate_sps=config.data_rate_sps,
             )
-        address = int(values['i2c_address'])
+        address = config.i2c_address
         self._address = _DEFAULT_ADDRESS.get(backend, 0) if address < 0 else address
-        self._rate_hz = float(values['rate_hz'])
+        self._rate_hz = config.rate_hz
         if not self._rate_hz > 0.0:
             raise ConfigurationError(f'rate_hz must be > 0, got {self._rate_hz}')
-        self._warm_up = WarmUp(duration_s=float(values['warmup_s']))
-        self._frame_id = str(values['frame_id'])
+        self._warm_up = WarmUp(duration_s=config.warmup_s)
+        self._frame_id = config.frame_id
         self._samples: deque[tuple[GasSample, bool, float]] = deque(maxlen=10)
         self._session: GasSession | None = None
         self._pinned = False
@@ -123,13 +102,13 @@ class GasNode(Node):
             diagnostic_msgs.DiagnosticArray, DIAGNOSTICS_TOPIC, 10
         )
         if backend == 'xiao_serial':
-            hardware_id = str(values['serial_port'])
+            hardware_id = config.serial_port
         else:
-            hardware_id = f'/dev/i2c-{values["i2c_bus"]} 0x{self._address:02X}'
+            hardware_id = f'/dev/i2c-{config.i2c_bus} 0x{self._address:02X}'
         self._monitor = DeviceMonitor(
             f'{self.get_fully_qualified_name()}: gas ({backend})',
             'fake' if self._fake else hardware_id,
-            float(values['stale_timeout_s']),
+            config.stale_timeout_s,
             self.get_logger(),
         )
         worker = DeviceWorker(
@@ -141,10 +120,10 @@ class GasNode(Node):
 
     def _open_bus(self) -> SMBusLike:
         if not self._fake:
-            return open_smbus(int(self._values['i2c_bus']))
+            return open_smbus(int(self._config.i2c_bus))
         if self._backend_name == 'grove_hat':
             hat = FakeGroveHat()
-            hat.channel_mv[int(self._values['channel'])] = round(FAKE_BACKGROUND_V * 1000)
+            hat.channel_mv[int(self._config.channel)] = round(FAKE_BACKGROUND_V * 1000)
             return FakeSMBus({self._address: hat})
         chip = FakeAds1115(self._device_clock, volts=FAKE_BACKGROUND_V, conversion_time_s=0.0)
         return FakeSMBus({self._address: chip})
@@ -152,24 +131,22 @@ class GasNode(Node):
     def _open_port(self) -> SerialPort:
         if self._fake:
             return FakeGasMcuPort(FakeGasMcu(lambda: round(1023 * FAKE_BACKGROUND_V / 3.3)))
-        return open_serial_port(str(self._values['serial_port']), baudrate=115200, timeout_s=0.05)
+        return open_serial_port(str(self._config.serial_port), baudrate=115200, timeout_s=0.05)
 
     def _make_backend(self) -> GasBackend:
-        values = self._values
+        config = self._config
         if self._backend_name == 'xiao_serial':
             return XiaoGasBackend(self._open_port(), clock=self._device_clock)
         bus = self._open_bus()
         try:
             if self._backend_name == 'grove_hat':
-                return GroveHatGasBackend(
-                    bus, address=self._address, channel=int(values['channel'])
-                )
+                return GroveHatGasBackend(bus, address=self._address, channel=config.channel)
             return AdsGasBackend(
                 bus,
                 address=self._address,
                 config=self._ads_config,
-                supply_v=float(values['supply_v']),
-                averaging=int(values['averaging']),
+                supply_v=config.supply_v,
+                averaging=config.averaging,
                 sleep=self._sleep,
                 clock=self._device_clock,
             )
@@ -227,7 +204,7 @@ class GasNode(Node):
 def main(args: list[str] | None = None) -> int:
     """Entry point of ``ros2 run hw_drivers gas_adc_node``."""
     return run_driver_node(
-        GasNode, 'gas_adc_node', args, summary=__doc__ or '', parameters=PARAMETERS
+        GasNode, 'gas_adc_node', args, summary=__doc__ or '', parameters=GAS_PARAMETERS
     )
 
 

@@ -19,6 +19,7 @@ from collections import deque
 from collections.abc import Callable
 from typing import Any
 
+from swarm_runtime.parameters import declare_config
 from swarm_runtime.ros import (
     Node,
     message_module,
@@ -37,42 +38,20 @@ from hw_drivers.node_common import (
     DIAGNOSTICS_TOPIC,
     DeviceMonitor,
     DevicePoller,
-    ParamSpec,
     TimerGate,
-    declare_parameter_table,
     no_sleep,
     publish_diagnostics,
     run_driver_node,
     seconds_clock,
 )
+from hw_drivers.parameters import MPU6050_PARAMETERS
 from hw_drivers.worker import DeviceWorker
 
-__all__ = ['PARAMETERS', 'Mpu6050Node', 'main']
+__all__ = ['Mpu6050Node', 'main']
 
 sensor_msgs = message_module('sensor_msgs')
 geometry_msgs = message_module('geometry_msgs')
 diagnostic_msgs = message_module('diagnostic_msgs')
-
-PARAMETERS: list[ParamSpec] = [
-    ('i2c_bus', 1, 'I2C bus number (/dev/i2c-N)'),
-    ('i2c_address', 0x68, 'I2C address: 0x68 (AD0 low) or 0x69 (AD0 high)'),
-    ('accepted_who_am_i', [0x68], 'WHO_AM_I values accepted (genuine MPU6050: 0x68)'),
-    ('dlpf_cfg', 3, 'digital low-pass filter setting 0..6 (3: 42 Hz gyro bandwidth)'),
-    ('sample_rate_div', 9, 'SMPLRT_DIV: internal rate = 1 kHz / (1 + div) with the DLPF on'),
-    ('gyro_fs_sel', 0, 'gyro range 0..3 = +-250, 500, 1000, 2000 deg/s'),
-    ('accel_afs_sel', 0, 'accelerometer range 0..3 = +-2, 4, 8, 16 g'),
-    ('rate_hz', 100.0, 'polling and publishing rate [Hz]'),
-    ('mounting', 'z_up', 'board orientation: z_up, or z_down (upside down)'),
-    ('calibration_s', 4.0, 'still time for the gyro-Z bias calibration at start [s]'),
-    ('calibration_max_std_dps', 0.3, 'gyro-Z spread above which the robot moved [deg/s]'),
-    ('zupt', True, 'track the gyro-Z bias while cmd_vel has been zero for zupt_hold_s'),
-    ('zupt_hold_s', 1.0, 'how long cmd_vel must be zero before the bias is tracked [s]'),
-    ('zupt_time_constant_s', 20.0, 'time constant of the bias tracking [s]'),
-    ('frame_id', 'imu_link', 'frame of the published messages'),
-    ('stale_timeout_s', 0.5, 'no message published for this long is reported stale [s]'),
-    ('device_thread', True, 'run the device loop in its own thread (false: from a timer)'),
-    ('fake_device', False, 'use a simulated, motionless MPU6050'),
-]
 
 
 class Mpu6050Node(Node):
@@ -80,45 +59,43 @@ class Mpu6050Node(Node):
 
     def __init__(self, **kwargs: Any) -> None:
         super().__init__('mpu6050_node', **kwargs)
-        values = declare_parameter_table(self, PARAMETERS)
-        self._values = values
+        config = declare_config(self, MPU6050_PARAMETERS).config
+        self._config = config
         self._chip_config = Mpu6050Config(
-            address=int(values['i2c_address']),
-            accepted_who_am_i=tuple(int(v) for v in values['accepted_who_am_i']),
-            dlpf_cfg=int(values['dlpf_cfg']),
-            sample_rate_div=int(values['sample_rate_div']),
-            gyro_fs_sel=int(values['gyro_fs_sel']),
-            accel_afs_sel=int(values['accel_afs_sel']),
+            address=config.i2c_address,
+            accepted_who_am_i=tuple(int(v) for v in config.accepted_who_am_i),
+            dlpf_cfg=config.dlpf_cfg,
+            sample_rate_div=config.sample_rate_div,
+            gyro_fs_sel=config.gyro_fs_sel,
+            accel_afs_sel=config.accel_afs_sel,
         )
         try:
-            self._mounting = Mounting(str(values['mounting']))
+            self._mounting = Mounting(config.mounting)
         except ValueError as err:
             raise ConfigurationError(f'mounting must be z_up or z_down: {err}') from err
-        self._rate_hz = float(values['rate_hz'])
+        self._rate_hz = config.rate_hz
         if not self._rate_hz > 0.0:
             raise ConfigurationError(f'rate_hz must be > 0, got {self._rate_hz}')
         zupt = ZuptConfig(
-            enabled=bool(values['zupt']),
-            hold_s=float(values['zupt_hold_s']),
-            time_constant_s=float(values['zupt_time_constant_s']),
+            enabled=config.zupt,
+            hold_s=config.zupt_hold_s,
+            time_constant_s=config.zupt_time_constant_s,
         )
         self._heading = HeadingState(
             CalibrationConfig(
-                duration_s=float(values['calibration_s']),
-                max_std_radps=math.radians(float(values['calibration_max_std_dps'])),
+                duration_s=config.calibration_s,
+                max_std_radps=math.radians(config.calibration_max_std_dps),
             ),
             stillness=StillnessDetector(zupt),
         )
-        self._frame_id = str(values['frame_id'])
-        self._threaded = bool(values['device_thread'])
+        self._frame_id = config.frame_id
+        self._threaded = config.device_thread
         self._device_clock: Callable[[], float] = (
             time.monotonic if self._threaded else seconds_clock(self)
         )
         self._sleep: Callable[[float], None] = time.sleep if self._threaded else no_sleep
         self._fake_chip = (
-            FakeMpu6050(self._device_clock, noise_dps=0.02, seed=1)
-            if values['fake_device']
-            else None
+            FakeMpu6050(self._device_clock, noise_dps=0.02, seed=1) if config.fake_device else None
         )
         self._readings: deque[ImuReading] = deque(maxlen=50)
         self._session: ImuSession | None = None
@@ -127,11 +104,11 @@ class Mpu6050Node(Node):
         self._diag_pub = self.create_publisher(
             diagnostic_msgs.DiagnosticArray, DIAGNOSTICS_TOPIC, 10
         )
-        hardware_id = f'/dev/i2c-{values["i2c_bus"]} 0x{self._chip_config.address:02X}'
+        hardware_id = f'/dev/i2c-{config.i2c_bus} 0x{self._chip_config.address:02X}'
         self._monitor = DeviceMonitor(
             f'{self.get_fully_qualified_name()}: imu',
             'fake' if self._fake_chip else hardware_id,
-            float(values['stale_timeout_s']),
+            config.stale_timeout_s,
             self.get_logger(),
         )
         worker = DeviceWorker(
@@ -155,7 +132,7 @@ class Mpu6050Node(Node):
     def _open_bus(self) -> SMBusLike:
         if self._fake_chip is not None:
             return FakeSMBus({self._chip_config.address: self._fake_chip})
-        return open_smbus(int(self._values['i2c_bus']))
+        return open_smbus(int(self._config.i2c_bus))
 
     def _connect(self) -> ImuSession:
         bus = self._open_bus()
@@ -216,7 +193,7 @@ class Mpu6050Node(Node):
 def main(args: list[str] | None = None) -> int:
     """Entry point of ``ros2 run hw_drivers mpu6050_node``."""
     return run_driver_node(
-        Mpu6050Node, 'mpu6050_node', args, summary=__doc__ or '', parameters=PARAMETERS
+        Mpu6050Node, 'mpu6050_node', args, summary=__doc__ or '', parameters=MPU6050_PARAMETERS
     )
 
 

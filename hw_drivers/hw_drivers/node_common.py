@@ -1,8 +1,8 @@
 """Pieces every driver node shares: parameter tables, device polling, diagnostics, main().
 
-* :func:`declare_parameter_table` declares each ``(name, default, description)`` once with a
-  read-only ParameterDescriptor and returns the values (the same tables are mirrored in
-  ``config/*.yaml`` and checked by a test).
+* The parameters of each driver are a spec in :mod:`hw_drivers.parameters`, declared with
+  :func:`swarm_runtime.parameters.declare_config`; ``--help`` lists them and
+  :func:`run_driver_node` checks the parameter files of the command line.
 * :class:`DevicePoller` runs a :class:`~hw_drivers.worker.DeviceWorker` in its own thread
   (robots) or from a node timer (deterministic tests on the built-in runtime).
 * :class:`DeviceMonitor` turns the worker's status plus data freshness into one
@@ -11,8 +11,8 @@
 * :class:`TimerGate` pauses a node's fast publishing timer while its device is missing, so
   an unplugged driver idles.
 * :func:`run_driver_node` is the body of every driver's ``main()``: ``--help``, the runtime
-  check, line-buffered output, then :func:`swarm_runtime.node_main.run_node` (init, spin,
-  clean stop on SIGINT / SIGTERM).
+  check, the parameter-file check, line-buffered output, then
+  :func:`swarm_runtime.node_main.run_node` (init, spin, clean stop on SIGINT / SIGTERM).
 """
 
 from __future__ import annotations
@@ -23,8 +23,9 @@ import time
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any, TypeVar
 
+from swarm_common.params import ParameterSpec, render_value
 from swarm_runtime.node_main import run_node
-from swarm_runtime.ros import message_module, rclpy, using_real_rclpy
+from swarm_runtime.ros import rclpy, using_real_rclpy
 from swarm_runtime.standalone import standalone_runtime_problem
 
 from hw_drivers.conversions import DiagnosticEntry, diagnostics_to_ros
@@ -36,10 +37,8 @@ __all__ = [
     'REMINDER_PERIOD_S',
     'DeviceMonitor',
     'DevicePoller',
-    'ParamSpec',
     'StatusLog',
     'TimerGate',
-    'declare_parameter_table',
     'driver_help',
     'no_sleep',
     'publish_diagnostics',
@@ -49,21 +48,10 @@ __all__ = [
     'start_driver_process',
 ]
 
-ParamSpec = tuple[str, Any, str]
 NodeT = TypeVar('NodeT')
 DIAGNOSTICS_TOPIC = '/diagnostics'
 #: While a status stays WARN or worse, it is logged again this often [s].
 REMINDER_PERIOD_S = 30.0
-
-
-def declare_parameter_table(node: Any, table: Sequence[ParamSpec]) -> dict[str, Any]:
-    """Declare every parameter of ``table`` (read-only, described); return name -> value."""
-    descriptor_class = message_module('rcl_interfaces').ParameterDescriptor
-    values: dict[str, Any] = {}
-    for name, default, description in table:
-        descriptor = descriptor_class(description=description, read_only=True)
-        values[name] = node.declare_parameter(name, default, descriptor).value
-    return values
 
 
 class DevicePoller:
@@ -255,7 +243,7 @@ def seconds_clock(node: Any) -> Callable[[], float]:
     return lambda: node.get_clock().now().nanoseconds * 1e-9
 
 
-def driver_help(name: str, summary: str, parameters: Sequence[ParamSpec]) -> str:
+def driver_help(name: str, summary: str, parameters: ParameterSpec) -> str:
     """The ``--help`` text of a driver: usage, what it does, its parameters.
 
     ``summary`` is the module docstring; its first paragraph is used.
@@ -267,9 +255,10 @@ def driver_help(name: str, summary: str, parameters: Sequence[ParamSpec]) -> str
         '',
         'parameters (-p name:=value, or --params-file):',
     ]
-    width = max((len(pname) for pname, _, _ in parameters), default=0)
-    for pname, default, description in parameters:
-        lines.append(f'  {pname:<{width}}  {description} [default: {default!r}]')
+    width = max((len(p.name) for p in parameters.parameters), default=0)
+    for p in parameters.parameters:
+        default = render_value(p.default)
+        lines.append(f'  {p.name:<{width}}  {p.description_text} [default: {default}]')
     lines += [
         '',
         'Without its device the driver reports an error on /diagnostics and retries with',
@@ -317,7 +306,7 @@ def spin_node(node: Any, *, tick_s: float = 0.05) -> None:
 
 
 def start_driver_process(
-    name: str, args: Sequence[str] | None, *, summary: str, parameters: Sequence[ParamSpec]
+    name: str, args: Sequence[str] | None, *, summary: str, parameters: ParameterSpec
 ) -> None:
     """What every driver's ``main()`` does before ``rclpy.init``.
 
@@ -342,7 +331,7 @@ def run_driver_node(
     args: list[str] | None,
     *,
     summary: str = '',
-    parameters: Sequence[ParamSpec] = (),
+    parameters: ParameterSpec,
     fatal_errors: tuple[type[Exception], ...] = (ConfigurationError,),
     on_signal: Callable[[NodeT], None] | None = None,
 ) -> int:
@@ -351,7 +340,9 @@ def run_driver_node(
     See :func:`start_driver_process` for ``--help`` and the runtime check, and
     :func:`swarm_runtime.node_main.run_node` for the stop: Ctrl-C, SIGTERM and an external
     shutdown end the process with status 0 and no traceback (``on_signal`` runs first);
-    ``fatal_errors`` (invalid parameters) with status 2 and one fatal log line naming them.
+    ``fatal_errors`` (invalid parameters) with status 2 and one fatal log line naming them,
+    and so does a bad parameter file or ``-p`` value (one line naming the file and the
+    parameter, before ``rclpy.init``).
     The node is destroyed in every case. On the built-in runtime the node is paced to the
     real clock (:func:`spin_node`).
     """
@@ -364,4 +355,5 @@ def run_driver_node(
         describe_fatal=lambda err: f'invalid parameters: {err}',
         on_signal=on_signal,
         spin=spin_node,
+        parameters=parameters,
     )

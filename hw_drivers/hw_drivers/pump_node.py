@@ -29,6 +29,7 @@ import time
 from collections.abc import Callable
 from typing import Any
 
+from swarm_runtime.parameters import declare_config
 from swarm_runtime.ros import Node, message_module
 
 from hw_drivers.backoff import Backoff, BackoffConfig
@@ -37,32 +38,20 @@ from hw_drivers.errors import FatalDeviceError, HwDriverError
 from hw_drivers.fakes.gpio import FakePumpOutput
 from hw_drivers.node_common import (
     DIAGNOSTICS_TOPIC,
-    ParamSpec,
     StatusLog,
     TimerGate,
-    declare_parameter_table,
     publish_diagnostics,
     run_driver_node,
 )
+from hw_drivers.parameters import PUMP_PARAMETERS
 from hw_drivers.pump_control import PumpController, PumpLimits
 from hw_drivers.pump_output import GpiodPumpOutput, PumpOutput, SafePumpLine, parse_line_id
 from hw_drivers.worker import DiagnosticLevel
 
-__all__ = ['PARAMETERS', 'PumpNode', 'main']
+__all__ = ['PumpNode', 'main']
 
 std_msgs = message_module('std_msgs')
 diagnostic_msgs = message_module('diagnostic_msgs')
-
-PARAMETERS: list[ParamSpec] = [
-    ('chip', '/dev/gpiochip0', 'GPIO chip device (Pi 4 40-pin header: /dev/gpiochip0)'),
-    ('line', 'GPIO17', "GPIO line name (GPIO17) or offset as a string ('17'); authors: BCM 17"),
-    ('active_low', False, 'true if the driver stage is inverting (line low = pump on)'),
-    ('max_on_s', 1.0, 'longest pulse the driver allows [s] (paper pulse: 0.5 s)'),
-    ('min_off_s', 1.0, 'shortest pause between pulses [s]'),
-    ('command_timeout_s', 0.5, 'commands older than this turn the pump off [s]'),
-    ('control_rate_hz', 50.0, 'rate of the safety check [Hz]'),
-    ('fake_device', False, 'drive a simulated line instead of a GPIO'),
-]
 
 
 class PumpNode(Node):
@@ -90,11 +79,11 @@ class PumpNode(Node):
         **kwargs: Any,
     ) -> None:
         super().__init__('pump_node', **kwargs)
-        values = declare_parameter_table(self, PARAMETERS)
+        config = declare_config(self, PUMP_PARAMETERS).config
         self._limits = PumpLimits(
-            max_on_s=float(values['max_on_s']),
-            min_off_s=float(values['min_off_s']),
-            command_timeout_s=float(values['command_timeout_s']),
+            max_on_s=config.max_on_s,
+            min_off_s=config.min_off_s,
+            command_timeout_s=config.command_timeout_s,
         )
         self._controller = PumpController(self._limits)
         if open_output is None:
@@ -103,19 +92,17 @@ class PumpNode(Node):
 
                 def open_output() -> PumpOutput:
                     return given
-            elif values['fake_device']:
+            elif config.fake_device:
                 open_output = FakePumpOutput
             else:
-                chip, line = str(values['chip']), parse_line_id(str(values['line']))
-                active_low = bool(values['active_low'])
+                chip, line = config.chip, parse_line_id(config.line)
+                active_low = config.active_low
 
                 def open_output() -> PumpOutput:
                     return GpiodPumpOutput(chip, line, active_low=active_low)
 
         self._open_output = open_output
-        self._hardware_id = (
-            'fake' if values['fake_device'] else f'{values["chip"]} {values["line"]}'
-        )
+        self._hardware_id = 'fake' if config.fake_device else f'{config.chip} {config.line}'
         self.line: SafePumpLine | None = None
         self._backoff = Backoff(BackoffConfig())
         self._retry_clock = retry_clock
@@ -136,7 +123,7 @@ class PumpNode(Node):
         )
         self.create_subscription(std_msgs.Bool, 'pump', self._on_command, 10)
         self._control_gate = TimerGate(
-            self.create_timer(1.0 / float(values['control_rate_hz']), self._on_timer)
+            self.create_timer(1.0 / config.control_rate_hz, self._on_timer)
         )
         self.create_timer(1.0, self._publish_diagnostics)
         self._try_open()
@@ -294,7 +281,7 @@ def main(args: list[str] | None = None) -> int:
         'pump_node',
         args,
         summary=__doc__ or '',
-        parameters=PARAMETERS,
+        parameters=PUMP_PARAMETERS,
         fatal_errors=(FatalDeviceError,),
         on_signal=PumpNode.shutdown_pump,
     )

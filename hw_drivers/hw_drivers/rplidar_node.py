@@ -10,12 +10,12 @@ Run: ``ros2 run hw_drivers rplidar_node --ros-args -r __ns:=/r0 -p port:=/dev/rp
 
 from __future__ import annotations
 
-import math
 import time
 from collections import deque
 from collections.abc import Callable
 from typing import Any
 
+from swarm_runtime.parameters import declare_config
 from swarm_runtime.ros import (
     Node,
     message_module,
@@ -24,69 +24,47 @@ from swarm_runtime.ros import (
 
 from hw_drivers.backoff import BackoffConfig
 from hw_drivers.conversions import scan_to_ros
-from hw_drivers.errors import ConfigurationError
 from hw_drivers.fakes.lidar import FakeRPLidar, FakeRPLidarPort
 from hw_drivers.node_common import (
     DIAGNOSTICS_TOPIC,
     DeviceMonitor,
     DevicePoller,
-    ParamSpec,
     TimerGate,
-    declare_parameter_table,
     no_sleep,
     publish_diagnostics,
     run_driver_node,
     seconds_clock,
 )
+from hw_drivers.parameters import RPLIDAR_PARAMETERS, RPLidarNodeConfig
 from hw_drivers.rplidar_device import RPLidarConfig, RPLidarSession, connect_rplidar
 from hw_drivers.rplidar_protocol import HealthStatus, Revolution, ScanBinning, bin_revolution
 from hw_drivers.worker import DeviceWorker, DiagnosticLevel
 
-__all__ = ['PARAMETERS', 'RPLidarNode', 'main']
+__all__ = ['RPLidarNode', 'main']
 
 sensor_msgs = message_module('sensor_msgs')
 diagnostic_msgs = message_module('diagnostic_msgs')
 
-PARAMETERS: list[ParamSpec] = [
-    ('port', '/dev/rplidar', 'serial device of the lidar (udev symlink or /dev/serial/by-id/...)'),
-    ('baudrate', 115200, 'serial speed [baud] (A1: 115200)'),
-    ('motor_on_dtr', False, 'DTR level that runs the motor (Slamtec adapters: false)'),
-    ('frame_id', 'laser', 'frame of the published scans'),
-    ('bins', 360, 'LaserScan bins over [-pi, pi)'),
-    ('angle_direction', -1, 'ROS angle = offset + direction * device angle; -1: device is CW'),
-    ('zero_offset_rad', math.pi, 'ROS angle of the device 0 deg mark [rad]; pi = Slamtec mapping'),
-    ('range_min_m', 0.15, 'shortest valid range [m]; shorter readings become -inf (REP 117)'),
-    ('range_max_m', 12.0, 'longest valid range [m]; longer readings become +inf'),
-    ('stall_timeout_s', 1.0, 'no revolution for this long restarts the motor and scan [s]'),
-    ('stale_timeout_s', 1.0, 'no scan published for this long is reported stale [s]'),
-    ('publish_rate_hz', 20.0, 'rate of the timer that publishes completed revolutions [Hz]'),
-    ('device_thread', True, 'run the device loop in its own thread (false: from a timer)'),
-    ('fake_device', False, 'use a synthetic lidar in a 4 m x 3 m room instead of the port'),
-]
 
-
-def config_from_parameters(values: dict[str, Any]) -> tuple[RPLidarConfig, ScanBinning]:
-    """Validate parameter values into the device and binning configurations.
+def device_configs(config: RPLidarNodeConfig) -> tuple[RPLidarConfig, ScanBinning]:
+    """The device and binning configurations of the node's parameters.
 
     Raises:
-        ConfigurationError: a value is out of range.
+        ConfigurationError: a value the device or binning configuration rejects.
     """
     device = RPLidarConfig(
-        port=str(values['port']),
-        baudrate=int(values['baudrate']),
-        motor_on_dtr=bool(values['motor_on_dtr']),
-        stall_timeout_s=float(values['stall_timeout_s']),
+        port=config.port,
+        baudrate=config.baudrate,
+        motor_on_dtr=config.motor_on_dtr,
+        stall_timeout_s=config.stall_timeout_s,
     )
     binning = ScanBinning(
-        bins=int(values['bins']),
-        angle_direction=int(values['angle_direction']),
-        zero_offset_rad=float(values['zero_offset_rad']),
-        range_min_m=float(values['range_min_m']),
-        range_max_m=float(values['range_max_m']),
+        bins=config.bins,
+        angle_direction=config.angle_direction,
+        zero_offset_rad=config.zero_offset_rad,
+        range_min_m=config.range_min_m,
+        range_max_m=config.range_max_m,
     )
-    for name in ('stale_timeout_s', 'publish_rate_hz'):
-        if not float(values[name]) > 0.0:
-            raise ConfigurationError(f'{name} must be > 0, got {values[name]}')
     return device, binning
 
 
@@ -95,16 +73,16 @@ class RPLidarNode(Node):
 
     def __init__(self, **kwargs: Any) -> None:
         super().__init__('rplidar_node', **kwargs)
-        values = declare_parameter_table(self, PARAMETERS)
-        self._device_config, self._binning = config_from_parameters(values)
-        self._frame_id = str(values['frame_id'])
-        threaded = bool(values['device_thread'])
+        config = declare_config(self, RPLIDAR_PARAMETERS).config
+        self._device_config, self._binning = device_configs(config)
+        self._frame_id = config.frame_id
+        threaded = config.device_thread
         self._threaded = threaded
         self._device_clock: Callable[[], float] = (
             time.monotonic if threaded else seconds_clock(self)
         )
         self._revolutions: deque[Revolution] = deque(maxlen=2)
-        self._fake = FakeRPLidar() if values['fake_device'] else None
+        self._fake = FakeRPLidar() if config.fake_device else None
         self._session: RPLidarSession | None = None
         self._connected_note = ''
         self._scan_pub = self.create_publisher(
@@ -117,7 +95,7 @@ class RPLidarNode(Node):
         self._monitor = DeviceMonitor(
             f'{self.get_fully_qualified_name()}: lidar',
             hardware_id,
-            float(values['stale_timeout_s']),
+            config.stale_timeout_s,
             self.get_logger(),
         )
         worker = DeviceWorker(
@@ -125,7 +103,7 @@ class RPLidarNode(Node):
         )
         self._poller = DevicePoller(self, worker, threaded=threaded)
         self._scan_gate = TimerGate(
-            self.create_timer(1.0 / float(values['publish_rate_hz']), self._publish_scans)
+            self.create_timer(1.0 / config.publish_rate_hz, self._publish_scans)
         )
         self.create_timer(1.0, self._publish_diagnostics)
 
@@ -205,7 +183,7 @@ class RPLidarNode(Node):
 def main(args: list[str] | None = None) -> int:
     """Entry point of ``ros2 run hw_drivers rplidar_node``."""
     return run_driver_node(
-        RPLidarNode, 'rplidar_node', args, summary=__doc__ or '', parameters=PARAMETERS
+        RPLidarNode, 'rplidar_node', args, summary=__doc__ or '', parameters=RPLIDAR_PARAMETERS
     )
 
 

@@ -7,6 +7,7 @@ from pathlib import Path
 
 import pytest
 import yaml
+from hw_drivers.parameters import NODE_SPECS
 from hw_drivers.robot_bringup import cli
 from hw_drivers.robot_bringup.cli import (
     BringupOptions,
@@ -15,8 +16,6 @@ from hw_drivers.robot_bringup.cli import (
     build_plan,
     driver_parameters,
 )
-
-from hw_drivers import aoa_receiver_node, gas_node, mpu6050_node, pump_node, rplidar_node
 
 
 def test_pump_starts_first_and_oabug_last_after_the_locator():
@@ -47,7 +46,7 @@ def test_fake_mode_switches_every_device_driver_to_its_simulated_device():
 def test_dry_run_prints_the_commands(capsys):
     assert cli.run(BringupOptions(launcher='python'), dry_run=True) == 0
     lines = capsys.readouterr().out.splitlines()
-    assert len(lines) == 6
+    assert len(lines) == 7
     assert lines[0].split()[1:3] == ['-m', 'hw_drivers.pump_node']
 
 
@@ -72,19 +71,13 @@ def test_a_dying_child_stops_the_others_and_fails_the_bringup(tmp_path):
 
 
 def test_example_parameter_file_names_real_parameters():
-    tables = {
-        'rplidar_node': rplidar_node.PARAMETERS,
-        'gas_adc_node': gas_node.PARAMETERS,
-        'mpu6050_node': mpu6050_node.PARAMETERS,
-        'aoa_receiver_node': aoa_receiver_node.PARAMETERS,
-        'pump_node': pump_node.PARAMETERS,
-    }
     path = Path(__file__).resolve().parents[1] / 'bringup' / 'r0.params.example.yaml'
     document = yaml.safe_load(path.read_text())
     for key, section in document.items():
         node = key.removeprefix('/**/')
-        names = {name for name, _, _ in tables[node]}
-        assert set(section['ros__parameters']) <= names, node
+        spec = NODE_SPECS[node]
+        for name, value in section['ros__parameters'].items():
+            spec.check(name, value, strict=True)
 
 
 @pytest.mark.slow

@@ -27,8 +27,6 @@ from pathlib import Path
 import pytest
 from hw_drivers.robot_bringup import cli
 
-from hw_drivers import aoa_receiver_node, gas_node, mpu6050_node, pump_node, rplidar_node
-
 DRIVER_MODULES = {
     'rplidar_node': 'hw_drivers.rplidar_node',
     'gas_adc_node': 'hw_drivers.gas_node',
@@ -290,19 +288,6 @@ def test_drivers_without_devices_idle_on_rclpy(tmp_path):
 @pytest.mark.slow
 def test_drivers_without_devices_idle_on_the_builtin_runtime(tmp_path):
     _check_idle(_idle_drivers(tmp_path, 'builtin'))
-
-
-def test_the_bringup_device_table_matches_the_drivers_parameters():
-    tables = {
-        'rplidar_node': rplidar_node.PARAMETERS,
-        'gas_adc_node': gas_node.PARAMETERS,
-        'mpu6050_node': mpu6050_node.PARAMETERS,
-        'aoa_receiver_node': aoa_receiver_node.PARAMETERS,
-        'pump_node': pump_node.PARAMETERS,
-    }
-    for node, devices in cli.DEVICE_PARAMETERS.items():
-        defaults = {name: default for name, default, _ in tables[node]}
-        assert devices == {name: defaults[name] for name in devices}, node
 
 
 # --- bringup --------------------------------------------------------------------------------

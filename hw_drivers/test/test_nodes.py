@@ -108,7 +108,7 @@ def test_gas_node_runs_every_backend(bed, backend):
 
 
 def test_gas_node_refuses_an_unknown_backend(bed):
-    with pytest.raises(ConfigurationError, match='backend must be one of'):
+    with pytest.raises(ConfigurationError, match="backend: 'pcf8591' is not one of ads1115"):
         bed.add_node(GasNode, parameter_overrides=[Parameter('backend', value='pcf8591')])
 
 

@@ -116,7 +116,9 @@ def test_junk_bursts_spliced_into_a_stream_add_almost_nothing_and_remove_almost_
 @given(st.integers(0, 2**31), st.integers(1, 20_000), st.lists(st.integers(0, 20_000)))
 def test_random_junk_alone_decodes_to_almost_nothing(seed, size, cuts):
     _, samples, revolutions = _decode(_junk(seed, size), [c for c in cuts if c <= size])
-    assert len(samples) <= 1 + size // 10_000
+    # One accepted stray window can give two samples before the next check rejects it; the
+    # aggregate rate is checked below over megabytes.
+    assert len(samples) <= 2 + size // 10_000
     assert revolutions == []
 
 

@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
-__all__ = ['ConfigError', 'MscPfError', 'ObservationError']
+from swarm_common import params
+
+__all__ = ['ConfigError', 'MscPfError', 'ObservationError', 'ParameterError']
 
 
 class MscPfError(Exception):
@@ -11,6 +13,10 @@ class MscPfError(Exception):
 
 class ConfigError(MscPfError, ValueError):
     """A configuration value is out of range or inconsistent with another one."""
+
+
+class ParameterError(ConfigError, params.ParameterError):
+    """A node parameter is unknown, of the wrong type, out of range or not one of its choices."""
 
 
 class ObservationError(MscPfError, ValueError):

@@ -27,6 +27,7 @@ from typing import Any
 
 import numpy as np
 from swarm_runtime.node_main import run_node
+from swarm_runtime.parameters import declare_config
 from swarm_runtime.ros import (
     Node,
     message_module,
@@ -36,7 +37,7 @@ from swarm_runtime.ros import (
 from msc_pf import conversions
 from msc_pf.drive import unicycle_command
 from msc_pf.errors import ConfigError, ObservationError
-from msc_pf.parameters import config_from_parameters, parameter_defaults, parameter_descriptions
+from msc_pf.parameters import MSC_PF_PARAMETERS, NODE_NAME, MscPfNodeConfig
 from msc_pf.peers import PeerInfo
 from msc_pf.robot import RobotController, StepOutput
 
@@ -46,17 +47,6 @@ _swarm = message_module('swarm_interfaces')
 _nav = message_module('nav_msgs')
 _geometry = message_module('geometry_msgs')
 _builtin = message_module('builtin_interfaces')
-_rcl = message_module('rcl_interfaces')
-
-NODE_PARAMETERS: dict[str, tuple[Any, str]] = {
-    'robot_id': (-1, 'Numeric robot ID; -1 takes it from the namespace (r3 -> 3).'),
-    'seed': (0, 'Seed of the robot controller (random search direction, PF, MSC draws).'),
-    'drive_rate_hz': (10.0, 'Rate of cmd_vel while steering toward the period waypoint [Hz].'),
-    'max_yaw_rate_rad_s': (2.0, 'Yaw-rate limit of the base [rad/s].'),
-    'heading_gain': (2.0, 'Yaw rate per radian of heading error [1/s].'),
-    'odom_timeout_s': (1.0, 'Stop when the last odometry is older than this [s].'),
-    'target_ids': ([-1], 'Emitter IDs that are targets; [-1] accepts every emitter.'),
-}
 
 
 class MscPfNode(Node):
@@ -64,33 +54,24 @@ class MscPfNode(Node):
 
     def __init__(self, **kwargs: Any) -> None:
         """Declare parameters, build the controller and the topics (kwargs go to Node)."""
-        super().__init__('msc_pf', **kwargs)
-        describe = _rcl.ParameterDescriptor
-        descriptions = parameter_descriptions()
-        for name, default in parameter_defaults().items():
-            self.declare_parameter(name, default, describe(description=descriptions[name]))
-        for name, (default, text) in NODE_PARAMETERS.items():
-            self.declare_parameter(name, default, describe(description=text))
+        super().__init__(NODE_NAME, **kwargs)
         try:
-            self.config = config_from_parameters(
-                {name: self.get_parameter(name).value for name in parameter_defaults()}
-            )
-            self._check_node_parameters()
+            self._declared = declare_config(self, MSC_PF_PARAMETERS, on_change=self._configure)
         except ConfigError as err:
             self.get_logger().fatal(f'invalid parameters: {err}')
             raise
-        robot_id = int(self.get_parameter('robot_id').value)
+        settings = self._declared.config
+        self._configure(settings)
+        self.config = settings.controller
+        robot_id = settings.robot_id
         self.robot_name = self.get_namespace().strip('/') or self.get_name()
         if robot_id < 0:
             try:
                 robot_id = conversions.robot_id_from_name(self.robot_name)
             except ValueError as err:
                 raise ConfigError(f'robot_id not set and {err}') from err
-        ids = [int(t) for t in self.get_parameter('target_ids').value]
-        self._accepted = None if ids == [-1] else frozenset(ids)
-        self.controller = RobotController(
-            robot_id, self.config, int(self.get_parameter('seed').value)
-        )
+        self._accepted = settings.accepted_targets
+        self.controller = RobotController(robot_id, self.config, settings.seed)
 
         self._pose: tuple[float, float, float] | None = None
         self._pose_time_s = -math.inf
@@ -112,17 +93,17 @@ class MscPfNode(Node):
         self._peer_pub = self.create_publisher(_swarm.MscPeer, 'peers/out', 10)
         self._state_pub = self.create_publisher(_swarm.MscPfState, 'state', 10)
         self.create_timer(self.config.period_s, self._on_control)
-        self.create_timer(1.0 / float(self.get_parameter('drive_rate_hz').value), self._on_drive)
+        self.create_timer(1.0 / settings.drive_rate_hz, self._on_drive)
         self.get_logger().info(
             f'{self.robot_name} (id {robot_id}) runs {self.config.scheme.value}, '
             f'period {self.config.period_s:g} s'
         )
 
-    def _check_node_parameters(self) -> None:
-        for name in ('drive_rate_hz', 'max_yaw_rate_rad_s', 'heading_gain', 'odom_timeout_s'):
-            value = float(self.get_parameter(name).value)
-            if not (math.isfinite(value) and value > 0.0):
-                raise ConfigError(f'{name} must be a positive number, got {value}')
+    def _configure(self, settings: MscPfNodeConfig) -> None:
+        """Take the steering settings (at start and after an accepted parameter change)."""
+        self._odom_timeout_s = settings.odom_timeout_s
+        self._max_yaw_rate_rad_s = settings.max_yaw_rate_rad_s
+        self._heading_gain = settings.heading_gain
 
     def _now_s(self) -> float:
         return self.get_clock().now().nanoseconds * 1e-9
@@ -162,8 +143,7 @@ class MscPfNode(Node):
     # ------------------------------------------------------------------ control
     def _on_control(self) -> None:
         now = self._now_s()
-        timeout = float(self.get_parameter('odom_timeout_s').value)
-        if self._pose is None or now - self._pose_time_s > timeout:
+        if self._pose is None or now - self._pose_time_s > self._odom_timeout_s:
             self._waypoint = None
             self.get_logger().warning('no fresh odometry: holding still', throttle_duration_sec=5.0)
             return
@@ -200,8 +180,7 @@ class MscPfNode(Node):
 
     def _on_drive(self) -> None:
         now = self._now_s()
-        timeout = float(self.get_parameter('odom_timeout_s').value)
-        stale = self._pose is None or now - self._pose_time_s > timeout
+        stale = self._pose is None or now - self._pose_time_s > self._odom_timeout_s
         late = now - self._last_step_s > 2.0 * self.config.period_s
         if stale or late or self._waypoint is None:
             self._cmd_pub.publish(conversions.twist_to_ros(0.0, 0.0, _geometry))
@@ -211,15 +190,21 @@ class MscPfNode(Node):
             self._waypoint,
             self._deadline_s - now,
             max_speed_m_s=self.config.max_speed_m_s,
-            max_yaw_rate_rad_s=float(self.get_parameter('max_yaw_rate_rad_s').value),
-            heading_gain=float(self.get_parameter('heading_gain').value),
+            max_yaw_rate_rad_s=self._max_yaw_rate_rad_s,
+            heading_gain=self._heading_gain,
         )
         self._cmd_pub.publish(conversions.twist_to_ros(speed, yaw_rate, _geometry))
 
 
 def main(args: list[str] | None = None) -> int:
     """Entry point of ``ros2 run msc_pf msc_pf_node``."""
-    return run_node(MscPfNode, args, name='msc_pf', fatal_errors=(ConfigError,))
+    return run_node(
+        MscPfNode,
+        args,
+        name=NODE_NAME,
+        fatal_errors=(ConfigError,),
+        parameters=MSC_PF_PARAMETERS,
+    )
 
 
 if __name__ == '__main__':

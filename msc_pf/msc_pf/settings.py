@@ -9,7 +9,9 @@ simulator build one :class:`MscPfConfig` at start and hand it to the core.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, fields
+
+from swarm_common.params import parameter, section
 
 from msc_pf.errors import ConfigError
 from msc_pf.schemes import Scheme
@@ -51,20 +53,19 @@ class RadioConfig:
 
     The paper's "P0 = 40.046" is the reference loss at 1 m (Friis at 2.4 GHz), so the RSSI at
     1 m is ``tx_power_dbm - reference_loss_db`` = -27.046 dBm.
-
-    Attributes:
-        tx_power_dbm: target transmit power [dBm] (Table I: 13).
-        reference_loss_db: path loss at 1 m [dB] (Table I's P0: 40.046).
-        path_loss_exponent: K of eq. (4) (Table I: 3).
-        noise_std_db: receiver noise standard deviation [dB] (Table I: variance 1).
-        detection_threshold_dbm: gamma_D, weaker signals are not heard [dBm] (Table I: -101).
     """
 
-    tx_power_dbm: float = 13.0
-    reference_loss_db: float = 40.046
-    path_loss_exponent: float = 3.0
-    noise_std_db: float = 1.0
-    detection_threshold_dbm: float = -101.0
+    tx_power_dbm: float = parameter(13.0, 'target transmit power (Table I: 13).', unit='dBm')
+    reference_loss_db: float = parameter(
+        40.046, "path loss at 1 m (Table I's P0: 40.046).", unit='dB'
+    )
+    path_loss_exponent: float = parameter(3.0, 'K of eq. (4) (Table I: 3).', gt=0.0)
+    noise_std_db: float = parameter(
+        1.0, 'receiver noise standard deviation (Table I: variance 1).', unit='dB', ge=0.0
+    )
+    detection_threshold_dbm: float = parameter(
+        -101.0, 'gamma_D, weaker signals are not heard (Table I: -101).', unit='dBm'
+    )
 
     def __post_init__(self) -> None:
         _require_finite(self)
@@ -94,64 +95,106 @@ class RadioConfig:
 
 @dataclass(frozen=True)
 class ParticleFilterConfig:
-    """SIR particle filter per target (eqs. 2-7; spec section 1.5).
+    """SIR particle filter per target (eqs. 2-7; spec section 1.5)."""
 
-    Attributes:
-        n_particles: N_p (Table I: 5041 = 71 x 71).
-        r_conv_m: radius of the convergence circle R_conv, eq. (6).
-        r_err_m: radius of the permissible error circle R_err, eq. (7).
-        window: number n of recent estimates tested by eq. (7), one per control step.
-        noise_variance_db2: sigma^2 of eq. (3) [dB^2].
-        gaussian_likelihood: True (default) uses the Gaussian exp(-e^2 / (2 sigma^2)) for the
-            noise variance sigma^2; False the paper's eq. (3) as printed, exp(-e^2 / sigma^2),
-            which treats the 1 dB noise as 0.71 dB: with a dozen neighbours' samples fused per
-            step that filter converged tens to hundreds of metres off the target.
-        censored_likelihood: divide each sample's likelihood by the chance
-            Phi((R_j - gamma_D) / s) that a target at the particle would have been heard at
-            all (s: the noise standard deviation the likelihood implies). The receiver reports
-            only samples above gamma_D, so near the detection edge the reported ones are
-            biased upward; without this a swarm lingering there converges on a wrong point.
-        initial_prior: 'detection_square' puts the lattice on the square around the detection
-            disc centred on the observer; 'field' spreads it over the whole field.
-        init_half_width_m: half width of the detection square [m]; None uses the radio model's
-            detection range (about 292 m).
-        resampling: 'systematic' (one uniform offset) or 'multinomial'.
-        roughening_kappa: kappa of the roughening jitter kappa * E * N^(-1/2). The common
-            0.2 left the static-target filter to collapse by resampling alone onto one arc of
-            the ring of distances a far swarm observes (spread under R_conv, estimate 100-400 m
-            off); 0.5 keeps that ring populated until the observations decide, while the
-            jitter it adds to the spread (about 6 m) stays well under R_conv.
-        roughening_floor_m: lower bound of the jitter standard deviation [m].
-        noise_pool_size: size of the pre-drawn pool of standard normals the jitter is taken
-            from at a random offset (a speed choice: drawing 2 x 20 x 5041 normals per update
-            costs more than the rest of the update); 0 draws fresh normals every update.
-        update_after_convergence: keep folding observations in after convergence (spec: yes).
-        fusion: 'joint' folds all samples of one control step (own and neighbours') into one
-            update per target (likelihood product, one resampling); 'sequential' makes one
-            update per observation point. Same posterior; 'joint' resamples less often and
-            is several times faster with many neighbours.
-        backend: how the update is computed: 'numpy' (the reference, every robot has it),
-            'numba' (compiled loops, msc_pf.pf_kernel; needs the numba package, which the
-            robot package does not require; bit-identical results, about twice as fast)
-            or 'auto' (numba when it can be imported, else numpy).
-    """
-
-    n_particles: int = 5041
-    r_conv_m: float = 20.0
-    r_err_m: float = 10.0
-    window: int = 10
-    noise_variance_db2: float = 1.0
-    gaussian_likelihood: bool = True
-    censored_likelihood: bool = True
-    initial_prior: str = 'detection_square'
-    init_half_width_m: float | None = None
-    resampling: str = 'systematic'
-    roughening_kappa: float = 0.5
-    roughening_floor_m: float = 0.5
-    noise_pool_size: int = 1 << 20
-    update_after_convergence: bool = True
-    fusion: str = 'joint'
-    backend: str = 'auto'
+    n_particles: int = parameter(5041, 'N_p (Table I: 5041 = 71 x 71).', ge=4)
+    r_conv_m: float = parameter(
+        20.0, 'radius of the convergence circle R_conv, eq. (6).', unit='m', gt=0.0
+    )
+    r_err_m: float = parameter(
+        10.0, 'radius of the permissible error circle R_err, eq. (7).', unit='m', gt=0.0
+    )
+    window: int = parameter(
+        10, 'number n of recent estimates tested by eq. (7), one per control step.', ge=2
+    )
+    noise_variance_db2: float = parameter(1.0, 'sigma^2 of eq. (3).', unit='dB^2', gt=0.0)
+    gaussian_likelihood: bool = parameter(
+        True,
+        (
+            'True (default) uses the Gaussian exp(-e^2 / (2 sigma^2)) for the noise '
+            "variance sigma^2; False the paper's eq. (3) as printed, exp(-e^2 / sigma^2), "
+            "which treats the 1 dB noise as 0.71 dB: with a dozen neighbours' samples fused "
+            'per step that filter converged tens to hundreds of metres off the target.'
+        ),
+    )
+    censored_likelihood: bool = parameter(
+        True,
+        (
+            "divide each sample's likelihood by the chance Phi((R_j - gamma_D) / s) that a "
+            'target at the particle would have been heard at all (s: the noise standard '
+            'deviation the likelihood implies). The receiver reports only samples above '
+            'gamma_D, so near the detection edge the reported ones are biased upward; '
+            'without this a swarm lingering there converges on a wrong point.'
+        ),
+    )
+    initial_prior: str = parameter(
+        'detection_square',
+        (
+            "'detection_square' puts the lattice on the square around the detection disc "
+            "centred on the observer; 'field' spreads it over the whole field."
+        ),
+        choices=INITIAL_PRIORS,
+    )
+    init_half_width_m: float | None = parameter(
+        None,
+        (
+            "half width of the detection square; unset (.nan) uses the radio model's detection "
+            'range (about 292 m).'
+        ),
+        unit='m',
+        gt=0.0,
+    )
+    resampling: str = parameter(
+        'systematic',
+        "'systematic' (one uniform offset) or 'multinomial'.",
+        choices=RESAMPLING_SCHEMES,
+    )
+    roughening_kappa: float = parameter(
+        0.5,
+        (
+            'kappa of the roughening jitter kappa * E * N^(-1/2). The common 0.2 left the '
+            'static-target filter to collapse by resampling alone onto one arc of the ring '
+            'of distances a far swarm observes (spread under R_conv, estimate 100-400 m '
+            'off); 0.5 keeps that ring populated until the observations decide, while the '
+            'jitter it adds to the spread (about 6 m) stays well under R_conv.'
+        ),
+        ge=0.0,
+    )
+    roughening_floor_m: float = parameter(
+        0.5, 'lower bound of the jitter standard deviation.', unit='m', ge=0.0
+    )
+    noise_pool_size: int = parameter(
+        1 << 20,
+        (
+            'size of the pre-drawn pool of standard normals the jitter is taken from at a '
+            'random offset (a speed choice: drawing 2 x 20 x 5041 normals per update costs '
+            'more than the rest of the update); 0 draws fresh normals every update.'
+        ),
+        ge=0,
+    )
+    update_after_convergence: bool = parameter(
+        True, 'keep folding observations in after convergence (spec: yes).'
+    )
+    fusion: str = parameter(
+        'joint',
+        (
+            "'joint' folds all samples of one control step (own and neighbours') into one "
+            "update per target (likelihood product, one resampling); 'sequential' makes one "
+            "update per observation point. Same posterior; 'joint' resamples less often and "
+            'is several times faster with many neighbours.'
+        ),
+        choices=FUSION_MODES,
+    )
+    backend: str = parameter(
+        'auto',
+        (
+            "how the update is computed: 'numpy' (the reference, every robot has it), "
+            "'numba' (compiled loops, msc_pf.pf_kernel; needs the numba package, which the "
+            'robot package does not require; bit-identical results, about twice as fast) or '
+            "'auto' (numba when it can be imported, else numpy)."
+        ),
+        choices=PF_BACKENDS,
+    )
 
     def __post_init__(self) -> None:
         _require_finite(self)
@@ -177,33 +220,39 @@ class ParticleFilterConfig:
 
 @dataclass(frozen=True)
 class SearchConfig:
-    """History-based search, eq. (1) (spec sections 1.2-1.3).
+    """History-based search, eq. (1) (spec sections 1.2-1.3)."""
 
-    Attributes:
-        alpha_outside: alpha of eqs. (1) and (8) outside D_th.
-        alpha_inside: alpha of eq. (8) within D_th of the goal.
-        k_s: weight of the own-history repulsion v^s.
-        k_o: weight of the neighbours'-history repulsion v^o.
-        random_period_s: how long one random direction v^r is kept [s]; 0 redraws every step.
-        cell_size_m: edge of a coverage-history cell [m].
-        history_radius_m: only cells closer than this repel [m]. About twice the detection
-            range (292 m), so the search sees the strip its own passes already covered; with
-            150 m robots re-crossed searched ground and the last target took up to 18000 s.
-        wall_margin_m: field edges closer than this repel [m]. About half the detection range:
-            a robot that far from an edge still hears targets on it, and with 50 m the
-            history terms pressed swarms against the edges, half their coverage wasted.
-        wall_weight: weight of the field-edge repulsion; None uses k_s.
-    """
-
-    alpha_outside: float = 20.0
-    alpha_inside: float = 5.0
-    k_s: float = 1.2
-    k_o: float = 0.5
-    random_period_s: float = 10.0
-    cell_size_m: float = 20.0
-    history_radius_m: float = 600.0
-    wall_margin_m: float = 150.0
-    wall_weight: float | None = None
+    alpha_outside: float = parameter(20.0, 'alpha of eqs. (1) and (8) outside D_th.')
+    alpha_inside: float = parameter(5.0, 'alpha of eq. (8) within D_th of the goal.')
+    k_s: float = parameter(1.2, 'weight of the own-history repulsion v^s.')
+    k_o: float = parameter(0.5, "weight of the neighbours'-history repulsion v^o.")
+    random_period_s: float = parameter(
+        10.0, 'how long one random direction v^r is kept; 0 redraws every step.', unit='s', ge=0.0
+    )
+    cell_size_m: float = parameter(20.0, 'edge of a coverage-history cell.', unit='m', gt=0.0)
+    history_radius_m: float = parameter(
+        600.0,
+        (
+            'only cells closer than this repel. About twice the detection range (292 m), so '
+            'the search sees the strip its own passes already covered; with 150 m robots '
+            're-crossed searched ground and the last target took up to 18000 s.'
+        ),
+        unit='m',
+        gt=0.0,
+    )
+    wall_margin_m: float = parameter(
+        150.0,
+        (
+            'field edges closer than this repel. About half the detection range: a robot '
+            'that far from an edge still hears targets on it, and with 50 m the history '
+            'terms pressed swarms against the edges, half their coverage wasted.'
+        ),
+        unit='m',
+        ge=0.0,
+    )
+    wall_weight: float | None = parameter(
+        None, 'weight of the field-edge repulsion; unset (.nan) uses k_s.'
+    )
 
     def __post_init__(self) -> None:
         _require_finite(self)
@@ -220,18 +269,22 @@ class SearchConfig:
 
 @dataclass(frozen=True)
 class AvoidanceConfig:
-    """Collision-avoidance vector S_i (spec section 1.3).
+    """Collision-avoidance vector S_i (spec section 1.3)."""
 
-    Attributes:
-        safety_radius_m: d_s; neighbours closer than this repel (linear form).
-        form: 'linear' sums (x_i - x_j)/d * (1 - d/d_s); 'inverse_square' sums
-            (x_i - x_j)/d^3 over every neighbour within ``inverse_square_range_m``.
-        inverse_square_range_m: neighbours considered by the inverse-square form [m].
-    """
-
-    safety_radius_m: float = 3.0
-    form: str = 'linear'
-    inverse_square_range_m: float = 20.0
+    safety_radius_m: float = parameter(
+        3.0, 'd_s; neighbours closer than this repel (linear form).', unit='m', gt=0.0
+    )
+    form: str = parameter(
+        'linear',
+        (
+            "'linear' sums (x_i - x_j)/d * (1 - d/d_s); 'inverse_square' sums (x_i - "
+            'x_j)/d^3 over every neighbour within ``inverse_square_range_m``.'
+        ),
+        choices=AVOIDANCE_FORMS,
+    )
+    inverse_square_range_m: float = parameter(
+        20.0, 'neighbours considered by the inverse-square form.', unit='m'
+    )
 
     def __post_init__(self) -> None:
         _require_finite(self)
@@ -241,21 +294,21 @@ class AvoidanceConfig:
 
 @dataclass(frozen=True)
 class SwarmConfig:
-    """Swarm formation, leader election, join and split (spec section 1.4).
+    """Swarm formation, leader election, join and split (spec section 1.4)."""
 
-    Attributes:
-        max_size: L_th, the largest swarm (Table I: 3).
-        comm_range_m: range of the peer radio [m] (Table I: 150).
-        formation_timeout_s: a robot that heard no peer by then starts alone [s].
-        membership_grace_steps: steps a robot may claim a leader that does not list it.
-        peer_timeout_s: a peer not heard for longer is out of range [s].
-    """
-
-    max_size: int = 3
-    comm_range_m: float = 150.0
-    formation_timeout_s: float = 5.0
-    membership_grace_steps: int = 2
-    peer_timeout_s: float = 2.5
+    max_size: int = parameter(3, 'L_th, the largest swarm (Table I: 3).', ge=1)
+    comm_range_m: float = parameter(
+        150.0, 'range of the peer radio (Table I: 150).', unit='m', gt=0.0
+    )
+    formation_timeout_s: float = parameter(
+        5.0, 'a robot that heard no peer by then starts alone.', unit='s'
+    )
+    membership_grace_steps: int = parameter(
+        2, 'steps a robot may claim a leader that does not list it.', ge=1
+    )
+    peer_timeout_s: float = parameter(
+        2.5, 'a peer not heard for longer is out of range.', unit='s', gt=0.0
+    )
 
     def __post_init__(self) -> None:
         _require_finite(self)
@@ -267,35 +320,40 @@ class SwarmConfig:
 
 @dataclass(frozen=True)
 class MscConfig:
-    """MSC mobility: evaluation value and PSO-style updates (Table I; spec section 1.6).
+    """MSC mobility: evaluation value and PSO-style updates (Table I; spec section 1.6)."""
 
-    Attributes:
-        inertia: w, inertial weight.
-        cognitive: c1, weight of the pull toward the robot's own best recent position.
-        social: c2, weight of the pull toward the best neighbour.
-        avoidance_degree: weight of S_i inside MSC.
-        dispersion_degree: D, penalty per closer robot heading to the same target.
-        dispersion_threshold: N_th; the penalty applies when more than N_th robots are closer.
-        pbest_window: H_p, number of recent samples p_best is chosen from.
-        rssi_window: samples in the moving average of RSSI compared with thresholds.
-        leader_rule: how the leader finds "where larger RSSI is likely": 'gradient' follows
-            the least-squares RSSI slope over the swarm's samples of the last ``pbest_window``
-            steps; 'pbest' pulls toward the best of its own last ``pbest_window`` positions.
-        full_pso: every robot uses both cognitive and social terms (optional variant).
-        detection_memory_s: a target not heard for longer counts as not detected [s].
-    """
-
-    inertia: float = 0.5
-    cognitive: float = 1.0
-    social: float = 1.0
-    avoidance_degree: float = 2.0
-    dispersion_degree: float = -100.0
-    dispersion_threshold: int = 3
-    pbest_window: int = 10
-    rssi_window: int = 3
-    leader_rule: str = 'gradient'
-    full_pso: bool = False
-    detection_memory_s: float = 3.0
+    inertia: float = parameter(0.5, 'w, inertial weight.')
+    cognitive: float = parameter(
+        1.0, "c1, weight of the pull toward the robot's own best recent position."
+    )
+    social: float = parameter(1.0, 'c2, weight of the pull toward the best neighbour.')
+    avoidance_degree: float = parameter(2.0, 'weight of S_i inside MSC.')
+    dispersion_degree: float = parameter(
+        -100.0, 'D, penalty per closer robot heading to the same target.'
+    )
+    dispersion_threshold: int = parameter(
+        3, 'N_th; the penalty applies when more than N_th robots are closer.', ge=0
+    )
+    pbest_window: int = parameter(10, 'H_p, number of recent samples p_best is chosen from.', ge=1)
+    rssi_window: int = parameter(
+        3, 'samples in the moving average of RSSI compared with thresholds.', ge=1
+    )
+    leader_rule: str = parameter(
+        'gradient',
+        (
+            'how the leader finds "where larger RSSI is likely": \'gradient\' follows the '
+            "least-squares RSSI slope over the swarm's samples of the last ``pbest_window`` "
+            "steps; 'pbest' pulls toward the best of its own last ``pbest_window`` "
+            'positions.'
+        ),
+        choices=LEADER_RULES,
+    )
+    full_pso: bool = parameter(
+        False, 'every robot uses both cognitive and social terms (optional variant).'
+    )
+    detection_memory_s: float = parameter(
+        3.0, 'a target not heard for longer counts as not detected.', unit='s', gt=0.0
+    )
 
     def __post_init__(self) -> None:
         _require_finite(self)
@@ -308,77 +366,123 @@ class MscConfig:
 
 @dataclass(frozen=True)
 class PhaseConfig:
-    """Phase thresholds, far-field formation, capture and re-targeting (spec 1.1, 1.7, 1.8).
+    """Phase thresholds, far-field formation, capture and re-targeting (spec 1.1, 1.7, 1.8)."""
 
-    Attributes:
-        gamma1_dbm: below it (and unconverged) the proposed scheme uses the far-field formation.
-        gamma2_dbm: above it every scheme approaches with MSC only (b-3).
-        gamma3_dbm: above it a robot stops and works (c-1).
-        hysteresis_db: margin before dropping back to a lower phase.
-        follower_offset_m: d_f, lateral slot spacing of followers in (b-1).
-        slot_time_s: time followers spend converging to their slots before copying the leader.
-        retarget_penalty: R (< 0), penalty per closer robot in the re-targeting rule.
-        retarget_threshold: N_thr for detected candidates of the re-targeting rule.
-        task_area_m: D_th; eq. (8) uses alpha_inside within this distance of the goal.
-        work_timeout_s: a robot that worked this long without a capture resumes (b-3).
-        work_block_s: after such a timeout the robot may not stop to work again for this long.
-        keep_converged_target: PF schemes: a robot whose selected target's estimate has
-            converged keeps approaching it with eq. (8) when the signal drops out (the paper:
-            "each swarm can directly approach the searching target once its location
-            estimation is converged"). Off by default: MSC+PF filters often converge at the
-            detection edge on a wrong point, and following such an estimate after the signal
-            is gone cost MSC+PF seed 0 (10 targets) 13419 s of CCT instead of 4888 s; off, the
-            robot searches again once nothing is heard.
-        retarget_unconverged: proposed scheme, (c-2) without a converged candidate: choose
-            among the targets whose filters are tracked but not converged (the "recorded
-            information on location estimation" of targets heard on the way) by the same
-            R * N_r rule, taking the largest-weight particle as the estimate, and approach it
-            with (b-1). False searches again (or takes a target heard now).
-        recorded_max_age_s: only unconverged filters that got a sample (own or a neighbour's)
-            within this time are candidates [s]: older ones are mostly of targets other
-            robots captured meanwhile, out of radio range (capture IDs spread by contact).
-        unheard_give_up_m: a robot that approaches an unconverged recorded estimate and does
-            not hear the target within this distance of it drops that filter [m]; about a third
-            of the 292 m detection range, so an estimate 100-200 m off still gets heard.
-        unheard_updates: proposed scheme: while the robot pursues a target it has not heard
-            for msc.detection_memory_s and no neighbour's sample of it arrives, its filter
-            folds in that non-detection at the robot and at its swarm's members (each
-            particle weighted by the chance a target there would have stayed below gamma_D),
-            so an estimate on the wrong side of the ring of distances a far swarm observed
-            moves to the side not yet ruled out. The paper's filter uses only the samples
-            heard; this is the same observation model's other half. Off by default: on 8
-            screened runs it fixed such losses but did not lower the mean CCT.
-        unheard_exhausted_share: with ``unheard_updates``, a filter of which less than this
-            share of the belief survives one step's non-detections is dropped (the robot has
-            covered the ground the filter allowed without hearing the target).
-        goal_progress_window_s: a leader that has driven toward a converged estimate with
-            eq. (8) for this long and come less than ``goal_progress_min_m`` closer to it
-            restarts that target's filter [s]; 0 turns the check off. A filter whose
-            particles all sit on the wrong side of the ring of distances can follow the
-            swarm: the swarm drives away from the target, the RSSI falls, the estimate moves
-            out with it, and the swarm chases it out of earshot.
-        goal_progress_min_m: the least approach to the goal over that window [m].
-    """
-
-    gamma1_dbm: float = -78.0
-    gamma2_dbm: float = -58.0
-    gamma3_dbm: float = -48.0
-    hysteresis_db: float = 1.0
-    follower_offset_m: float = 20.0
-    slot_time_s: float = 20.0
-    retarget_penalty: float = -100.0
-    retarget_threshold: int = 3
-    task_area_m: float = 5.0
-    work_timeout_s: float = 30.0
-    work_block_s: float = 10.0
-    keep_converged_target: bool = False
-    retarget_unconverged: bool = True
-    recorded_max_age_s: float = 600.0
-    unheard_give_up_m: float = 100.0
-    unheard_updates: bool = False
-    unheard_exhausted_share: float = 0.01
-    goal_progress_window_s: float = 60.0
-    goal_progress_min_m: float = 15.0
+    gamma1_dbm: float = parameter(
+        -78.0,
+        'below it (and unconverged) the proposed scheme uses the far-field formation.',
+        unit='dBm',
+    )
+    gamma2_dbm: float = parameter(
+        -58.0, 'above it every scheme approaches with MSC only (b-3).', unit='dBm'
+    )
+    gamma3_dbm: float = parameter(-48.0, 'above it a robot stops and works (c-1).', unit='dBm')
+    hysteresis_db: float = parameter(
+        1.0, 'margin before dropping back to a lower phase.', unit='dB', ge=0.0
+    )
+    follower_offset_m: float = parameter(
+        20.0, 'd_f, lateral slot spacing of followers in (b-1).', unit='m'
+    )
+    slot_time_s: float = parameter(
+        20.0, 'time followers spend converging to their slots before copying the leader.', unit='s'
+    )
+    retarget_penalty: float = parameter(
+        -100.0, 'R (< 0), penalty per closer robot in the re-targeting rule.', lt=0.0
+    )
+    retarget_threshold: int = parameter(
+        3, 'N_thr for detected candidates of the re-targeting rule.', ge=0
+    )
+    task_area_m: float = parameter(
+        5.0, 'D_th; eq. (8) uses alpha_inside within this distance of the goal.', unit='m', gt=0.0
+    )
+    work_timeout_s: float = parameter(
+        30.0, 'a robot that worked this long without a capture resumes (b-3).', unit='s', gt=0.0
+    )
+    work_block_s: float = parameter(
+        10.0, 'after such a timeout the robot may not stop to work again for this long.', unit='s'
+    )
+    keep_converged_target: bool = parameter(
+        False,
+        (
+            "PF schemes: a robot whose selected target's estimate has converged keeps "
+            'approaching it with eq. (8) when the signal drops out (the paper: "each swarm '
+            'can directly approach the searching target once its location estimation is '
+            'converged"). Off by default: MSC+PF filters often converge at the detection '
+            'edge on a wrong point, and following such an estimate after the signal is gone '
+            'cost MSC+PF seed 0 (10 targets) 13419 s of CCT instead of 4888 s; off, the '
+            'robot searches again once nothing is heard.'
+        ),
+    )
+    retarget_unconverged: bool = parameter(
+        True,
+        (
+            'proposed scheme, (c-2) without a converged candidate: choose among the targets '
+            'whose filters are tracked but not converged (the "recorded information on '
+            'location estimation" of targets heard on the way) by the same R * N_r rule, '
+            'taking the largest-weight particle as the estimate, and approach it with '
+            '(b-1). False searches again (or takes a target heard now).'
+        ),
+    )
+    recorded_max_age_s: float = parameter(
+        600.0,
+        (
+            "only unconverged filters that got a sample (own or a neighbour's) within this "
+            'time are candidates: older ones are mostly of targets other robots captured '
+            'meanwhile, out of radio range (capture IDs spread by contact).'
+        ),
+        unit='s',
+        ge=0.0,
+    )
+    unheard_give_up_m: float = parameter(
+        100.0,
+        (
+            'a robot that approaches an unconverged recorded estimate and does not hear the '
+            'target within this distance of it drops that filter; about a third of the 292 '
+            'm detection range, so an estimate 100-200 m off still gets heard.'
+        ),
+        unit='m',
+        gt=0.0,
+    )
+    unheard_updates: bool = parameter(
+        False,
+        (
+            'proposed scheme: while the robot pursues a target it has not heard for '
+            "msc.detection_memory_s and no neighbour's sample of it arrives, its filter "
+            "folds in that non-detection at the robot and at its swarm's members (each "
+            'particle weighted by the chance a target there would have stayed below '
+            'gamma_D), so an estimate on the wrong side of the ring of distances a far '
+            "swarm observed moves to the side not yet ruled out. The paper's filter uses "
+            "only the samples heard; this is the same observation model's other half. Off "
+            'by default: on 8 screened runs it fixed such losses but did not lower the mean '
+            'CCT.'
+        ),
+    )
+    unheard_exhausted_share: float = parameter(
+        0.01,
+        (
+            'with ``unheard_updates``, a filter of which less than this share of the belief '
+            "survives one step's non-detections is dropped (the robot has covered the "
+            'ground the filter allowed without hearing the target).'
+        ),
+        ge=0.0,
+        lt=1.0,
+    )
+    goal_progress_window_s: float = parameter(
+        60.0,
+        (
+            'a leader that has driven toward a converged estimate with eq. (8) for this '
+            'long and come less than ``goal_progress_min_m`` closer to it restarts that '
+            "target's filter; 0 turns the check off. A filter whose particles all sit on "
+            'the wrong side of the ring of distances can follow the swarm: the swarm drives '
+            'away from the target, the RSSI falls, the estimate moves out with it, and the '
+            'swarm chases it out of earshot.'
+        ),
+        unit='s',
+        ge=0.0,
+    )
+    goal_progress_min_m: float = parameter(
+        15.0, 'the least approach to the goal over that window.', unit='m', gt=0.0
+    )
 
     def __post_init__(self) -> None:
         _require_finite(self)
@@ -402,26 +506,21 @@ class PhaseConfig:
 
 @dataclass(frozen=True)
 class MscPfConfig:
-    """Everything one robot's controller needs.
+    """Everything one robot's controller needs."""
 
-    Attributes:
-        scheme: which of the three schemes runs.
-        field_size_m: edge of the square field [m]; the field spans [0, size] in x and y.
-        max_speed_m_s: robot speed [m/s] (Table I: 1).
-        period_s: control period Delta t [s].
-    """
-
-    scheme: Scheme = Scheme.PROPOSED
-    field_size_m: float = 2000.0
-    max_speed_m_s: float = 1.0
-    period_s: float = 1.0
-    radio: RadioConfig = field(default_factory=RadioConfig)
-    particle_filter: ParticleFilterConfig = field(default_factory=ParticleFilterConfig)
-    search: SearchConfig = field(default_factory=SearchConfig)
-    avoidance: AvoidanceConfig = field(default_factory=AvoidanceConfig)
-    swarm: SwarmConfig = field(default_factory=SwarmConfig)
-    msc: MscConfig = field(default_factory=MscConfig)
-    phases: PhaseConfig = field(default_factory=PhaseConfig)
+    scheme: Scheme = parameter(Scheme.PROPOSED, 'which of the three schemes runs.')
+    field_size_m: float = parameter(
+        2000.0, 'edge of the square field; the field spans [0, size] in x and y.', unit='m', gt=0.0
+    )
+    max_speed_m_s: float = parameter(1.0, 'robot speed (Table I: 1).', unit='m/s', gt=0.0)
+    period_s: float = parameter(1.0, 'control period Delta t.', unit='s', gt=0.0)
+    radio: RadioConfig = section(RadioConfig)
+    particle_filter: ParticleFilterConfig = section(ParticleFilterConfig)
+    search: SearchConfig = section(SearchConfig)
+    avoidance: AvoidanceConfig = section(AvoidanceConfig)
+    swarm: SwarmConfig = section(SwarmConfig)
+    msc: MscConfig = section(MscConfig)
+    phases: PhaseConfig = section(PhaseConfig)
 
     def __post_init__(self) -> None:
         if not isinstance(self.scheme, Scheme):

@@ -8,13 +8,10 @@ it, so the formation timeouts below take a quarter of their length on real DDS.
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 import pytest
-import yaml
 from msc_pf.errors import ConfigError
-from msc_pf.node import NODE_PARAMETERS, MscPfNode
-from msc_pf.parameters import parameter_defaults
+from msc_pf.node import MscPfNode
 from swarm_runtime.ros import Parameter, message_module, qos_profile_sensor_data
 from swarm_runtime.testing import NodeTestBed
 
@@ -145,21 +142,3 @@ def test_invalid_parameters_stop_the_node_at_start(make_harness):
         make_harness(**{'phases.gamma2_dbm': -90.0})
     with pytest.raises(ConfigError, match='drive_rate_hz'):
         make_harness(drive_rate_hz=0.0)
-
-
-def test_parameter_file_mirrors_the_defaults():
-    path = Path(__file__).resolve().parents[1] / 'config' / 'msc_pf.yaml'
-    loaded = yaml.safe_load(path.read_text())['/**']['ros__parameters']
-    flat = {}
-    for key, value in loaded.items():
-        if isinstance(value, dict):
-            flat.update({f'{key}.{k}': v for k, v in value.items()})
-        else:
-            flat[key] = value
-    expected = {**parameter_defaults(), **{k: v for k, (v, _) in NODE_PARAMETERS.items()}}
-    assert flat.keys() == expected.keys()
-    for key, value in expected.items():
-        if isinstance(value, float) and math.isnan(value):
-            assert math.isnan(flat[key])
-        else:
-            assert flat[key] == value, key

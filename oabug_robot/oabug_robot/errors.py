@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
-__all__ = ['ConfigError', 'OABugError', 'ScanError']
+from swarm_common import params
+
+__all__ = ['ConfigError', 'OABugError', 'ParameterError', 'ScanError']
 
 
 class OABugError(Exception):
@@ -11,6 +13,10 @@ class OABugError(Exception):
 
 class ConfigError(OABugError, ValueError):
     """A configuration value is out of range or inconsistent with another one."""
+
+
+class ParameterError(ConfigError, params.ParameterError):
+    """A node parameter is unknown, of the wrong type, out of range or not one of its choices."""
 
 
 class ScanError(OABugError, ValueError):

@@ -22,6 +22,7 @@ from typing import Any
 
 import numpy as np
 from swarm_runtime.node_main import run_node
+from swarm_runtime.parameters import declare_config
 from swarm_runtime.ros import (
     Node,
     message_module,
@@ -40,19 +41,8 @@ from oabug_robot.conversions import (
 )
 from oabug_robot.errors import ConfigError, ScanError
 from oabug_robot.fsm import Event, OABugFsm, SensorSnapshot
+from oabug_robot.node_settings import NODE_NAME, OABUG_PARAMETERS, OABugNodeConfig
 from oabug_robot.scan_features import ScanFeatureExtractor, ScanFeatures
-from oabug_robot.settings import (
-    Departure,
-    MotionConfig,
-    OABugConfig,
-    PerceptionConfig,
-    SoundMemory,
-    SoundTurnRule,
-    SoundWallSide,
-    SoundWeighting,
-    TurnDirection,
-    Variant,
-)
 from oabug_robot.sound import PeerBearings
 
 __all__ = ['OABugNode', 'main']
@@ -61,215 +51,24 @@ sensor_msgs = message_module('sensor_msgs')
 geometry_msgs = message_module('geometry_msgs')
 std_msgs = message_module('std_msgs')
 swarm_interfaces = message_module('swarm_interfaces')
-rcl_interfaces = message_module('rcl_interfaces')
 
 # Seconds between two repetitions of the same warning.
 WARN_PERIOD_S = 2.0
-_DEFAULTS = OABugConfig()
-_PERCEPTION = PerceptionConfig()
-_MOTION = MotionConfig()
-
-# name, default, description. Declared read-only: the controller is built once at start.
-PARAMETERS: tuple[tuple[str, Any, str], ...] = (
-    ('variant', _DEFAULTS.variant.value, 'random, minimum, sound, gas or gas_sound (Table I)'),
-    ('robot_index', 0, 'i: this robot index in the swarm, 0..robot_count-1'),
-    ('robot_count', 1, 'n: number of robots that depart together'),
-    ('departure', 'center', 'center (full-circle fan) or edge (half-circle fan)'),
-    (
-        'heading_bias_deg',
-        0.0,
-        'bias of the preferred directions [deg] in the IMU yaw frame; for edge departure, '
-        'the direction into the building minus 90',
-    ),
-    ('control_rate_hz', 10.0, 'control loop rate [Hz]'),
-    (
-        'state_rate_hz',
-        2.0,
-        'state topic rate [Hz]; a step with an event or a change of staleness is always published',
-    ),
-    ('stale_timeout_s', 1.0, 'stop when scan, imu (or gas, gas variants) is older [s]'),
-    ('gas_threshold', _DEFAULTS.gas_threshold, 'raw 10-bit gas reading that means scent'),
-    ('scent_window_s', _DEFAULTS.scent_window_s, 'scent counts at a corner for this long [s]'),
-    ('revisit_flip_count', _DEFAULTS.revisit_flip_count, 'revisits before the 180 deg flip'),
-    (
-        'visit_count_resets_on_fresh_corner',
-        _DEFAULTS.visit_count_resets_on_fresh_corner,
-        'an unscented outer corner resets the revisit count (count revisits in a row)',
-    ),
-    (
-        'inner_corner_resumes_following',
-        _DEFAULTS.inner_corner_resumes_following,
-        'an inner corner after a revisit returns to Following Wall (paper Fig. 3)',
-    ),
-    (
-        'wall_end_face_m',
-        _DEFAULTS.wall_end_face_m,
-        'an outer corner this soon after a wrap is the same wall end: keep wrapping [m]',
-    ),
-    ('fixed_turn', _DEFAULTS.fixed_turn.value, 'left or right: turn at a wall without sound'),
-    (
-        'robot_hit_turn',
-        _DEFAULTS.robot_hit_turn.value,
-        'left or right: 90 deg turn after hitting another robot (paper: right)',
-    ),
-    (
-        'robot_hit_repeat_s',
-        _DEFAULTS.robot_hit_repeat_s,
-        'a robot hit this soon after the previous one turns to a random heading [s]',
-    ),
-    (
-        'sound_turn_rule',
-        _DEFAULTS.sound_turn_rule.value,
-        'wall side from the sound: away (towards theta_opp, paper) or toward the peers',
-    ),
-    (
-        'sound_wall_side',
-        _DEFAULTS.sound_wall_side.value,
-        'Sound variant: wall contacts whose side the sound picks: every_contact (paper), '
-        'first_contact or never (fixed_turn)',
-    ),
-    (
-        'gas_sound_wall_side',
-        _DEFAULTS.gas_sound_wall_side.value,
-        'Gas+Sound: the same; first_contact (the paper discussion), every_contact '
-        '(Table I) or never',
-    ),
-    (
-        'sound_side_deadband_deg',
-        math.degrees(_DEFAULTS.sound_side_deadband_rad),
-        'Sound variant: theta_opp this close to straight ahead or behind picks no side, '
-        'fixed_turn is taken (paper: 0) [deg]',
-    ),
-    (
-        'gas_sound_side_deadband_deg',
-        math.degrees(_DEFAULTS.gas_sound_side_deadband_rad),
-        'Gas+Sound: the same [deg]',
-    ),
-    ('sound_weighting', _DEFAULTS.sound_weighting.value, 'distance (paper) or unit'),
-    (
-        'sound_memory',
-        _DEFAULTS.sound_memory.value,
-        "once (authors' simulator) or stored (paper wording)",
-    ),
-    (
-        'sound_updates_at_corner',
-        _DEFAULTS.sound_updates_at_corner,
-        'Sound variant updates phi from the bearings at outer corners (paper)',
-    ),
-    ('pump_on_s', _DEFAULTS.pump_on_s, 'pump burst length [s]'),
-    ('pump_period_s', _DEFAULTS.pump_period_s, 'time between pump bursts [s]'),
-    (
-        'pump_min_speed_mps',
-        _DEFAULTS.pump_min_speed_mps,
-        'a burst starts only at this forward speed or faster (0: plain clock) [m/s]',
-    ),
-    ('bearing_timeout_s', _DEFAULTS.bearing_timeout_s, 'bearings older than this are unused [s]'),
-    ('own_tag_id', '', 'own AoA tag id, ignored in the bearings ("" keeps all)'),
-    ('seed', -1, 'seed of the Random variant; -1 uses robot_index'),
-    ('robot_radius_m', _PERCEPTION.robot_radius_m, 'robot body radius [m]'),
-    ('wall_hit_distance_m', _PERCEPTION.wall_hit_distance_m, 'wall this close ahead is hit [m]'),
-    (
-        'robot_hit_distance_m',
-        _PERCEPTION.robot_hit_distance_m,
-        'peer this close in the front cone is hit [m]',
-    ),
-    ('lidar_yaw_offset_deg', 0.0, 'yaw of the lidar zero ray in the robot frame [deg]'),
-    ('forward_speed_mps', _MOTION.forward_speed_mps, 'cruise speed [m/s]'),
-    ('turn_rate_radps', _MOTION.turn_rate_radps, 'largest yaw rate [rad/s]'),
-    ('wall_distance_m', _MOTION.wall_distance_m, 'distance kept from the followed wall [m]'),
-    ('random_step_m', _MOTION.random_step_m, 'Random variant: distance per random draw [m]'),
-)
-
-
-def _parse(enum_type: Any, name: str, text: str) -> Any:
-    try:
-        return enum_type(text.strip().lower())
-    except ValueError:
-        choices = ', '.join(e.value for e in enum_type)
-        msg = f'parameter {name}={text!r} is not one of {choices}'
-        raise ConfigError(msg) from None
-
-
-def config_from_parameters(values: dict[str, Any]) -> OABugConfig:
-    """Build the controller configuration from the node's parameter values.
-
-    Raises:
-        ConfigError: a value is unknown or out of range.
-    """
-    seed = int(values['seed'])
-    perception = PerceptionConfig(
-        robot_radius_m=float(values['robot_radius_m']),
-        wall_hit_distance_m=float(values['wall_hit_distance_m']),
-        robot_hit_distance_m=float(values['robot_hit_distance_m']),
-        lidar_yaw_offset_rad=math.radians(float(values['lidar_yaw_offset_deg'])),
-    )
-    motion = MotionConfig(
-        forward_speed_mps=float(values['forward_speed_mps']),
-        turn_rate_radps=float(values['turn_rate_radps']),
-        min_turn_rate_radps=min(_MOTION.min_turn_rate_radps, float(values['turn_rate_radps'])),
-        wall_distance_m=float(values['wall_distance_m']),
-        random_step_m=float(values['random_step_m']),
-    )
-    return OABugConfig(
-        variant=Variant.parse(str(values['variant'])),
-        robot_index=int(values['robot_index']),
-        robot_count=int(values['robot_count']),
-        departure=Departure.parse(str(values['departure'])),
-        heading_bias_rad=math.radians(float(values['heading_bias_deg'])),
-        gas_threshold=int(values['gas_threshold']),
-        scent_window_s=float(values['scent_window_s']),
-        revisit_flip_count=int(values['revisit_flip_count']),
-        visit_count_resets_on_fresh_corner=bool(values['visit_count_resets_on_fresh_corner']),
-        inner_corner_resumes_following=bool(values['inner_corner_resumes_following']),
-        wall_end_face_m=float(values['wall_end_face_m']),
-        fixed_turn=_parse(TurnDirection, 'fixed_turn', str(values['fixed_turn'])),
-        robot_hit_turn=_parse(TurnDirection, 'robot_hit_turn', str(values['robot_hit_turn'])),
-        robot_hit_repeat_s=float(values['robot_hit_repeat_s']),
-        sound_turn_rule=_parse(SoundTurnRule, 'sound_turn_rule', str(values['sound_turn_rule'])),
-        sound_wall_side=_parse(SoundWallSide, 'sound_wall_side', str(values['sound_wall_side'])),
-        gas_sound_wall_side=_parse(
-            SoundWallSide, 'gas_sound_wall_side', str(values['gas_sound_wall_side'])
-        ),
-        sound_side_deadband_rad=math.radians(float(values['sound_side_deadband_deg'])),
-        gas_sound_side_deadband_rad=math.radians(float(values['gas_sound_side_deadband_deg'])),
-        sound_weighting=_parse(SoundWeighting, 'sound_weighting', str(values['sound_weighting'])),
-        sound_memory=_parse(SoundMemory, 'sound_memory', str(values['sound_memory'])),
-        sound_updates_at_corner=bool(values['sound_updates_at_corner']),
-        pump_on_s=float(values['pump_on_s']),
-        pump_period_s=float(values['pump_period_s']),
-        pump_min_speed_mps=float(values['pump_min_speed_mps']),
-        bearing_timeout_s=float(values['bearing_timeout_s']),
-        seed=seed if seed >= 0 else int(values['robot_index']),
-        perception=perception,
-        motion=motion,
-    )
 
 
 class OABugNode(Node):
     """One OA-Bug robot: reads its sensor topics, drives cmd_vel and the pump."""
 
-    def __init__(self, node_name: str = 'oabug', **kwargs: Any) -> None:
+    def __init__(self, node_name: str = NODE_NAME, **kwargs: Any) -> None:
         super().__init__(node_name, **kwargs)
-        values = {}
-        for name, default, description in PARAMETERS:
-            descriptor = rcl_interfaces.ParameterDescriptor(description=description, read_only=True)
-            values[name] = self.declare_parameter(name, default, descriptor).value
         try:
-            self._config = config_from_parameters(values)
-            rate_hz = float(values['control_rate_hz'])
-            self._stale_timeout_s = float(values['stale_timeout_s'])
-            if not (math.isfinite(rate_hz) and rate_hz > 0.0):
-                raise ConfigError(f'control_rate_hz must be > 0, got {rate_hz}')
-            if not (math.isfinite(self._stale_timeout_s) and self._stale_timeout_s > 0.0):
-                raise ConfigError(f'stale_timeout_s must be > 0, got {self._stale_timeout_s}')
-            state_rate_hz = float(values['state_rate_hz'])
-            if not (math.isfinite(state_rate_hz) and state_rate_hz > 0.0):
-                raise ConfigError(f'state_rate_hz must be > 0, got {state_rate_hz}')
-            self._state_period_s = 1.0 / state_rate_hz
+            self._declared = declare_config(self, OABUG_PARAMETERS, on_change=self._configure)
         except ConfigError as err:
             self.get_logger().fatal(f'invalid configuration: {err}')
             raise
-        self._own_tag_id = str(values['own_tag_id'])
+        settings = self._declared.config
+        self._config = settings.controller_config()
+        self._configure(settings)
         self._fsm = OABugFsm(self._config)
         self._extractor = ScanFeatureExtractor(self._config.perception)
 
@@ -297,12 +96,18 @@ class OABugNode(Node):
         self.create_subscription(
             swarm_interfaces.PeerBearingArray, 'bearings', self._on_bearings, sensor_qos
         )
-        self._timer = self.create_timer(1.0 / rate_hz, self._on_control)
+        self._timer = self.create_timer(1.0 / settings.control_rate_hz, self._on_control)
         self.get_logger().info(
             f'OA-Bug {self._config.variant.value}: robot {self._config.robot_index} of '
             f'{self._config.robot_count}, {self._config.departure.value} departure, '
             f'preferred direction {math.degrees(self._fsm.memory.preferred_direction_rad):.1f} deg'
         )
+
+    def _configure(self, settings: OABugNodeConfig) -> None:
+        """Take the settings a running node may change (at start and on a parameter change)."""
+        self._stale_timeout_s = settings.stale_timeout_s
+        self._state_period_s = 1.0 / settings.state_rate_hz
+        self._own_tag_id = settings.own_tag_id
 
     @property
     def fsm(self) -> OABugFsm:
@@ -453,7 +258,12 @@ def main(args: list[str] | None = None) -> int:
     """Console entry point: ``ros2 run oabug_robot oabug``."""
     # The node logs its configuration errors itself (describe_fatal None: no second line).
     return run_node(
-        OABugNode, args, name='oabug', fatal_errors=(ConfigError,), describe_fatal=lambda _: None
+        OABugNode,
+        args,
+        name=NODE_NAME,
+        fatal_errors=(ConfigError,),
+        describe_fatal=lambda _: None,
+        parameters=OABUG_PARAMETERS,
     )
 
 

@@ -12,8 +12,10 @@ metres, durations seconds.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, fields
 from enum import Enum
+
+from swarm_common.params import parameter, section
 
 from oabug_robot.errors import ConfigError
 
@@ -171,11 +173,13 @@ class PerceptionConfig:
         lidar_yaw_offset_rad: yaw of the lidar's zero ray in the robot frame [rad].
     """
 
-    robot_radius_m: float = 0.1
+    robot_radius_m: float = parameter(0.1, 'robot body radius', unit='m', gt=0.0)
     front_half_width_m: float = 0.12
-    wall_hit_distance_m: float = 0.22
+    wall_hit_distance_m: float = parameter(0.22, 'wall this close ahead is hit', unit='m', ge=0.0)
     wrap_stop_distance_m: float = 0.18
-    robot_hit_distance_m: float = 0.2
+    robot_hit_distance_m: float = parameter(
+        0.2, 'peer this close in the front cone is hit', unit='m', ge=0.0
+    )
     robot_cone_half_angle_rad: float = math.radians(30.0)
     peer_bearing_tolerance_rad: float = math.radians(10.0)
     peer_mask_range_m: float = 1.0
@@ -189,7 +193,9 @@ class PerceptionConfig:
     side_wall_fit_tolerance_m: float = 0.02
     abeam_behind_m: float = 0.02
     abeam_reach_m: float = 0.45
-    lidar_yaw_offset_rad: float = 0.0
+    lidar_yaw_offset_rad: float = parameter(
+        0.0, 'yaw of the lidar zero ray in the robot frame', unit='deg', degrees=True
+    )
 
     def __post_init__(self) -> None:
         for f in fields(self):
@@ -240,15 +246,24 @@ class MotionConfig:
             (going round a wall end takes at most half a turn) [rad].
     """
 
-    forward_speed_mps: float = 0.3
-    turn_rate_radps: float = 2.0
-    min_turn_rate_radps: float = 0.3
+    forward_speed_mps: float = parameter(0.3, 'cruise speed', unit='m/s', gt=0.0)
+    turn_rate_radps: float = parameter(2.0, 'largest yaw rate', unit='rad/s', gt=0.0)
+    min_turn_rate_radps: float = parameter(
+        0.3,
+        'smallest yaw rate of a turn in place, so turns finish; at most turn_rate_radps',
+        unit='rad/s',
+        gt=0.0,
+    )
     heading_gain_per_s: float = 3.0
     heading_tolerance_rad: float = math.radians(3.0)
-    wall_distance_m: float = 0.15
+    wall_distance_m: float = parameter(
+        0.15, 'distance kept from the followed wall', unit='m', gt=0.0
+    )
     wall_distance_gain_radps_per_m: float = 6.0
     wall_angle_gain_per_s: float = 2.5
-    random_step_m: float = 0.1
+    random_step_m: float = parameter(
+        0.1, 'Random variant: distance per random draw', unit='m', gt=0.0
+    )
     random_turn_probability: float = 0.5
     lost_wall_arc_rad: float = 1.5 * math.pi
 
@@ -344,35 +359,108 @@ class OABugConfig:
         motion: speeds and controller gains.
     """
 
-    variant: Variant = Variant.GAS_SOUND
-    robot_index: int = 0
-    robot_count: int = 1
-    departure: Departure = Departure.CENTER
-    heading_bias_rad: float = 0.0
-    gas_threshold: int = 200
-    scent_window_s: float = 2.0
-    revisit_flip_count: int = 3
-    visit_count_resets_on_fresh_corner: bool = True
-    inner_corner_resumes_following: bool = True
-    wall_end_face_m: float = 0.15
-    fixed_turn: TurnDirection = TurnDirection.RIGHT
-    robot_hit_turn: TurnDirection = TurnDirection.RIGHT
-    robot_hit_repeat_s: float = 4.0
-    sound_turn_rule: SoundTurnRule = SoundTurnRule.AWAY
-    sound_wall_side: SoundWallSide = SoundWallSide.EVERY_CONTACT
-    gas_sound_wall_side: SoundWallSide = SoundWallSide.FIRST_CONTACT
-    sound_side_deadband_rad: float = 0.0
-    gas_sound_side_deadband_rad: float = math.radians(45.0)
-    sound_weighting: SoundWeighting = SoundWeighting.DISTANCE
-    sound_memory: SoundMemory = SoundMemory.ONCE
-    sound_updates_at_corner: bool = True
-    pump_on_s: float = 0.5
-    pump_period_s: float = 5.0
-    pump_min_speed_mps: float = 0.2
-    bearing_timeout_s: float = 1.0
+    variant: Variant = parameter(Variant.GAS_SOUND, 'which algorithm of Table I runs')
+    robot_index: int = parameter(0, 'i: this robot index in the swarm, 0..robot_count-1', ge=0)
+    robot_count: int = parameter(1, 'n: number of robots that depart together', ge=1)
+    departure: Departure = parameter(
+        Departure.CENTER, 'center: full-circle fan of preferred directions; edge: half-circle fan'
+    )
+    heading_bias_rad: float = parameter(
+        0.0,
+        (
+            'bias of the preferred directions in the IMU yaw frame; for edge departure, the '
+            'direction into the building minus 90'
+        ),
+        unit='deg',
+        degrees=True,
+    )
+    gas_threshold: int = parameter(200, 'raw 10-bit gas reading that means scent', ge=0, le=1023)
+    scent_window_s: float = parameter(
+        2.0, 'scent counts at a corner for this long', unit='s', ge=0.0
+    )
+    revisit_flip_count: int = parameter(3, 'revisits before the 180 deg flip', ge=1)
+    visit_count_resets_on_fresh_corner: bool = parameter(
+        True, 'an unscented outer corner resets the revisit count (count revisits in a row)'
+    )
+    inner_corner_resumes_following: bool = parameter(
+        True, 'an inner corner after a revisit returns to Following Wall (paper Fig. 3)'
+    )
+    wall_end_face_m: float = parameter(
+        0.15,
+        'an outer corner this soon after a wrap is the same wall end: keep wrapping',
+        unit='m',
+        ge=0.0,
+    )
+    fixed_turn: TurnDirection = parameter(
+        TurnDirection.RIGHT, 'side turned to at a wall without sound'
+    )
+    robot_hit_turn: TurnDirection = parameter(
+        TurnDirection.RIGHT, 'side of the 90 deg turn after hitting another robot (paper: right)'
+    )
+    robot_hit_repeat_s: float = parameter(
+        4.0,
+        'a robot hit this soon after the previous one turns to a random heading',
+        unit='s',
+        ge=0.0,
+    )
+    sound_turn_rule: SoundTurnRule = parameter(
+        SoundTurnRule.AWAY,
+        'wall side from the sound: away (towards theta_opp, paper) or toward the peers',
+    )
+    sound_wall_side: SoundWallSide = parameter(
+        SoundWallSide.EVERY_CONTACT,
+        (
+            'Sound variant: wall contacts whose side the sound picks: every_contact '
+            '(paper), first_contact or never (fixed_turn)'
+        ),
+    )
+    gas_sound_wall_side: SoundWallSide = parameter(
+        SoundWallSide.FIRST_CONTACT,
+        (
+            'Gas+Sound: the same; first_contact (the paper discussion), every_contact '
+            '(Table I) or never'
+        ),
+    )
+    sound_side_deadband_rad: float = parameter(
+        0.0,
+        (
+            'Sound variant: theta_opp this close to straight ahead or behind picks no side, '
+            'fixed_turn is taken (paper: 0)'
+        ),
+        unit='deg',
+        degrees=True,
+        ge=0.0,
+        le=90.0,
+    )
+    gas_sound_side_deadband_rad: float = parameter(
+        math.radians(45.0), 'Gas+Sound: the same', unit='deg', degrees=True, ge=0.0, le=90.0
+    )
+    sound_weighting: SoundWeighting = parameter(
+        SoundWeighting.DISTANCE,
+        "how the peers' bearings are summed: distance-weighted (paper) or unit vectors",
+    )
+    sound_memory: SoundMemory = parameter(
+        SoundMemory.ONCE,
+        "theta_opp is used once (authors' simulator) or stored as the preferred direction "
+        '(paper wording)',
+    )
+    sound_updates_at_corner: bool = parameter(
+        True, 'Sound variant updates phi from the bearings at outer corners (paper)'
+    )
+    pump_on_s: float = parameter(0.5, 'pump burst length', unit='s', ge=0.0)
+    pump_period_s: float = parameter(5.0, 'time between pump bursts', unit='s', gt=0.0)
+    pump_min_speed_mps: float = parameter(
+        0.2,
+        'a burst starts only at this forward speed or faster (0: plain clock)',
+        unit='m/s',
+        ge=0.0,
+    )
+    bearing_timeout_s: float = parameter(
+        1.0, 'bearings older than this are unused', unit='s', ge=0.0
+    )
     seed: int = 0
-    perception: PerceptionConfig = field(default_factory=PerceptionConfig)
-    motion: MotionConfig = field(default_factory=MotionConfig)
+    perception: PerceptionConfig = section(PerceptionConfig, prefix='')
+    motion: MotionConfig = section(MotionConfig, prefix='')
 
     def __post_init__(self) -> None:
         _require(self.robot_count >= 1, f'robot_count must be >= 1, got {self.robot_count}')

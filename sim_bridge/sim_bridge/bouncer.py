@@ -9,17 +9,31 @@ a robot move), not to search.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+from swarm_common.params import ParameterSpec, parameter
 from swarm_runtime.node_main import run_node
+from swarm_runtime.parameters import declare_config
 from swarm_runtime.ros import Node, message_module, qos_profile_sensor_data
 
-__all__ = ['WallBouncer', 'main']
+__all__ = ['BOUNCER_PARAMETERS', 'BouncerConfig', 'WallBouncer', 'main']
 
 _geometry = message_module('geometry_msgs')
 _sensor = message_module('sensor_msgs')
-_rcl = message_module('rcl_interfaces')
+
+
+@dataclass(frozen=True)
+class BouncerConfig:
+    """The bouncer's parameters."""
+
+    speed_mps: float = parameter(0.3, 'speed', unit='m/s', ge=0.0)
+    turn_rate_radps: float = parameter(1.2, 'turn rate', unit='rad/s')
+    clearance_m: float = parameter(0.45, 'turn when closer ahead', unit='m', ge=0.0)
+
+
+BOUNCER_PARAMETERS = ParameterSpec(BouncerConfig)
 
 
 class WallBouncer(Node):
@@ -27,20 +41,10 @@ class WallBouncer(Node):
 
     def __init__(self, **kwargs: Any) -> None:
         super().__init__('bouncer', **kwargs)
-        describe = _rcl.ParameterDescriptor
-        self._speed = float(
-            self.declare_parameter('speed_mps', 0.3, describe(description='Speed [m/s].')).value
-        )
-        self._turn = float(
-            self.declare_parameter(
-                'turn_rate_radps', 1.2, describe(description='Turn rate [rad/s].')
-            ).value
-        )
-        self._clearance = float(
-            self.declare_parameter(
-                'clearance_m', 0.45, describe(description='Turn when closer ahead [m].')
-            ).value
-        )
+        config = declare_config(self, BOUNCER_PARAMETERS).config
+        self._speed = config.speed_mps
+        self._turn = config.turn_rate_radps
+        self._clearance = config.clearance_m
         self._pub = self.create_publisher(_geometry.Twist, 'cmd_vel', 10)
         self.create_subscription(_sensor.LaserScan, 'scan', self._on_scan, qos_profile_sensor_data)
 
@@ -58,7 +62,7 @@ class WallBouncer(Node):
 
 def main(args: list[str] | None = None) -> int:
     """Entry point: ``python -m sim_bridge.bouncer --ros-args -r __ns:=/r0``."""
-    return run_node(WallBouncer, args, name='bouncer')
+    return run_node(WallBouncer, args, name='bouncer', parameters=BOUNCER_PARAMETERS)
 
 
 if __name__ == '__main__':

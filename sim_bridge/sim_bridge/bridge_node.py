@@ -6,6 +6,8 @@ Per robot ``<name>`` (r0, r1, ...) it publishes ``/<name>/scan``, ``gas``, ``bea
 swarm-wide it publishes ``/clock`` and the ground truth ``/sim/poses``, ``/sim/coverage``
 (and ``/sim/site`` when the site model can be converted). With ``peer_msg_type`` set it
 relays ``/<name>/peers/out`` to the other robots' ``peers/in`` within ``comm_range_m``.
+For viewers it publishes the REP 105 transform tree on ``/tf`` and ``/tf_static`` and the
+site, rooms, robots and paths as ``/sim/markers/...`` (:mod:`sim_bridge.visualization`).
 
 The node holds no simulation logic: :class:`swarm_sim.engine.SimEngine` does the work and
 :mod:`sim_bridge.conversions` builds the messages. It steps the engine on a wall timer of one
@@ -25,6 +27,7 @@ from typing import Any
 
 import numpy as np
 from swarm_runtime.node_main import run_node
+from swarm_runtime.parameters import declare_config
 from swarm_runtime.ros import (
     Node,
     QoSDurabilityPolicy,
@@ -32,19 +35,19 @@ from swarm_runtime.ros import (
     message_module,
     qos_profile_sensor_data,
 )
-from swarm_sim.departure import departure_poses
+from swarm_sim.departure import place_starts
 from swarm_sim.engine import EngineConfig, SimEngine, SiteGeometry, StepOutput
 from swarm_sim.errors import ConfigurationError, SimulationError
 from swarm_sim.peer_relay import RelayConfig, RelayModel, parse_message_type
 from swarm_sim.site_geometry import geometry_from_site
 
 from sim_bridge import conversions
-from sim_bridge.bridge_parameters import ENGINE_PARAMETERS, config_from_values, values_from_config
+from sim_bridge.bridge_parameters import BRIDGE_PARAMETERS, NODE_NAME, BridgeNodeConfig
 from sim_bridge.extensions import RobotStates, SimExtension
+from sim_bridge.visualization import BridgeVisualization
 
 __all__ = ['SimBridgeNode', 'main']
 
-_rcl = message_module('rcl_interfaces')
 _geometry = message_module('geometry_msgs')
 _std = message_module('std_msgs')
 _sensor = message_module('sensor_msgs')
@@ -53,10 +56,6 @@ _rosgraph = message_module('rosgraph_msgs')
 _swarm = message_module('swarm_interfaces')
 
 _LATCHED = QoSProfile(depth=1, durability=QoSDurabilityPolicy.TRANSIENT_LOCAL)
-
-
-def _descriptor(description: str) -> Any:
-    return _rcl.ParameterDescriptor(description=description)
 
 
 class SimBridgeNode(Node):
@@ -82,28 +81,11 @@ class SimBridgeNode(Node):
             extensions: mission-specific world parts, attached in order.
             node_kwargs: passed to rclpy's Node (namespace, parameter_overrides, ...).
         """
-        super().__init__('sim_bridge', **node_kwargs)
-        base = engine_config or EngineConfig()
-        for spec in ENGINE_PARAMETERS:
-            default = values_from_config(base)[spec.name]
-            self.declare_parameter(spec.name, default, _descriptor(spec.description))
-        declare = self.declare_parameter
-        declare('robot_count', 1, _descriptor('Robots r0..r{n-1} (ignored with start poses).'))
-        declare(
-            'site_file',
-            '',
-            _descriptor('Site when none is given: small/medium/big (seeded), .lay or site file.'),
-        )
-        declare('departure', 'center', _descriptor("Departure point of the site: 'center'/'edge'."))
-        declare('heading_bias_rad', 0.0, _descriptor('Common bias of the departure fan [rad].'))
-        declare('real_time_factor', 1.0, _descriptor('Sim seconds per wall second (wall timer).'))
-        declare('peer_msg_type', '', _descriptor("Peer message type to relay; '' = no relay."))
-        declare('comm_range_m', math.inf, _descriptor('Peer relay range [m]; inf = unlimited.'))
-        declare('peer_loss_probability', 0.0, _descriptor('Chance one relayed message is lost.'))
-        declare('coverage_rate_hz', 1.0, _descriptor('Rate of periodic /sim/coverage [Hz].'))
-
-        values = {s.name: self.get_parameter(s.name).value for s in ENGINE_PARAMETERS}
-        self.config = config_from_values(values, base)
+        super().__init__(NODE_NAME, **node_kwargs)
+        base = BridgeNodeConfig(engine=engine_config or EngineConfig())
+        self._declared = declare_config(self, BRIDGE_PARAMETERS, base=base, on_change=self._retime)
+        self.settings: BridgeNodeConfig = self._declared.config
+        self.config = self.settings.engine
         self._site_model = site if site is not None and not isinstance(site, SiteGeometry) else None
         geometry = self._resolve_site(site)
         poses = self._resolve_poses(initial_poses)
@@ -144,19 +126,15 @@ class SimBridgeNode(Node):
             self.create_subscription(_std.Bool, f'/{name}/pump', self._make_pump_callback(i), 10)
         self._publish_site()
         self._relay = self._setup_relay()
+        self._visualization = self._setup_visualization()
 
         self.extensions = tuple(extensions)
         for ext in self.extensions:
             ext.attach(self, self.robot_names)
 
-        rtf = float(self.get_parameter('real_time_factor').value)
-        if not (math.isfinite(rtf) and rtf > 0.0):
-            msg = f'real_time_factor must be positive, got {rtf}'
-            raise ConfigurationError(msg)
-        coverage_rate = float(self.get_parameter('coverage_rate_hz').value)
-        if not coverage_rate > 0.0:
-            raise ConfigurationError('coverage_rate_hz must be positive')
+        coverage_rate = self.settings.coverage_rate_hz
         self._coverage_every = max(1, round(self.config.physics_rate_hz / coverage_rate))
+        rtf = self.settings.real_time_factor
         self._timer = self.create_timer(self.config.physics_period_s / rtf, self._on_tick)
         self._publish_coverage()
         self.get_logger().info(
@@ -165,19 +143,27 @@ class SimBridgeNode(Node):
             f'physics {self.config.physics_rate_hz:g} Hz, seed {self.config.seed}'
         )
 
+    def _retime(self, settings: BridgeNodeConfig) -> None:
+        """Apply an accepted parameter change (only ``real_time_factor`` may change)."""
+        self.settings = settings
+        period_s = self.config.physics_period_s / settings.real_time_factor
+        self._timer.timer_period_ns = round(period_s * 1e9)
+
     # Set-up helpers -------------------------------------------------------------------
 
     def _resolve_site(self, site: Any) -> SiteGeometry:
         if isinstance(site, SiteGeometry):
             return site
         if site is None:
-            path = str(self.get_parameter('site_file').value)
+            path = self.settings.site_file
             if not path:
                 raise ConfigurationError('no site given: set the site_file parameter')
             from swarm_sim.site_loading import load_site
 
             site = load_site(path, seed=self.config.seed)
             self._site_model = site
+        for warning in getattr(site, 'warnings', ()):
+            self.get_logger().warning(f'site: {warning}')
         return geometry_from_site(site)
 
     def _resolve_poses(self, initial_poses: np.ndarray | None) -> np.ndarray:
@@ -185,11 +171,16 @@ class SimBridgeNode(Node):
             return np.asarray(initial_poses, dtype=float)
         if self._site_model is None:
             raise ConfigurationError('initial_poses are required when the site is a geometry')
-        count = int(self.get_parameter('robot_count').value)
-        name = str(self.get_parameter('departure').value)
-        point = self._site_model.departure(name)
-        bias = float(self.get_parameter('heading_bias_rad').value)
-        return departure_poses(point.xy, name, count, bias)
+        count = self.settings.robot_count
+        name = self.settings.departure
+        bias = self.settings.heading_bias_rad
+        starts = place_starts(self._site_model, name, count, bias_rad=bias, body=self.config.body)
+        if starts.moved:
+            self.get_logger().info(
+                f'{len(starts.moved)} of {count} starts moved off the nominal fan into free '
+                f'space (at most {float(starts.moved_by_m.max()):.3f} m)'
+            )
+        return starts.poses
 
     def _publish_site(self) -> None:
         if self._site_model is None:
@@ -203,11 +194,21 @@ class SimBridgeNode(Node):
         self._site_pub = self.create_publisher(type(msg), '/sim/site', _LATCHED)
         self._site_pub.publish(msg)
 
+    def _setup_visualization(self) -> BridgeVisualization:
+        return BridgeVisualization(
+            self,
+            self.engine,
+            self.robot_names,
+            self._site_model,
+            tf_rate_hz=self.settings.tf_rate_hz,
+            path_rate_hz=self.settings.path_rate_hz,
+        )
+
     def _setup_relay(self) -> RelayModel | None:
         config = RelayConfig(
-            msg_type=str(self.get_parameter('peer_msg_type').value),
-            comm_range_m=float(self.get_parameter('comm_range_m').value),
-            loss_probability=float(self.get_parameter('peer_loss_probability').value),
+            msg_type=self.settings.peer_msg_type,
+            comm_range_m=self.settings.comm_range_m,
+            loss_probability=self.settings.peer_loss_probability,
         )
         if not config.enabled:
             return None
@@ -302,6 +303,7 @@ class SimBridgeNode(Node):
                             poses[i], twists[i], t, f'{name}/odom', f'{name}/base_link'
                         )
                     )
+        self._visualization.on_step(out)
         if out.ground_truth_due:
             self._poses_pub.publish(conversions.true_poses_to_ros(names, out.poses, t))
         if out.new_room_entries or self.engine.step_index % self._coverage_every == 0:
@@ -338,7 +340,13 @@ class SimBridgeNode(Node):
 
 def main(args: list[str] | None = None) -> int:
     """Entry point of ``ros2 run sim_bridge sim_bridge``."""
-    return run_node(SimBridgeNode, args, name='sim_bridge', fatal_errors=(SimulationError,))
+    return run_node(
+        SimBridgeNode,
+        args,
+        name=NODE_NAME,
+        fatal_errors=(SimulationError,),
+        parameters=BRIDGE_PARAMETERS,
+    )
 
 
 if __name__ == '__main__':

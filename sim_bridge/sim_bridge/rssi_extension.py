@@ -10,7 +10,10 @@ physics step:
   (swarm_interfaces/RssiArray, sensor QoS): one noisy sample of every detectable,
   uncaptured target;
 * every ``status_period_s`` and at each capture publishes ``/sim/targets``
-  (swarm_interfaces/RssiTargetArray), the ground truth the algorithm nodes never read.
+  (swarm_interfaces/RssiTargetArray), the ground truth the algorithm nodes never read;
+* at the start and at each capture latches ``/sim/markers/targets`` (visualization_msgs/
+  MarkerArray, :mod:`sim_bridge.markers`): every target with its work area D_th, orange
+  until captured, then green.
 
 The mission is done one physics step after the step that captured the last target, so the
 final ``/sim/targets`` message reaches subscribers (e.g. a bag recorder) before the run stops.
@@ -26,11 +29,14 @@ from swarm_common.stamps import stamp_from_seconds
 from swarm_runtime.ros import message_module, qos_profile_sensor_data
 from swarm_sim.rssi_targets import Capture, RssiTargetField
 
+from sim_bridge import markers
 from sim_bridge.extensions import RobotStates
 
 __all__ = ['RssiExtension']
 
 _EPS_T = 1e-9
+_OPEN_RGBA = (0.95, 0.45, 0.1, 1.0)
+_CAPTURED_RGBA = (0.2, 0.7, 0.2, 1.0)
 
 
 class RssiExtension:
@@ -61,6 +67,7 @@ class RssiExtension:
         self._rssi_pubs: list[Any] = []
         self._captured_pubs: list[Any] = []
         self._targets_pub: Any = None
+        self._markers_pub: Any = None
         self._swarm = message_module('swarm_interfaces')
         self._builtin = message_module('builtin_interfaces')
 
@@ -76,6 +83,15 @@ class RssiExtension:
             node.create_publisher(swarm.CapturedTargets, f'/{n}/captured', 10) for n in robot_names
         ]
         self._targets_pub = node.create_publisher(swarm.RssiTargetArray, '/sim/targets', 10)
+        try:
+            marker_class = message_module('visualization_msgs').MarkerArray
+        except (ImportError, AttributeError, LookupError):
+            self._markers_pub = None  # the bridge has logged that markers are off
+        else:
+            self._markers_pub = node.create_publisher(
+                marker_class, markers.TARGETS_TOPIC, markers.marker_qos()
+            )
+            self._markers_pub.publish(self.targets_markers(0.0))
 
     def _stamp(self, time_s: float) -> Any:
         return stamp_from_seconds(time_s, self._builtin.Time)
@@ -90,6 +106,8 @@ class RssiExtension:
         if dt > 0.0:
             speeds = np.abs(np.asarray(states.velocities, dtype=float)[:, 0])
             captures = self.targets.work(positions, speeds, dt, sim_time_s)
+        if captures and self._markers_pub is not None:
+            self._markers_pub.publish(self.targets_markers(sim_time_s))
         for capture in captures:
             self.captures.append(capture)
             msg = self._swarm.CapturedTargets(target_ids=[capture.target_id])
@@ -138,6 +156,23 @@ class RssiExtension:
         times = field.capture_time_s
         msg.capture_completion_time_s = float(np.max(times)) if field.all_captured else math.nan
         return msg
+
+    def targets_markers(self, time_s: float) -> Any:
+        """The /sim/markers/targets MarkerArray at ``time_s``: one sphere per target, orange
+        until captured, then green, with its work area (D_th) and its ID."""
+        field = self.targets
+        config = field.config
+        unit = max(config.field_size_m / 150.0, 0.01)
+        colours = [_CAPTURED_RGBA if c else _OPEN_RGBA for c in field.captured]
+        return markers.target_markers(
+            field.positions_m,
+            1.5 * unit,
+            colours,
+            [f'T{i}' for i in range(config.n_targets)],
+            unit,
+            time_s,
+            area_radius_m=config.task_area_m,
+        )
 
     def is_done(self) -> bool:
         """True one step after every target was captured and reported."""

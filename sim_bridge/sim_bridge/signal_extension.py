@@ -4,7 +4,9 @@ The ROS-free model is :class:`swarm_sim.signal_mission.SignalMissionModel` (samp
 observation clock, noise, continuous detection, tau). The adapter :class:`SignalExtension`
 publishes, per robot, ``/<name>/signal`` (swarm_interfaces/SignalSample, sensor QoS) and,
 for the bag, ``/sim/source_search`` (swarm_interfaces/SourceSearchStatus, ground truth the
-algorithm nodes never read).
+algorithm nodes never read) and ``/sim/markers/targets`` (visualization_msgs/MarkerArray,
+latched, :mod:`sim_bridge.markers`): the source with its detection radius, red until a robot
+finds it, then green; sent at the start and when the source is found.
 """
 
 from __future__ import annotations
@@ -16,12 +18,15 @@ from swarm_common.stamps import stamp_from_seconds
 from swarm_runtime.ros import message_module, qos_profile_sensor_data
 from swarm_sim.signal_mission import SignalMissionModel
 
+from sim_bridge import markers
 from sim_bridge.extensions import RobotStates
 
 __all__ = ['SignalExtension']
 
 _STATUS_PERIOD_S = 1.0
 _EPS_T = 1e-9
+_SOURCE_RGBA = (0.85, 0.15, 0.15, 1.0)
+_FOUND_RGBA = (0.2, 0.7, 0.2, 1.0)
 
 
 class SignalExtension:
@@ -41,6 +46,8 @@ class SignalExtension:
         self._names: tuple[str, ...] = ()
         self._next_status_s = 0.0
         self._final_sent = False
+        self._markers_pub: Any = None
+        self._found_shown = False
         self._swarm = message_module('swarm_interfaces')
         self._builtin = message_module('builtin_interfaces')
 
@@ -53,6 +60,15 @@ class SignalExtension:
         self._status_pub = node.create_publisher(
             self._swarm.SourceSearchStatus, '/sim/source_search', 10
         )
+        try:
+            marker_class = message_module('visualization_msgs').MarkerArray
+        except (ImportError, AttributeError, LookupError):
+            self._markers_pub = None  # the bridge has logged that markers are off
+        else:
+            self._markers_pub = node.create_publisher(
+                marker_class, markers.TARGETS_TOPIC, markers.marker_qos()
+            )
+            self._markers_pub.publish(self.source_markers(0.0))
 
     def _stamp(self, time_s: float) -> Any:
         return stamp_from_seconds(time_s, self._builtin.Time)
@@ -70,6 +86,9 @@ class SignalExtension:
                 msg.header.frame_id = f'{self._names[i]}/base_link'
                 msg.value = float(value)
                 pub.publish(msg)
+        if self.model.found and not self._found_shown and self._markers_pub is not None:
+            self._found_shown = True
+            self._markers_pub.publish(self.source_markers(sim_time_s))
         if self.model.done or sim_time_s + _EPS_T >= self._next_status_s:
             self._status_pub.publish(self.status_message(sim_time_s))
             self._next_status_s = sim_time_s + _STATUS_PERIOD_S
@@ -99,6 +118,23 @@ class SignalExtension:
         msg.tau = float(m.tau())
         msg.done = m.done
         return msg
+
+    def source_markers(self, time_s: float) -> Any:
+        """The /sim/markers/targets MarkerArray at ``time_s``: the source, red until found,
+        then green, with its detection radius."""
+        case = self.model.case
+        x0, x1, y0, y1 = case.arena_m
+        unit = max(max(x1 - x0, y1 - y0) / 150.0, 0.01)
+        colour = _FOUND_RGBA if self.model.found else _SOURCE_RGBA
+        return markers.target_markers(
+            np.asarray(case.source_m, dtype=float).reshape(1, 2),
+            1.5 * unit,
+            [colour],
+            ['source'],
+            unit,
+            time_s,
+            area_radius_m=float(case.detection_radius_m),
+        )
 
     def is_done(self) -> bool:
         return self._end_time_s is not None and self._time_s >= self._end_time_s + self.linger_s

@@ -4,7 +4,7 @@ import math
 
 import numpy as np
 import pytest
-from sim_bridge.bridge_parameters import ENGINE_PARAMETERS, config_from_values, values_from_config
+from sim_bridge.bridge_parameters import BRIDGE_PARAMETERS, BridgeNodeConfig, config_from_values
 from swarm_sim.departure import departure_poses, preferred_directions
 from swarm_sim.engine import EngineConfig
 from swarm_sim.errors import ConfigurationError
@@ -38,9 +38,11 @@ def test_message_types_are_parsed_or_rejected():
 
 
 def test_every_parameter_round_trips_through_the_engine_config():
-    values = values_from_config(EngineConfig())
-    assert set(values) == {p.name for p in ENGINE_PARAMETERS}
-    assert config_from_values(values) == EngineConfig()
+    changed = EngineConfig(seed=3, physics_rate_hz=20.0)
+    values = BRIDGE_PARAMETERS.values_of(BridgeNodeConfig(engine=changed))
+    assert values['seed'] == 3
+    assert values['physics_rate_hz'] == 20.0
+    assert config_from_values(values) == changed
 
 
 def test_parameter_values_reach_the_nested_config():
@@ -52,11 +54,14 @@ def test_parameter_values_reach_the_nested_config():
 
 
 def test_bad_parameter_values_are_rejected_with_the_parameter_name():
-    with pytest.raises(ConfigurationError, match='unknown bridge parameters: bogus'):
+    with pytest.raises(ConfigurationError, match="unknown parameter 'bogus'"):
         config_from_values({'bogus': 1.0})
-    with pytest.raises(ConfigurationError, match='scan_rate_hz must be of type float'):
+    with pytest.raises(
+        ConfigurationError,
+        match='scan_rate_hz: expected a floating-point number',
+    ):
         config_from_values({'scan_rate_hz': 'fast'})
-    with pytest.raises(ConfigurationError, match='rate_hz must be positive'):
+    with pytest.raises(ConfigurationError, match='scan_rate_hz: must be > 0 Hz'):
         config_from_values({'scan_rate_hz': -1.0})
 
 

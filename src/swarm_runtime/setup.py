@@ -24,7 +24,7 @@ setup(
         (f'share/{PACKAGE_NAME}', ['package.xml']),
         *share_files('config'),
     ],
-    install_requires=['numpy', 'PyYAML', 'rosbags', 'mcap'],
+    install_requires=['numpy', 'PyYAML', 'rosbags', 'mcap', 'swarm_common'],
     zip_safe=True,
     maintainer='Swarm search maintainers',
     maintainer_email='maintainers@swarm-search.org',

@@ -44,6 +44,7 @@ from swarm_sim.ground_truth import RoomEntry
 from swarm_experiments.errors import MissionError
 
 __all__ = [
+    'VIEWER_TOPICS',
     'MissionProgress',
     'MissionResult',
     'MissionSpec',
@@ -54,6 +55,10 @@ __all__ = [
 ]
 
 NodeFactory = Callable[..., Any]
+
+#: What Foxglove and RViz need to show a recorded run: the transform tree and the site's
+#: markers (sim_bridge.visualization). Every spawner records them by default.
+VIEWER_TOPICS = ('/tf', '/tf_static', '/sim/markers/*')
 
 # Callbacks run per node after the stop, to deliver the messages of the last step.
 _DRAIN_CALLBACKS_PER_NODE = 20
@@ -89,14 +94,15 @@ class RecordingSpec:
     Attributes:
         path: the bag directory to create; it must not exist yet.
         topics: absolute topic names to record; None records every topic.
-        latched_topics: topics published once with transient-local durability (the site,
-            the coverage): the recorder subscribes to them transient-local so it gets the
-            message published before it started.
+        latched_topics: topics (names or patterns) published with transient-local durability
+            (the site, the coverage, the static transforms, the markers): the recorder
+            subscribes to them transient-local so it gets what was published before it
+            started.
     """
 
     path: Path
     topics: tuple[str, ...] | None = None
-    latched_topics: tuple[str, ...] = ('/sim/site', '/sim/coverage')
+    latched_topics: tuple[str, ...] = ('/sim/site', '/sim/coverage', '/tf_static', '/sim/markers/*')
 
 
 @dataclass(frozen=True)

@@ -5,7 +5,7 @@ The ROS path (:func:`swarm_experiments.mission.run_mission`) runs the sim bridge
 travels as a message. This module drives the very same parts directly: the
 :class:`swarm_sim.engine.SimEngine` and, per robot, the node's own controller
 (:class:`oabug_robot.fsm.OABugFsm`) and scan feature extractor, built from the same node
-parameters by :func:`oabug_robot.node.config_from_parameters`. It reproduces what the
+parameters by :data:`oabug_robot.node_settings.OABUG_PARAMETERS`. It reproduces what the
 messages and the executor do to the data, so a batch run's trajectories and first room
 entries equal the ROS path's (tested):
 
@@ -42,11 +42,12 @@ from typing import Any
 import numpy as np
 from oabug_robot.errors import ScanError
 from oabug_robot.fsm import Command, OABugFsm, SensorSnapshot
-from oabug_robot.node import PARAMETERS, config_from_parameters
+from oabug_robot.node_settings import OABUG_PARAMETERS
 from oabug_robot.scan_features import LaserScanData, ScanFeatureExtractor, ScanFeatures
 from oabug_robot.scan_features_kernel import extract_many_flat
 from oabug_robot.sound import PeerBearings
 from swarm_common.angles import yaw_from_quaternion, yaw_to_quaternion
+from swarm_common.params import ParameterError
 from swarm_common.stamps import NS_PER_S, seconds_to_ns
 from swarm_runtime.builtin._messages import cdr_roundtrip_enabled
 from swarm_sim.engine import EngineConfig, SimEngine, SiteGeometry
@@ -88,23 +89,23 @@ class BatchRobot:
 
         Raises:
             oabug_robot.errors.ConfigError: a parameter value is invalid.
+            ConfigurationError: a name that is not an OA-Bug node parameter.
         """
-        values = {name: default for name, default, _ in PARAMETERS}
-        unknown = set(parameters) - set(values) - {'use_sim_time'}
-        if unknown:
-            msg = f'unknown OA-Bug parameters: {", ".join(sorted(unknown))}'
-            raise ConfigurationError(msg)
-        values.update({k: v for k, v in parameters.items() if k != 'use_sim_time'})
-        self.config = config_from_parameters(values)
-        rate_hz = float(values['control_rate_hz'])
-        self.stale_timeout_s = float(values['stale_timeout_s'])
-        if not (math.isfinite(rate_hz) and rate_hz > 0.0):
-            msg = f'control_rate_hz must be > 0, got {rate_hz}'
-            raise ConfigurationError(msg)
+        try:
+            settings = OABUG_PARAMETERS.build(
+                {k: v for k, v in parameters.items() if k != 'use_sim_time'}
+            )
+        except ParameterError as err:
+            if err.unknown:
+                raise ConfigurationError(str(err)) from err
+            raise
+        self.config = settings.controller_config()
+        rate_hz = settings.control_rate_hz
+        self.stale_timeout_s = settings.stale_timeout_s
         # The node's timer: period in whole nanoseconds, first deadline one period in.
         self.control_period_ns = int(1.0 / rate_hz * NS_PER_S)
         self.next_control_ns = self.control_period_ns
-        self.own_tag = str(values['own_tag_id']).strip().upper()
+        self.own_tag = settings.own_tag_id.strip().upper()
         self.fsm = OABugFsm(self.config)
         # Robots of one group have equal perception settings (set by the batch runner).
         self.perception_group = 0

@@ -26,13 +26,14 @@ from pathlib import Path
 import numpy as np
 from swarm_common.cli import EXIT_SUCCESS, fail
 from swarm_common.errors import SwarmError
-from swarm_sim.departure import departure_poses
+from swarm_sim.departure import place_starts
 from swarm_sim.engine import EngineConfig
 from swarm_sim.errors import ConfigurationError
 from swarm_sim.site_loading import load_site, site_budget_actions
 
 from swarm_experiments.errors import ExperimentError
 from swarm_experiments.mission import (
+    VIEWER_TOPICS,
     MissionProgress,
     MissionResult,
     MissionSpec,
@@ -56,7 +57,7 @@ __all__ = [
 VARIANTS = ('random', 'minimum', 'sound', 'gas', 'gas_sound')
 ACTION_LENGTH_M = 0.1
 DEFAULT_ACTIONS = 1000
-DEFAULT_RECORD_TOPICS = ('/clock', '/sim/poses', '/sim/coverage', '/sim/site')
+DEFAULT_RECORD_TOPICS = ('/clock', '/sim/poses', '/sim/coverage', '/sim/site', *VIEWER_TOPICS)
 # OA-Bug node parameters the spawner sets from its own options (see build_mission).
 SPAWNER_PARAMETERS = (
     'variant',
@@ -88,6 +89,8 @@ class SpawnSettings:
         speed_mps: the robots' cruise speed [m/s].
         record: bag directory to write, or None.
         record_robot_topics: also record each robot's state, cmd_vel and pump topics.
+        record_scans: also record each robot's lidar scans (``/r<i>/scan``, about 8 kB/s
+            per robot; off by default, the viewers' scan displays show them when present).
         out_dir: directory for the PNGs, or None for no plots.
         robot_parameters: extra OA-Bug node parameters for every robot.
         engine: world configuration (its seed is replaced by ``seed``).
@@ -103,6 +106,7 @@ class SpawnSettings:
     speed_mps: float = 0.3
     record: Path | None = None
     record_robot_topics: bool = True
+    record_scans: bool = False
     out_dir: Path | None = None
     robot_parameters: dict[str, object] = field(default_factory=dict)
     engine: EngineConfig = field(default_factory=EngineConfig)
@@ -158,14 +162,6 @@ class OABugRun:
         return self.mission.coverage
 
 
-def heading_bias_rad(departure: str, into_site_rad: float | None, seed: int) -> float:
-    """The fan's bias: random for a centre start; for an edge start, inward minus 90 deg."""
-    if departure == 'edge' and into_site_rad is not None:
-        return float(into_site_rad) - 0.5 * math.pi
-    rng = np.random.default_rng(np.random.SeedSequence([seed, 0xB1A5]))
-    return float(rng.uniform(-math.pi, math.pi))
-
-
 def oabug_parameter_overrides(items: Sequence[str]) -> dict[str, object]:
     """OA-Bug node parameters from ``NAME=VALUE`` items, typed and checked before a run.
 
@@ -178,14 +174,11 @@ def oabug_parameter_overrides(items: Sequence[str]) -> dict[str, object]:
         ExperimentError: the OA-Bug package cannot be imported.
     """
     try:
-        from oabug_robot.node import PARAMETERS, config_from_parameters
+        from oabug_robot.node_settings import OABUG_PARAMETERS
     except ImportError as err:
         msg = f'the OA-Bug node (package oabug_robot) cannot be imported: {err}'
         raise ExperimentError(msg) from err
-    declared = {name: default for name, default, _ in PARAMETERS}
-    return parse_overrides(
-        items, declared, reserved=SPAWNER_PARAMETERS, check=config_from_parameters
-    )
+    return parse_overrides(items, OABUG_PARAMETERS, reserved=SPAWNER_PARAMETERS)
 
 
 def _oabug_factory() -> Callable[..., object]:
@@ -200,13 +193,10 @@ def _oabug_factory() -> Callable[..., object]:
 def build_mission(config: SpawnSettings) -> tuple[MissionSpec, float]:
     """The mission spec of ``config`` and the heading bias it uses."""
     site = load_site(config.site, seed=config.site_seed)
-    try:
-        point = site.departure(config.departure)
-    except Exception as err:
-        raise ConfigurationError(str(err)) from err
-    fan = 'edge' if point.heading_rad is not None else 'center'
-    bias = heading_bias_rad(fan, point.heading_rad, config.seed)
-    poses = departure_poses(point.xy, fan, config.robots, bias)
+    starts = place_starts(
+        site, config.departure, config.robots, seed=config.seed, body=config.engine.body
+    )
+    fan, bias, poses = starts.fan, starts.bias_rad, starts.poses
     factory = _oabug_factory()
     robots = []
     for i in range(config.robots):
@@ -228,6 +218,8 @@ def build_mission(config: SpawnSettings) -> tuple[MissionSpec, float]:
         if config.record_robot_topics:
             for i in range(config.robots):
                 topics += [f'/r{i}/state', f'/r{i}/cmd_vel', f'/r{i}/pump']
+        if config.record_scans:
+            topics += [f'/r{i}/scan' for i in range(config.robots)]
         recording = RecordingSpec(Path(config.record), tuple(topics))
     engine = dataclasses.replace(config.engine, seed=int(config.seed))
     spec = MissionSpec(
@@ -338,6 +330,9 @@ def _parser() -> argparse.ArgumentParser:
     parser.add_argument('--speed', type=float, default=0.3, help='robot cruise speed [m/s]')
     parser.add_argument('--record', type=Path, default=None, help='write a rosbag2 bag here')
     parser.add_argument(
+        '--record-scans', action='store_true', help="also record the robots' lidar scans"
+    )
+    parser.add_argument(
         '--out', type=Path, default=Path('oabug_results'), help='directory for the PNGs'
     )
     parser.add_argument('--no-plots', action='store_true', help='do not write PNGs')
@@ -368,10 +363,14 @@ def main(argv: Sequence[str] | None = None) -> int:
             actions=args.actions,
             speed_mps=args.speed,
             record=args.record,
+            record_scans=args.record_scans,
             out_dir=None if args.no_plots else args.out,
         )
+        site_warnings = load_site(config.site, seed=config.site_seed).warnings
     except SwarmError as err:
         return fail('spawn', err)
+    for warning in site_warnings:
+        print(f'spawn: warning: {warning}', file=sys.stderr, flush=True)
 
     def show(p: MissionProgress) -> None:
         print(

@@ -39,7 +39,13 @@ from swarm_experiments.bayes_batch import MissionSpec as BatchMissionSpec
 from swarm_experiments.bayes_batch import depot_fan
 from swarm_experiments.cli_args import points_argument
 from swarm_experiments.errors import ExperimentError
-from swarm_experiments.mission import MissionSpec, RecordingSpec, RobotNodeSpec, run_mission
+from swarm_experiments.mission import (
+    VIEWER_TOPICS,
+    MissionSpec,
+    RecordingSpec,
+    RobotNodeSpec,
+    run_mission,
+)
 from swarm_experiments.node_overrides import parse_overrides
 from swarm_experiments.open_field import point_robot_engine_config
 
@@ -71,6 +77,7 @@ DEFAULT_RECORD_TOPICS = (
     '/sim/source_search',
     '/r*/state',
     '/r*/peers/out',
+    *VIEWER_TOPICS,
 )
 GLOWWORM_RATE_HZ = 100.0
 
@@ -198,10 +205,9 @@ def node_parameter_overrides(items: Sequence[str]) -> dict[str, Any]:
             ``--noise``, ``--outer-optimizer``), a value of the wrong type, or one the node
             rejects.
     """
-    from bayes_swarm.node_settings import PARAMETERS, settings_from_values
+    from bayes_swarm.node_settings import BAYES_SWARM_PARAMETERS
 
-    declared = {spec.name: spec.default for spec in PARAMETERS}
-    return parse_overrides(items, declared, reserved=SPAWNER_PARAMETERS, check=settings_from_values)
+    return parse_overrides(items, BAYES_SWARM_PARAMETERS, reserved=SPAWNER_PARAMETERS)
 
 
 def node_parameters(case: SignalCase, settings: SpawnSettings, n: int, i: int) -> dict[str, Any]:

@@ -38,6 +38,7 @@ from swarm_sim.rssi_targets import RssiTargetConfig, RssiTargetField, place_robo
 from swarm_experiments.cli_args import points_argument
 from swarm_experiments.errors import ExperimentError
 from swarm_experiments.mission import (
+    VIEWER_TOPICS,
     MissionProgress,
     MissionSpec,
     RecordingSpec,
@@ -54,7 +55,14 @@ SPAWNER_PARAMETERS = ('scheme', 'seed', 'robot_id', 'field_size_m', 'swarm.comm_
 
 SCHEMES = ('proposed', 'msc_pf', 'msc')
 PEER_TYPE = 'swarm_interfaces/msg/MscPeer'
-DEFAULT_RECORD_TOPICS = ('/clock', '/sim/poses', '/sim/targets', '/r*/state', '/r*/peers/out')
+DEFAULT_RECORD_TOPICS = (
+    '/clock',
+    '/sim/poses',
+    '/sim/targets',
+    '/r*/state',
+    '/r*/peers/out',
+    *VIEWER_TOPICS,
+)
 
 
 @dataclass(frozen=True)
@@ -153,11 +161,9 @@ def controller_parameter_overrides(items: Sequence[str]) -> dict[str, Any]:
         ConfigurationError: a malformed item, an unknown or spawner-set name, a value of the
             wrong type, or one the controller rejects.
     """
-    from msc_pf.parameters import config_from_parameters, parameter_defaults
+    from msc_pf.parameters import MSC_PF_PARAMETERS
 
-    return parse_overrides(
-        items, parameter_defaults(), reserved=SPAWNER_PARAMETERS, check=config_from_parameters
-    )
+    return parse_overrides(items, MSC_PF_PARAMETERS, reserved=SPAWNER_PARAMETERS)
 
 
 def node_parameters(settings: SpawnSettings, index: int) -> dict[str, Any]:

@@ -161,3 +161,21 @@ def test_a_bearing_cycle_is_held_as_each_robots_report_would_be(float32_fields):
             a, b = got.peer_bearings(1.5), want.peer_bearings(1.5)
             assert a[0].tobytes() == b[0].tobytes()
             assert a[1].tobytes() == b[1].tobytes()
+
+
+def test_the_spawner_starts_robots_in_free_space_on_a_seeded_fan():
+    from swarm_sim.departure import place_starts
+    from swarm_sim.site_loading import load_site
+
+    site = load_site('small')
+    for seed in (0, 1):
+        config = SpawnSettings(site='small', robots=10, departure='edge', seed=seed)
+        spec, bias = build_mission(config)
+        starts = place_starts(site, 'edge', 10, seed=seed, body=config.engine.body)
+        np.testing.assert_array_equal(spec.initial_poses, starts.poses)
+        assert bias == starts.bias_rad
+        headings = [float(r.parameters['heading_bias_deg']) for r in spec.robots]
+        assert headings == [math.degrees(bias)] * 10
+    first, _ = build_mission(SpawnSettings(site='small', robots=10, departure='edge', seed=0))
+    second, _ = build_mission(SpawnSettings(site='small', robots=10, departure='edge', seed=1))
+    assert not np.allclose(first.initial_poses[:, 2], second.initial_poses[:, 2])

@@ -8,10 +8,12 @@ import pytest
 from bayes_swarm.messages import DecisionKind
 from bayes_swarm.settings import Arena, BayesSwarmConfig
 from swarm_analysis.tau import tau_from_bag
+from swarm_common.stamps import stamp_to_seconds
 from swarm_experiments.bayes_batch import MissionSpec as HarnessSpec
 from swarm_experiments.bayes_batch import run_mission as run_harness
 from swarm_experiments.errors import ExperimentError
 from swarm_experiments.spawn_bayes_swarm import SpawnSettings, batch_mission_spec, main, run
+from swarm_runtime.bag import read_messages
 from swarm_sim.signal_fields import get_case
 
 
@@ -78,6 +80,21 @@ def test_a_recorded_case_1_bag_gives_the_same_tau(tmp_path):
     # /sim/poses is sampled at 2 Hz: the recomputed detection may lag by one sample.
     assert from_bag.found_time_s == pytest.approx(result.found_time_s, abs=0.5)
     assert from_bag.tau == pytest.approx(result.tau, abs=0.5 * 0.1 / math.sqrt(5.0))
+    # The viewer topics: the source turns green when found; /tf at 10 Hz of 20 Hz odometry.
+    targets = [
+        item.message for item in read_messages(tmp_path / 'bag', topics=['/sim/markers/targets'])
+    ]
+    assert len(targets) == 2
+    first, last = (next(m for m in a.markers if m.ns == 'targets') for a in targets)
+    source = get_case('case1').source_m
+    assert (first.pose.position.x, first.pose.position.y) == pytest.approx(tuple(source))
+    assert first.color.r > first.color.g
+    assert last.color.g > last.color.r
+    stamps = [
+        stamp_to_seconds(item.message.transforms[0].header.stamp)
+        for item in read_messages(tmp_path / 'bag', topics=['/tf'])
+    ]
+    assert np.diff(stamps) == pytest.approx(0.1, abs=1e-6)
 
 
 @pytest.mark.slow
@@ -142,7 +159,7 @@ def test_command_line_parameters_override_the_case_for_every_robot():
     [
         ('horizn_s=3', "unknown parameter 'horizn_s' (did you mean horizon_s?)"),
         ('n_robots=4', "'n_robots' is set by the spawner"),
-        ('horizon_s=-3', 'horizon_s must be > 0'),
+        ('horizon_s=-3', 'parameter horizon_s: must be > 0 s, got -3 s'),
     ],
 )
 def test_command_line_rejects_bad_parameters_with_exit_status_2(capsys, option, message):

@@ -6,9 +6,11 @@ import numpy as np
 import pytest
 from msc_pf.schemes import Scheme
 from swarm_analysis.cct import cct_from_bag
+from swarm_common.stamps import stamp_to_seconds
 from swarm_experiments.errors import ExperimentError
 from swarm_experiments.msc_pf_batch import BatchScenario, run_batch
 from swarm_experiments.spawn_msc_pf import SpawnSettings, main, run
+from swarm_runtime.bag import read_messages
 
 TARGET = np.array([[1100.0, 1060.0]])
 
@@ -49,6 +51,26 @@ def test_cct_recomputed_from_the_bag_matches_the_run(ros_run):
     result = cct_from_bag(ros_run.settings.record)
     assert result.all_captured
     assert result.cct_s == pytest.approx(ros_run.cct_s, abs=1e-6)
+
+
+@pytest.mark.slow
+def test_the_bag_shows_the_target_turn_from_open_to_captured(ros_run):
+    messages = [
+        item.message
+        for item in read_messages(ros_run.settings.record, topics=['/sim/markers/targets'])
+    ]
+    # Latched at the start, then sent again at the capture.
+    assert len(messages) == 2
+    spheres = [[m for m in array.markers if m.ns == 'targets'] for array in messages]
+    (first,), (last,) = spheres
+    assert (first.pose.position.x, first.pose.position.y) == tuple(TARGET[0])
+    assert first.color.r > first.color.g  # open: orange
+    assert last.color.g > last.color.r  # captured: green
+    areas = [m for m in messages[0].markers if m.ns == 'target_areas']
+    assert areas[0].scale.x == pytest.approx(2.0 * 5.0)  # the work area D_th
+    assert stamp_to_seconds(messages[1].markers[0].header.stamp) == pytest.approx(
+        ros_run.cct_s, abs=0.2
+    )
 
 
 @pytest.mark.slow
@@ -110,7 +132,7 @@ def test_command_line_parameters_reach_every_robot_node_typed():
             "unknown parameter 'msc.leader_rul' (did you mean msc.leader_rule?)",
         ),
         ('swarm.comm_range_m=50', "'swarm.comm_range_m' is set by the spawner"),
-        ('msc.leader_rule=uphill', 'leader_rule not in'),
+        ('msc.leader_rule=uphill', "msc.leader_rule: 'uphill' is not one of gradient, pbest"),
         ('phases.unheard_updates=maybe', 'expected true or false'),
     ],
 )

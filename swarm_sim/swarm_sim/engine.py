@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from swarm_common.angles import wrap_angle
+from swarm_common.params import parameter, section
 
 from swarm_sim.errors import ConfigurationError, WorldGeometryError
 from swarm_sim.geometry import RayCaster
@@ -75,20 +76,30 @@ class EngineConfig:
             there is no scent field either (pumps then lay nothing).
     """
 
-    physics_rate_hz: float = 10.0
-    cmd_vel_timeout_s: float = 0.5
-    pump_timeout_s: float = 1.0
-    pump_offset_m: float = 0.12
-    ground_truth_rate_hz: float = 2.0
-    seed: int = 0
+    physics_rate_hz: float = parameter(
+        10.0, 'Physics steps per second of sim time.', unit='Hz', gt=0.0
+    )
+    cmd_vel_timeout_s: float = parameter(
+        0.5, 'A robot stops when cmd_vel is older.', unit='s', gt=0.0
+    )
+    pump_timeout_s: float = parameter(
+        1.0, 'A pump stops when its last "on" is older.', unit='s', gt=0.0
+    )
+    pump_offset_m: float = parameter(
+        0.12, 'Pump nozzle distance behind the robot centre.', unit='m'
+    )
+    ground_truth_rate_hz: float = parameter(2.0, 'Rate of /sim/poses.', unit='Hz', gt=0.0)
+    seed: int = parameter(
+        0, 'Seed of every random draw in the world; equal seeds give equal runs.', ge=0
+    )
     sensors: frozenset[str] = SENSORS
-    body: BodyConfig = field(default_factory=BodyConfig)
-    lidar: LidarConfig = field(default_factory=LidarConfig)
-    scent: ScentConfig = field(default_factory=ScentConfig)
-    gas: GasSensorConfig = field(default_factory=GasSensorConfig)
-    bearings: BearingConfig = field(default_factory=BearingConfig)
-    imu: ImuConfig = field(default_factory=ImuConfig)
-    odometry: OdometryConfig = field(default_factory=OdometryConfig)
+    body: BodyConfig = section(BodyConfig, prefix='')
+    lidar: LidarConfig = section(LidarConfig, prefix='scan_')
+    scent: ScentConfig = section(ScentConfig, prefix='scent_')
+    gas: GasSensorConfig = section(GasSensorConfig, prefix='gas_')
+    bearings: BearingConfig = section(BearingConfig, prefix='bearing_')
+    imu: ImuConfig = section(ImuConfig, prefix='imu_')
+    odometry: OdometryConfig = section(OdometryConfig, prefix='odom_')
 
     def __post_init__(self) -> None:
         for name in ('physics_rate_hz', 'cmd_vel_timeout_s', 'pump_timeout_s'):

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from swarm_common.angles import wrap_angle
+from swarm_common.params import parameter
 
 from swarm_sim.errors import ConfigurationError, WorldGeometryError
 from swarm_sim.geometry import WallGrid, as_segments
@@ -37,10 +38,10 @@ class BodyConfig:
         max_angular_speed_radps: yaw rate limit [rad/s].
     """
 
-    robot_radius_m: float = 0.1
-    wall_thickness_m: float = 0.025
-    max_linear_speed_mps: float = 0.5
-    max_angular_speed_radps: float = 2.0
+    robot_radius_m: float = parameter(0.1, 'Radius of every robot disc.', unit='m', gt=0.0)
+    wall_thickness_m: float = parameter(0.025, 'Thickness of every wall.', unit='m', ge=0.0)
+    max_linear_speed_mps: float = parameter(0.5, 'Forward speed limit.', unit='m/s', gt=0.0)
+    max_angular_speed_radps: float = parameter(2.0, 'Yaw rate limit.', unit='rad/s', gt=0.0)
 
     def __post_init__(self) -> None:
         for name in ('robot_radius_m', 'max_linear_speed_mps', 'max_angular_speed_radps'):

@@ -132,3 +132,22 @@ def test_unknown_file_types_and_missing_files_fail_cleanly(
 def test_a_bad_departure_argument_is_an_argparse_error(tmp_path: Path) -> None:
     with pytest.raises(SystemExit):
         main(['import-lay', 'x.lay', '-o', str(tmp_path / 'x.yaml'), '--departure', 'center'])
+
+
+def test_import_and_validate_log_the_sites_warnings_on_stderr(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    plan = tmp_path / 'boxes.lay'
+    plan.write_text(
+        '%%%%%%%%%%%%\n%    %     %\n%    %%%%%%%\n%  D       %\n%          %\n%%%%%%%%%%%%\n'
+    )
+    out = tmp_path / 'boxes.yaml'
+    assert main(['import-lay', str(plan), '-o', str(out)]) == 0
+    captured = capsys.readouterr()
+    assert 'found 0 rooms and 0 doors, 1 sealed voids read as solid' in captured.out
+    assert f'warning: {plan}:2:7: an enclosed area with no door' in captured.err
+    assert main(['validate', str(plan)]) == 0
+    assert f'warning: {plan}:2:7:' in capsys.readouterr().err
+    # The site file holds the void as solid already: nothing left to warn about.
+    assert main(['validate', str(out)]) == 0
+    assert 'warning' not in capsys.readouterr().err

@@ -37,6 +37,15 @@ doors:
 """
 
 
+def test_a_departure_point_inside_a_room_is_a_warning_naming_line_and_key() -> None:
+    text = MINIMAL.replace('  edge: {x_m: 2.0', '  inside: {x_m: 3.2, y_m: 2.2}\n  edge: {x_m: 2.0')
+    site = parse_site(text, 'box.yaml')
+    (warning,) = site.warnings
+    assert warning.startswith("box.yaml:6: departure_points.inside: departure point 'inside'")
+    assert "lies inside room 1 ('A'): robots start in that room" in warning
+    assert parse_site(MINIMAL, 'box.yaml').warnings == ()
+
+
 def test_a_minimal_site_file_loads_into_the_site_it_describes() -> None:
     site = parse_site(MINIMAL, 'box.yaml')
     assert site.name == 'box'

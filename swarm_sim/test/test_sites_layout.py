@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import numpy as np
@@ -250,10 +251,22 @@ def test_a_labelled_room_without_door_is_reported_at_its_first_cell(tmp_path: Pa
         import_text(tmp_path, text)
 
 
-def test_an_enclosed_area_without_a_gap_in_a_plan_is_reported(tmp_path: Path) -> None:
+def test_an_enclosed_area_without_a_gap_in_a_plan_is_a_sealed_void_read_as_solid(
+    tmp_path: Path,
+) -> None:
     text = replace_char(UNLABELLED, 7, 10, '%')  # close the bottom room's gap
-    with pytest.raises(LayoutError, match=r':8:2: an enclosed area has no door'):
-        import_text(tmp_path, text)
+    result = import_text(tmp_path, text)
+    assert result.rooms_found == 3
+    assert result.voids_found == 1
+    (warning,) = result.site.warnings
+    assert re.search(
+        r'plan\.lay:8:2: an enclosed area with no door \(51 cells, lines 7-10, '
+        r'columns 1-18\) .* read as solid',
+        warning,
+    )
+    # Read as solid: no room there.
+    bottom = (4 * CELL_M, 1.5 * CELL_M)
+    assert result.site.room_ids_at(np.array([bottom])).tolist() == [NO_ROOM]
 
 
 def test_a_departure_point_on_a_wall_is_inside_a_wall(tmp_path: Path) -> None:
@@ -267,7 +280,9 @@ def test_a_runner_departure_point_in_a_wall_block_is_reported_with_its_place(
     text = LABELLED
     for line, column in ((5, 8), (5, 9), (6, 8), (6, 9)):
         text = replace_char(text, line, column, '%')
-    with pytest.raises(LayoutError, match=r":5:9: departure point 'center' .* is walled in"):
+    with pytest.raises(
+        LayoutError, match=r":5:8: departure point 'center' lies inside a solid block of wall"
+    ):
         import_text(tmp_path, text)
 
 
@@ -312,16 +327,39 @@ def test_rooms_touching_without_a_wall_are_reported(tmp_path: Path) -> None:
         import_text(tmp_path, text)
 
 
-def test_a_plan_without_departure_mark_or_with_two_is_reported(tmp_path: Path) -> None:
-    with pytest.raises(LayoutError, match="needs a departure point marked 'D'"):
-        import_text(tmp_path, UNLABELLED.replace('D', ' '))
+def test_a_plan_without_departure_mark_starts_in_its_middle_and_says_so(tmp_path: Path) -> None:
+    # The authors' simulator starts from the middle of a plan without 'D'.
+    site = import_text(tmp_path, UNLABELLED.replace('D', ' ')).site
+    assert list(site.departure_points) == ['center']
+    assert site.departure('center').xy == pytest.approx((8.5 * CELL_M, 4.5 * CELL_M))
+    assert any(
+        "no departure mark 'D': departure point 'center' is the middle of the plan (line 5.5, "
+        'column 9.5)' in w
+        for w in site.warnings
+    )
+
+
+def test_a_second_departure_mark_is_reported(tmp_path: Path) -> None:
     with pytest.raises(LayoutError, match=r":8:3: a second departure mark 'D'"):
         import_text(tmp_path, replace_char(UNLABELLED, 8, 3, 'D'))
+    text = replace_char(replace_char(LABELLED, 5, 3, 'D'), 5, 9, 'D')
+    with pytest.raises(LayoutError, match=r":5:9: a second departure mark 'D'"):
+        import_text(tmp_path, text)
 
 
-def test_room_letters_in_a_plan_forced_unlabelled_are_reported(tmp_path: Path) -> None:
-    with pytest.raises(LayoutError, match=r":2:2: 'A' belongs to labelled layouts"):
-        import_text(tmp_path, LABELLED, mode='unlabelled')
+def test_room_letters_in_a_plan_forced_unlabelled_read_as_free_space_with_a_warning(
+    tmp_path: Path,
+) -> None:
+    result = import_text(tmp_path, LABELLED, mode='unlabelled', departures={'hall': (5.5, 8)})
+    assert result.mode is LayoutMode.UNLABELLED
+    warnings = '\n'.join(result.site.warnings)
+    assert re.search(
+        r"plan\.lay:2:2: 'A' \(8 places\) has no meaning in an unlabelled plan", warnings
+    )
+    assert "plan.lay:8:2: '3' (8 places)" in warnings
+    assert "plan.lay:2:14: '#' (1 place)" in warnings
+    # The door marks read as gaps, so the rooms are still found behind them.
+    assert result.rooms_found == 4
 
 
 def test_an_empty_or_tiny_layout_is_reported(tmp_path: Path) -> None:

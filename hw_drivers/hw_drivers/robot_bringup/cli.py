@@ -3,10 +3,11 @@
 ``robot_bringup --robot r0 --own-tag D2 --variant gas_sound --robot-index 0 --robot-count 4``
 first checks what it needs (the parameter file, the device files, ROS, the programs to run)
 and stops with one line per problem and exit status 2 if anything is missing. It then
-starts, in this order, the pump driver (first, so the line is held off), the lidar, gas, IMU
-and AoA receiver drivers, optionally the locator host binary (after the AoA receiver is
-listening), and the OA-Bug node, all in the robot's namespace with frame ids that match the
-simulator's (``r0/laser``, ``r0/imu_link``, ...).
+starts, in this order, the pump driver (first, so the line is held off), the static frames
+node (the sensor mounts on ``/tf_static``), the lidar, gas, IMU and AoA receiver drivers,
+optionally the locator host binary (after the AoA receiver is listening), and the OA-Bug
+node, all in the robot's namespace with frame ids that match the simulator's (``r0/laser``,
+``r0/imu_link``, ...).
 
 Every child runs in a process group of its own. When one exits, or the bringup gets SIGINT,
 SIGTERM or SIGHUP, every group is sent SIGTERM, and SIGKILL after ``--grace`` seconds, so no
@@ -48,6 +49,8 @@ from swarm_runtime.standalone import (
     runtime_missing_reason,
 )
 
+from hw_drivers.parameters import NODE_SPECS
+
 __all__ = [
     'DEVICE_PARAMETERS',
     'EXIT_CHILD_FAILED',
@@ -77,18 +80,21 @@ EXECUTABLES = {
     'gas_adc_node': ('hw_drivers', 'hw_drivers.gas_node'),
     'mpu6050_node': ('hw_drivers', 'hw_drivers.mpu6050_node'),
     'aoa_receiver_node': ('hw_drivers', 'hw_drivers.aoa_receiver_node'),
+    'static_frames_node': ('hw_drivers', 'hw_drivers.static_frames_node'),
     'oabug': ('oabug_robot', 'oabug_robot.node'),
 }
 DRIVERS = ('pump_node', 'rplidar_node', 'gas_adc_node', 'mpu6050_node', 'aoa_receiver_node')
 
-#: Driver parameters that name a device, with the drivers' defaults (a test keeps them equal
-#: to the nodes' parameter tables; the nodes themselves are not imported here, which would
-#: need ROS and the generated messages).
+#: Driver parameters that name a device, with the drivers' defaults (from their parameter
+#: specs, which are ROS-free: importing them needs neither ROS nor the generated messages).
 DEVICE_PARAMETERS: dict[str, dict[str, Any]] = {
-    'pump_node': {'chip': '/dev/gpiochip0'},
-    'rplidar_node': {'port': '/dev/rplidar'},
-    'gas_adc_node': {'backend': 'ads1115', 'i2c_bus': 1, 'serial_port': '/dev/gas_mcu'},
-    'mpu6050_node': {'i2c_bus': 1},
+    node: {name: NODE_SPECS[node][name].default for name in names}
+    for node, names in {
+        'pump_node': ('chip',),
+        'rplidar_node': ('port',),
+        'gas_adc_node': ('backend', 'i2c_bus', 'serial_port'),
+        'mpu6050_node': ('i2c_bus',),
+    }.items()
 }
 
 
@@ -128,10 +134,12 @@ def driver_parameters(robot: str, *, own_tag_id: str = '', fake: bool = False) -
     """Per-driver parameters that make a real robot publish what the simulator publishes.
 
     Frame ids follow the sim bridge (``<robot>/laser``, ``<robot>/gas_sensor``,
-    ``<robot>/imu_link``, ``<robot>/base_link`` for bearings).
+    ``<robot>/imu_link``, ``<robot>/base_link`` for bearings); the static frames node
+    prefixes its frames the same way.
     """
     params: dict[str, dict[str, Any]] = {
         'pump_node': {},
+        'static_frames_node': {'frame_prefix': f'{robot}/'},
         'rplidar_node': {'frame_id': f'{robot}/laser'},
         'gas_adc_node': {'frame_id': f'{robot}/gas_sensor'},
         'mpu6050_node': {'frame_id': f'{robot}/imu_link'},
@@ -200,9 +208,11 @@ def build_plan(options: BringupOptions) -> list[ChildSpec]:
         params['gas_adc_node']['backend'] = options.gas_backend
     for name, extra in options.extra.items():
         params.setdefault(name, {}).update(extra)
+    # The pump first (its line is held off), then the static frames, then the sensors.
+    order = (DRIVERS[0], 'static_frames_node', *DRIVERS[1:])
     plan = [
         ChildSpec(name, _command(name, options.robot, params[name], options), settle_s=0.5)
-        for name in DRIVERS
+        for name in order
     ]
     if options.locator_command:
         # The authors' locator exits whenever its TCP connection ends: respawn it alone.

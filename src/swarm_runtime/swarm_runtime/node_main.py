@@ -3,9 +3,12 @@
 Every node's console entry point is one call::
 
     def main(args: list[str] | None = None) -> int:
-        return run_node(OABugNode, args, name='oabug', fatal_errors=(ConfigError,))
+        return run_node(
+            OABugNode, args, name='oabug', fatal_errors=(ConfigError,), parameters=OABUG_PARAMETERS
+        )
 
-:func:`run_node` does the Jazzy boilerplate (``rclpy.init``, build the node, spin it,
+:func:`run_node` checks the parameter arguments against the node's spec, then does the
+Jazzy boilerplate (``rclpy.init``, build the node, spin it,
 ``destroy_node``, ``rclpy.try_shutdown``) and makes a stop by Ctrl-C (SIGINT) or SIGTERM
 exit with status 0 and no traceback, on real rclpy and on the built-in runtime. Catching
 KeyboardInterrupt and ExternalShutdownException is not enough on real rclpy:
@@ -37,6 +40,10 @@ from collections.abc import Callable, Sequence
 from types import FrameType
 from typing import Any, TypeVar
 
+from swarm_common.cli import fail
+from swarm_common.params import ParameterSpec
+
+from swarm_runtime.parameters import ParameterFileError, check_parameter_arguments
 from swarm_runtime.ros import ExternalShutdownException, rclpy, using_real_rclpy
 
 __all__ = ['EXIT_FATAL_ERROR', 'STOP_SIGNALS', 'run_node']
@@ -117,6 +124,7 @@ def run_node(
     describe_fatal: Callable[[Exception], str | None] = str,
     on_signal: Callable[[NodeT], None] | None = None,
     spin: Callable[[NodeT], None] | None = None,
+    parameters: ParameterSpec | None = None,
 ) -> int:
     """Initialise rclpy with ``args``, build the node, spin it until stopped; return the status.
 
@@ -131,14 +139,22 @@ def run_node(
         on_signal: called with the node (once it exists) as soon as SIGINT or SIGTERM
             arrives, before the stop begins; e.g. to switch an actuator off.
         spin: runs the node until the context shuts down (default ``rclpy.spin``).
+        parameters: the node's parameter spec; its ``--params-file`` files and ``-p`` values
+            (for the node named ``name``) are checked before ``rclpy.init``, and a bad one
+            ends the process with one line on stderr naming the file and the parameter.
 
     Returns:
         0 after a stop (Ctrl-C, SIGTERM, shutdown by a callback or another thread),
-        ``EXIT_FATAL_ERROR`` after one of ``fatal_errors``.
+        ``EXIT_FATAL_ERROR`` after one of ``fatal_errors`` or a bad parameter argument.
 
     Raises:
         Exception: whatever the node or a callback raised while the context was still ok.
     """
+    if parameters is not None:
+        try:
+            check_parameter_arguments(parameters, name, args)
+        except ParameterFileError as err:
+            return fail(name, err, EXIT_FATAL_ERROR)
     teardown = _Teardown()
 
     def signalled() -> None:

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from swarm_common.angles import wrap_angle
+from swarm_common.params import parameter
 
 from swarm_sim.errors import ConfigurationError
 from swarm_sim.geometry import as_segments, count_crossings, padded_walls
@@ -39,13 +40,17 @@ class BearingConfig:
         dropout_probability: chance that one report of one tag is lost.
     """
 
-    rate_hz: float = 5.0
-    range_m: float = 50.0
-    wall_range_factor: float = 0.88
-    azimuth_noise_std_rad: float = math.radians(3.0)
+    rate_hz: float = parameter(
+        5.0, 'AoA locator report rate.', unit='Hz', gt=0.0, name='bearings_rate_hz'
+    )
+    range_m: float = parameter(50.0, 'AoA line-of-sight range (paper: 30-50).', unit='m', gt=0.0)
+    wall_range_factor: float = parameter(0.88, 'Range factor per wall.', ge=0.0, le=1.0)
+    azimuth_noise_std_rad: float = parameter(
+        math.radians(3.0), 'AoA azimuth error std.', unit='rad', ge=0.0
+    )
     elevation_noise_std_rad: float = math.radians(3.0)
     distance_noise_fraction: float = 0.3
-    dropout_probability: float = 0.02
+    dropout_probability: float = parameter(0.02, 'Chance a report is lost.', ge=0.0, le=1.0)
 
     def __post_init__(self) -> None:
         if not (self.rate_hz > 0.0 and self.range_m > 0.0):

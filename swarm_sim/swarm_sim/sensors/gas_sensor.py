@@ -20,6 +20,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from swarm_common.params import parameter
 
 from swarm_sim.errors import ConfigurationError
 from swarm_sim.sensors_kernel import gas_update_kernel
@@ -44,13 +45,13 @@ class GasSensorConfig:
         sensor_offset_m: sensor position ahead of the robot's centre [m].
     """
 
-    rate_hz: float = 10.0
-    rise_time_constant_s: float = 3.0
-    fall_time_constant_s: float = 5.0
-    baseline_raw: float = 60.0
+    rate_hz: float = parameter(10.0, 'Gas sensor sample rate.', unit='Hz', gt=0.0)
+    rise_time_constant_s: float = parameter(3.0, 'MP503 rise lag.', unit='s', gt=0.0)
+    fall_time_constant_s: float = parameter(5.0, 'MP503 fall lag.', unit='s', gt=0.0)
+    baseline_raw: float = parameter(60.0, 'Clean-air reading on the 10-bit scale.', unit='counts')
     half_response_ppm: float = 400.0
-    noise_std_raw: float = 4.0
-    sensor_offset_m: float = 0.08
+    noise_std_raw: float = parameter(4.0, 'Gas reading noise std.', unit='counts', ge=0.0)
+    sensor_offset_m: float = parameter(0.08, 'Gas sensor distance ahead of centre.', unit='m')
 
     def __post_init__(self) -> None:
         positive = ('rate_hz', 'rise_time_constant_s', 'fall_time_constant_s', 'half_response_ppm')

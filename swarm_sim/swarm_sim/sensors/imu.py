@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from swarm_common.angles import wrap_angle
+from swarm_common.params import parameter
 
 from swarm_sim.errors import ConfigurationError
 from swarm_sim.sensors_kernel import imu_update_kernel
@@ -34,10 +35,22 @@ class ImuConfig:
         bias_random_walk_radps_per_sqrt_s: bias drift rate [rad/s/sqrt(s)].
     """
 
-    rate_hz: float = 10.0
+    rate_hz: float = parameter(10.0, 'IMU output rate.', unit='Hz', gt=0.0)
     noise_density_radps_per_sqrt_hz: float = math.radians(0.005)
-    residual_bias_std_radps: float = 0.0
-    bias_random_walk_radps_per_sqrt_s: float = 0.0
+    residual_bias_std_radps: float = parameter(
+        0.0,
+        'Spread of the per-robot gyro bias left after calibration; 0 = ideal heading.',
+        unit='rad/s',
+        ge=0.0,
+        name='gyro_residual_bias_std_radps',
+    )
+    bias_random_walk_radps_per_sqrt_s: float = parameter(
+        0.0,
+        'Gyro bias drift.',
+        unit='rad/s/sqrt(s)',
+        ge=0.0,
+        name='gyro_bias_random_walk_radps_per_sqrt_s',
+    )
 
     def __post_init__(self) -> None:
         if not self.rate_hz > 0.0:

@@ -12,6 +12,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from swarm_common.params import parameter
 
 from swarm_sim.errors import ConfigurationError
 from swarm_sim.geometry import RayCaster
@@ -34,13 +35,19 @@ class LidarConfig:
         dropout_probability: chance that a sample is lost (reads ``inf``).
     """
 
-    num_bins: int = 360
-    range_min_m: float = 0.15
-    range_max_m: float = 12.0
-    rate_hz: float = 5.5
-    range_noise_fraction: float = 0.01
+    num_bins: int = parameter(360, 'Lidar samples per revolution.', ge=1, name='scan_bins')
+    range_min_m: float = parameter(
+        0.15, 'Shortest lidar range; closer reads inf.', unit='m', ge=0.0
+    )
+    range_max_m: float = parameter(
+        12.0, 'Longest lidar range; farther reads inf.', unit='m', gt=0.0
+    )
+    rate_hz: float = parameter(5.5, 'Lidar revolutions per second (A1: 5.5).', unit='Hz', gt=0.0)
+    range_noise_fraction: float = parameter(
+        0.01, 'Range noise std / range.', ge=0.0, name='scan_noise_fraction'
+    )
     range_noise_min_m: float = 0.002
-    dropout_probability: float = 0.005
+    dropout_probability: float = parameter(0.005, 'Chance a sample is lost.', ge=0.0, le=1.0)
 
     def __post_init__(self) -> None:
         if self.num_bins < 4:

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from swarm_common.angles import wrap_angle
+from swarm_common.params import parameter
 
 from swarm_sim.errors import ConfigurationError
 
@@ -28,8 +29,10 @@ class OdometryConfig:
         rotation_noise_fraction: std of the rotation error per increment, as a fraction.
     """
 
-    rate_hz: float = 10.0
-    distance_noise_fraction: float = 0.0
+    rate_hz: float = parameter(10.0, 'Odometry output rate.', unit='Hz', gt=0.0)
+    distance_noise_fraction: float = parameter(
+        0.0, 'Odometry distance error std per increment, as a fraction.', ge=0.0
+    )
     rotation_noise_fraction: float = 0.0
 
     def __post_init__(self) -> None:
@@ -51,6 +54,11 @@ class WheelOdometry:
         self._rng = rng
         self._pose = np.array(initial_poses, dtype=float)
         self._last_true = np.array(initial_poses, dtype=float)
+
+    @property
+    def poses(self) -> np.ndarray:
+        """(N, 3) odometry poses x [m], y [m], yaw [rad] now (a copy)."""
+        return self._pose.copy()
 
     def update(self, true_poses: np.ndarray, dt_s: float) -> tuple[np.ndarray, np.ndarray]:
         """Integrate the motion since the last update.

@@ -20,6 +20,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from swarm_common.params import parameter
 
 from swarm_sim.errors import ConfigurationError
 from swarm_sim.geometry import WallGrid, as_segments
@@ -44,14 +45,16 @@ class ScentConfig:
         walls_block: when True, vapour does not cross walls.
     """
 
-    deposit_rate_ppm_m2_per_s: float = 80.0
+    deposit_rate_ppm_m2_per_s: float = parameter(
+        80.0, 'Ethanol released while a pump runs.', unit='ppm m^2/s', ge=0.0
+    )
     deposit_period_s: float = 0.25
     initial_spread_m: float = 0.08
-    final_spread_m: float = 0.15
+    final_spread_m: float = parameter(0.15, 'Settled puff standard deviation.', unit='m', gt=0.0)
     spread_time_constant_s: float = 10.0
-    decay_time_constant_s: float = 1800.0
+    decay_time_constant_s: float = parameter(1800.0, 'Puff evaporation.', unit='s', gt=0.0)
     cutoff_sigmas: float = 3.0
-    walls_block: bool = True
+    walls_block: bool = parameter(True, 'True: vapour does not cross walls.')
 
     def __post_init__(self) -> None:
         positive = (

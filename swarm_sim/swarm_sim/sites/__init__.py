@@ -14,6 +14,7 @@ from swarm_sim.sites.errors import (
     SiteError,
     SiteFileError,
     SiteValidationError,
+    SiteWarning,
 )
 from swarm_sim.sites.generator import (
     BIG,
@@ -53,6 +54,7 @@ __all__ = [
     'SiteError',
     'SiteFileError',
     'SiteValidationError',
+    'SiteWarning',
     'generate_layout',
     'generate_site',
     'import_layout',

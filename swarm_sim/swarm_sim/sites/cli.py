@@ -9,7 +9,8 @@ Examples::
     site_tool render small7.yaml -o small7.png
 
 Every command exits with 0 on success and 1 on an invalid site or bad input, printing the
-error (file, line and column or key) to stderr.
+error (file, line and column or key) to stderr. The site's warnings (a sealed void read as
+solid, a departure point inside a room, ...) go to stderr as ``warning: ...`` lines.
 """
 
 from __future__ import annotations
@@ -53,6 +54,11 @@ def _summary(site: Site) -> str:
     )
 
 
+def _log_warnings(site: Site) -> None:
+    for warning in site.warnings:
+        print(f'warning: {warning}', file=sys.stderr)
+
+
 def _render(site: Site, path: str) -> None:
     from swarm_sim.sites.plotting import render_site  # matplotlib only when drawing
 
@@ -77,6 +83,7 @@ def _generate(args: argparse.Namespace) -> int:
     site = layout_to_site(
         layout, mode=LayoutMode.LABELLED, cell_m=config.cell_m, name=name, seed=args.seed
     ).site
+    _log_warnings(site)
     save_site(site, args.output)
     print(f'wrote {args.output}: {_summary(site)}')
     if args.lay:
@@ -107,10 +114,12 @@ def _import_lay(args: argparse.Namespace) -> int:
         departures=dict(args.departure) if args.departure else None,
         max_door_cells=args.max_door_cells,
     )
+    voids = f', {result.voids_found} sealed voids read as solid' if result.voids_found else ''
     print(
         f'{args.layout}: {result.mode.value} layout, found {result.rooms_found} rooms and '
-        f'{result.doors_found} doors'
+        f'{result.doors_found} doors{voids}'
     )
+    _log_warnings(result.site)
     save_site(result.site, args.output)
     print(f'wrote {args.output}: {_summary(result.site)}')
     if args.png:
@@ -121,12 +130,14 @@ def _import_lay(args: argparse.Namespace) -> int:
 def _validate(args: argparse.Namespace) -> int:
     site = load_any(args.site)
     validate_site(site, robot_radius_m=args.robot_radius_m)
+    _log_warnings(site)
     print(f'{args.site}: valid. {_summary(site)}')
     return 0
 
 
 def _render_command(args: argparse.Namespace) -> int:
     site = load_any(args.site)
+    _log_warnings(site)
     _render(site, args.output)
     return 0
 
@@ -158,7 +169,7 @@ def build_parser() -> argparse.ArgumentParser:
     imports.add_argument('--cell-m', type=float, default=CELL_M, help='grid spacing [m]')
     imports.add_argument('--name', help='site name (default: the file name)')
     imports.add_argument(
-        '--departure-name', default='edge', help="name of the 'D' point of an unlabelled plan"
+        '--departure-name', default='edge', help="name of the departure point marked 'D'"
     )
     imports.add_argument(
         '--departure',

@@ -3,10 +3,19 @@
 Every error says where the problem is: a file with its line and column (``.lay`` layouts), a
 file with its key path and line (site files), or world coordinates in metres (sites built in
 code). :class:`SiteError` is the base class, so callers that only care that a site is unusable
-catch that one.
+catch that one; it is a :class:`swarm_sim.errors.SimulationError`, so it is rooted at
+:class:`swarm_common.errors.SwarmError` like every error the suite raises on purpose.
+
+Problems that leave a usable site (a sealed void read as solid, a departure point inside a
+room) are not errors: they are :class:`SiteWarning` items, which the importers turn into the
+one-line texts of :attr:`swarm_sim.sites.model.Site.warnings`.
 """
 
 from __future__ import annotations
+
+from dataclasses import dataclass
+
+from swarm_sim.errors import SimulationError
 
 __all__ = [
     'GeneratorError',
@@ -14,12 +23,29 @@ __all__ = [
     'SiteError',
     'SiteFileError',
     'SiteValidationError',
+    'SiteWarning',
     'format_key_path',
 ]
 
 
-class SiteError(Exception):
+class SiteError(SimulationError):
     """Base class of every error raised by :mod:`swarm_sim.sites`."""
+
+
+@dataclass(frozen=True)
+class SiteWarning:
+    """A problem that leaves the site usable, with the place it was found.
+
+    Attributes:
+        message: one line saying what is odd and what the site does about it.
+        position_m: (x, y) [m] of the place, when there is one (layout importers turn it
+            into a line and column).
+        key_path: the site-file key path of the item concerned, when there is one.
+    """
+
+    message: str
+    position_m: tuple[float, float] | None = None
+    key_path: tuple[str | int, ...] = ()
 
 
 class SiteValidationError(SiteError):

@@ -155,7 +155,9 @@ _SOLID: Final = 0
 _OPEN: Final = 1
 _INTERIOR: Final = 2
 _DOOR: Final = 3
-_LABELS: Final = [ord(ch) for ch in 'ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz']
+# Room letters, cycled; 'D' is left out because it marks the departure point in a layout
+# (the authors' generator uses it for its fourth room, their layout reader as the departure).
+_LABELS: Final = [ord(ch) for ch in 'ABCEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz']
 
 
 def resolve_config(config: GeneratorConfig | str) -> GeneratorConfig:

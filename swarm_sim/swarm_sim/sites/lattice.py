@@ -72,16 +72,21 @@ def runs(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return rows, starts, stops
 
 
-def wall_segments(wall: np.ndarray, cell_m: float) -> np.ndarray:
+def wall_segments(
+    wall: np.ndarray, cell_m: float, extra_solid: np.ndarray | None = None
+) -> np.ndarray:
     """(M, 4) wall segments x0, y0, x1, y1 [m] of an (H, W) bool vertex mask.
 
     Collinear wall edges are merged into maximal segments; edges with a solid square on both
-    sides are dropped. Horizontal segments come first, each with x0 < x1; then vertical ones
-    with y0 < y1.
+    sides are dropped. ``extra_solid`` ((H-1, W-1) bool) counts more squares as solid (sealed
+    voids read as solid). Horizontal segments come first, each with x0 < x1; then vertical
+    ones with y0 < y1.
     """
     n_rows = wall.shape[0]
     horizontal, vertical = edge_walls(wall)
     solid = solid_squares(wall)
+    if extra_solid is not None:
+        solid = solid | extra_solid
     horizontal = horizontal.copy()
     vertical = vertical.copy()
     horizontal[1:-1] &= ~(solid[:-1] & solid[1:])

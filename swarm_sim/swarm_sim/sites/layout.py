@@ -5,39 +5,53 @@ One character per grid vertex, 1 cell = 4/15 m (see :mod:`.lattice` for the geom
 ===========  ================================================================================
 ``%``        wall vertex; straight runs of them are wall lines
 `` ``        free space (corridors, and room interiors in unlabelled plans)
+``.``        free space too (the authors' ``layout.lay`` marks floors with it)
 ``A`` and up interior of a room in a *labelled* layout, one letter per room: any printable
-             character from ``A`` on (the authors' generator labels room i with chr(65 + i),
-             so past ``Z`` come ``[ \\ ] ^ _ ```` , lower case and beyond)
+             character from ``A`` on except ``D`` (the authors' generator labels room i with
+             chr(65 + i), so past ``Z`` come ``[ \\ ] ^ _ ```` , lower case and beyond).
+             In an unlabelled plan a letter means nothing and is read as free space (with
+             a warning), as the authors' simulator reads every character but ``%``.
 ``0``-``9``  interior of a room holding a victim (labelled layouts)
 ``/``        door to a corridor (labelled); on the outer border: the site's single entrance
 ``#``        door between two rooms (labelled)
-``D``        the departure point in an *unlabelled* plan (a room letter in labelled ones)
+``D``        the departure point, in both kinds of layout (a group of ``D`` marks its centre);
+             never a room
 ===========  ================================================================================
 
 The first and last lines and columns are the enclosure: they hold only ``%``, except one run
 of ``/`` marking the entrance.
 
 *Labelled* layouts (the authors' generator output) name every room; each 4-connected group of
-one letter is a room. *Unlabelled* layouts (the authors' building plans) only draw walls;
-rooms are then found as the areas closed off by door gaps: a free vertex between two wall
-vertices of a straight line, with free space on both sides of the line that widens on at
-least one side (in the authors' simulator a door is a missing vertex in a wall line; wider
-gaps, up to ``max_door_cells``, must widen on both sides). A one-cell-wide room whose door
-leads into another one-cell-wide room is found merged with it, and a one-cell-wide corridor
-behind a gap counts as a room.
+one letter is a room, and it must be closed: every vertex around it is a wall or a door mark.
+*Unlabelled* layouts (the authors' building plans) only draw walls; rooms are then found as
+the areas closed off by door gaps: a free vertex between two wall vertices of a straight
+line, with free space on both sides of the line that widens on at least one side (in the
+authors' simulator a door is a missing vertex in a wall line; wider gaps, up to
+``max_door_cells``, must widen on both sides). A one-cell-wide room whose door leads into
+another one-cell-wide room is found merged with it, and a one-cell-wide corridor behind a gap
+counts as a room. Auto mode reads a layout as labelled when it has door marks (``/`` or
+``#`` inside the enclosure) or victim digits.
 
-Departure points: an unlabelled plan marks one with ``D`` (a group of ``D`` marks its
-centre). Labelled layouts follow the authors' runner: "center" at the middle of the bounds
-and "edge" 2.5 cells inside the entrance (or above the middle of the bottom wall when there
-is no entrance), heading into the building.
+Departure points: a ``D`` mark (named ``departure_name``). Without one, labelled layouts
+follow the authors' runner: "center" at the middle of the bounds and "edge" 2.5 cells inside
+the entrance (or above the middle of the bottom wall when there is no entrance), heading into
+the building; unlabelled plans start from the middle of the bounds ("center"), as the
+authors' simulator does. A departure point inside a solid block of wall (an island of the
+plan) or in an enclosed area cut off from the rooms is an error; inside a room it is a
+warning (robots start in that room).
+
+A *sealed void*, an enclosed area with no door that no departure point is in and that holds
+no room, is read as solid, with a warning (the authors' building plans have such boxes).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from enum import StrEnum
+from functools import cached_property
 from pathlib import Path
 from typing import Final
 
@@ -46,13 +60,14 @@ from scipy import ndimage
 
 from swarm_sim.sites import lattice
 from swarm_sim.sites.door_gaps import closing_masks, find_door_gaps
-from swarm_sim.sites.errors import LayoutError, SiteValidationError
+from swarm_sim.sites.errors import LayoutError, SiteValidationError, SiteWarning
 from swarm_sim.sites.model import CELL_M, NO_ROOM, DeparturePoint, Door, Room, Site
 from swarm_sim.sites.validation import validate_site
 
 __all__ = [
     'CORRIDOR_DOOR',
     'DEPARTURE',
+    'FLOOR',
     'FREE',
     'ROOM_DOOR',
     'WALL',
@@ -61,6 +76,7 @@ __all__ = [
     'LayoutMode',
     'detect_mode',
     'import_layout',
+    'is_room_label',
     'layout_to_site',
     'parse_layout',
     'read_layout',
@@ -69,6 +85,7 @@ __all__ = [
 
 WALL: Final = ord('%')
 FREE: Final = ord(' ')
+FLOOR: Final = ord('.')
 CORRIDOR_DOOR: Final = ord('/')
 ROOM_DOOR: Final = ord('#')
 DEPARTURE: Final = ord('D')
@@ -79,20 +96,21 @@ EDGE_INSET_CELLS: Final = 2.5
 """How far inside the entrance the "edge" departure point sits [cells] (authors' runner)."""
 
 _KNOWN_CHARACTERS = (
-    "'%' wall, ' ' free, 'A'-'z' room letters, '0'-'9' victim rooms, '/' and '#' doors, "
-    "'D' departure"
+    "'%' wall, ' ' and '.' free, 'A'-'z' room letters, '0'-'9' victim rooms, '/' and '#' "
+    "doors, 'D' departure"
 )
+_SIDES: Final = ('top', 'bottom', 'left', 'right')
 
 
 class LayoutMode(StrEnum):
     """How rooms are given in a layout."""
 
     AUTO = 'auto'
-    """Labelled if the layout has room letters, digits or door marks inside; else unlabelled."""
+    """Labelled if the layout has door marks (``/``, ``#``) inside or victim digits."""
     LABELLED = 'labelled'
     """Rooms are letter/digit areas, doors are ``/`` and ``#``."""
     UNLABELLED = 'unlabelled'
-    """Only walls; rooms are found behind door gaps; ``D`` marks the departure point."""
+    """Only walls; rooms are found behind door gaps; other marks read as free space."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -134,20 +152,29 @@ class LayoutImport:
     """Result of importing a layout.
 
     Attributes:
-        site: the validated site.
+        site: the validated site; ``site.warnings`` holds the import's warnings.
         mode: the mode used (AUTO resolved).
         rooms_found: number of rooms.
         doors_found: number of doors (the entrance not counted).
+        voids_found: sealed voids read as solid.
     """
 
     site: Site
     mode: LayoutMode
     rooms_found: int
     doors_found: int
+    voids_found: int = 0
+
+
+def is_room_label(code: int) -> bool:
+    """Whether a character code can label a room in a labelled layout (``A`` and up except
+    the departure mark ``D``, printable, not white space)."""
+    char = chr(code)
+    return code >= _LABEL_FIRST and code != DEPARTURE and char.isprintable() and not char.isspace()
 
 
 def _is_label(codes: np.ndarray) -> np.ndarray:
-    return codes >= _LABEL_FIRST
+    return (codes >= _LABEL_FIRST) & (codes != DEPARTURE)
 
 
 def _is_digit(codes: np.ndarray) -> np.ndarray:
@@ -176,9 +203,8 @@ def parse_layout(text: str, source: str = '<layout>') -> Layout:
             raise LayoutError(source, number, None, msg)
         for column, char in enumerate(line, start=1):
             code = ord(char)
-            known = code in (WALL, FREE, CORRIDOR_DOOR, ROOM_DOOR) or (
-                _DIGIT_FIRST <= code <= _DIGIT_LAST
-                or (code >= _LABEL_FIRST and char.isprintable() and not char.isspace())
+            known = code in (WALL, FREE, FLOOR, CORRIDOR_DOOR, ROOM_DOOR, DEPARTURE) or (
+                _DIGIT_FIRST <= code <= _DIGIT_LAST or is_room_label(code)
             )
             if not known:
                 msg = f'unknown character {char!r}; a layout uses {_KNOWN_CHARACTERS}'
@@ -207,10 +233,13 @@ def write_layout(layout: Layout, path: str | Path) -> None:
 
 
 def detect_mode(layout: Layout) -> LayoutMode:
-    """LABELLED when room letters other than ``D``, digits or inner door marks appear."""
+    """LABELLED when door marks (``/``, ``#``) or victim digits appear inside the enclosure.
+
+    Every room of a valid labelled layout has a marked door, so a layout without marks is
+    read as a plan; its letters, if any, then mean nothing and read as free space.
+    """
     inner = layout.codes[1:-1, 1:-1]
-    labelled = (_is_label(inner) & (inner != DEPARTURE)) | _is_digit(inner)
-    labelled |= (inner == CORRIDOR_DOOR) | (inner == ROOM_DOOR)
+    labelled = _is_digit(inner) | (inner == CORRIDOR_DOOR) | (inner == ROOM_DOOR)
     return LayoutMode.LABELLED if bool(np.any(labelled)) else LayoutMode.UNLABELLED
 
 
@@ -255,13 +284,17 @@ def layout_to_site(
         mode: labelled, unlabelled or auto (see :class:`LayoutMode`).
         cell_m: grid spacing [m]; the paper's 4/15 m by default.
         name: site name; defaults to the layout's source.
-        departure_name: name given to the ``D`` departure point of an unlabelled plan.
+        departure_name: name given to the departure point marked ``D``.
         departures: explicit departure points, name -> (line, column) in the file (1-based,
             fractional values allowed: (15.5, 30.5) lies between four characters). They
-            replace the ``D`` mark or the runner's "center"/"edge".
+            replace the ``D`` mark and the automatic ones.
         max_door_cells: widest door gap of an unlabelled plan, in missing vertices (the
             authors' doors miss one; a plan drawn with 0.8 m doors needs 2).
         seed: generator seed to record in the site, if the layout was generated.
+
+    Returns:
+        the import; its site's ``warnings`` list what was read leniently, each one line
+        starting ``file:line:column:``.
 
     Raises:
         LayoutError: malformed or invalid layout, naming the line and column.
@@ -276,21 +309,23 @@ def layout_to_site(
         )
     if mode is LayoutMode.AUTO:
         mode = detect_mode(layout)
-    builder = _SiteBuilder(layout, cell_m)
+    builder = _SiteBuilder(layout, cell_m, mode)
     entrance = builder.entrance()
     explicit = [builder.departure_at(n, line, col) for n, (line, col) in (departures or {}).items()]
+    mark = builder.marked_departure_point(departure_name)
     if mode is LayoutMode.LABELLED:
         rooms, doors = builder.labelled_rooms_and_doors()
-        points = explicit or builder.runner_departure_points(entrance)
+        points = explicit or ([mark] if mark else builder.runner_departure_points(entrance))
     else:
-        builder.check_unlabelled_characters()
-        points = explicit or [builder.marked_departure_point(departure_name)]
+        points = explicit or [mark if mark else builder.middle_departure_point()]
         rooms, doors = builder.rooms_behind_door_gaps(points[0], max_door_cells)
+    voids = builder.sealed_voids(points)
+    builder.check_departure_places(points, voids)
     site = Site(
         name=name if name is not None else layout.source,
         width_m=(layout.shape[1] - 1) * cell_m,
         height_m=(layout.shape[0] - 1) * cell_m,
-        walls=lattice.wall_segments(builder.wall, cell_m),
+        walls=lattice.wall_segments(builder.wall, cell_m, voids),
         rooms=tuple(rooms),
         doors=tuple(doors),
         entrance=builder.entrance_door(entrance),
@@ -299,22 +334,43 @@ def layout_to_site(
         seed=seed,
     )
     try:
-        validate_site(site)
+        checked = validate_site(site)
     except SiteValidationError as err:
         line, column = builder.line_column(err.position_m)
         raise LayoutError(layout.source, line, column, err.message) from err
-    return LayoutImport(site=site, mode=mode, rooms_found=len(rooms), doors_found=len(doors))
+    warnings = [*builder.warnings, *checked]
+    if warnings:
+        site = dataclasses.replace(site, warnings=tuple(builder.describe(w) for w in warnings))
+    return LayoutImport(
+        site=site,
+        mode=mode,
+        rooms_found=len(rooms),
+        doors_found=len(doors),
+        voids_found=builder.voids_found,
+    )
+
+
+def _nearest(value: float) -> int:
+    """The nearest integer, halves rounded down (a place between two characters is named by
+    the first one, whatever its parity)."""
+    return math.ceil(value - 0.5)
 
 
 class _SiteBuilder:
     """The steps of turning a layout into site parts; every error names line and column."""
 
-    def __init__(self, layout: Layout, cell_m: float) -> None:
+    def __init__(self, layout: Layout, cell_m: float, mode: LayoutMode) -> None:
         self.layout = layout
-        self.codes = layout.codes
         self.cell_m = cell_m
         self.n_rows, self.n_cols = layout.shape
-        self.wall = self.codes == WALL
+        self.warnings: list[SiteWarning] = []
+        self.voids_found = 0
+        codes = np.array(layout.codes, copy=True)
+        codes[codes == FLOOR] = FREE
+        if mode is LayoutMode.UNLABELLED:
+            self._free_meaningless_marks(codes)
+        self.codes = codes
+        self.wall = codes == WALL
         self.square_rooms = np.full((self.n_rows - 1, self.n_cols - 1), NO_ROOM, dtype=np.int64)
 
     def error(self, row: int | None, col: int | None, message: str) -> LayoutError:
@@ -325,6 +381,14 @@ class _SiteBuilder:
             message,
         )
 
+    def warn(self, row: float, col: float, message: str) -> None:
+        self.warnings.append(SiteWarning(message, position_m=self.xy(row, col)))
+
+    def describe(self, warning: SiteWarning) -> str:
+        """A warning as one line, ``file:line:column: message``."""
+        line, column = self.line_column(warning.position_m)
+        return str(LayoutError(self.layout.source, line, column, warning.message))
+
     def xy(self, row: float, col: float) -> tuple[float, float]:
         return lattice.vertex_to_xy(row, col, self.n_rows, self.cell_m)
 
@@ -333,9 +397,28 @@ class _SiteBuilder:
         if position_m is None:
             return (None, None)
         row, col = lattice.xy_to_vertex(position_m[0], position_m[1], self.n_rows, self.cell_m)
-        row = min(max(round(row), 0), self.n_rows - 1)
-        col = min(max(round(col), 0), self.n_cols - 1)
-        return (row + 1, col + 1)
+        row, col = _nearest(row), _nearest(col)
+        return (min(max(row, 0), self.n_rows - 1) + 1, min(max(col, 0), self.n_cols - 1) + 1)
+
+    def _free_meaningless_marks(self, codes: np.ndarray) -> None:
+        """In a plan, room letters, digits and inner door marks mean nothing: read them as
+        free space, as the authors' simulator does, with one warning per character."""
+        inner = np.zeros(codes.shape, dtype=bool)
+        inner[1:-1, 1:-1] = True
+        marks = inner & (
+            _is_label(codes) | _is_digit(codes) | (codes == ROOM_DOOR) | (codes == CORRIDOR_DOOR)
+        )
+        for code in np.unique(codes[marks]).tolist():
+            places = np.argwhere(marks & (codes == code))
+            row, col = (int(v) for v in places[0])
+            count = len(places)
+            msg = (
+                f'{chr(code)!r} ({count} place{"s" if count > 1 else ""}) has no meaning in an '
+                "unlabelled plan and is read as free space, as in the authors' simulator (a "
+                "labelled layout has door marks '/' or '#')"
+            )
+            self.warn(row, col, msg)
+        codes[marks] = FREE
 
     # Enclosure and entrance -------------------------------------------------------------
 
@@ -374,7 +457,7 @@ class _SiteBuilder:
                 continue
             previous_was_door = False
             if code != WALL:
-                what = 'a gap' if code == FREE else f'{chr(code)!r}'
+                what = 'a gap' if code == FREE else f'{chr(int(self.layout.codes[row, col]))!r}'
                 msg = (
                     f'the enclosure is open: the outer wall has {what} here; the first and last '
                     "lines and columns must be '%', except one run of '/' marking the entrance "
@@ -408,6 +491,14 @@ class _SiteBuilder:
         room_id = int(self.square_rooms[inner_square])
         return Door((*a, *b), () if room_id == NO_ROOM else (room_id,))
 
+    def _sealed(self) -> np.ndarray:
+        """Vertices that block: walls and the entrance (closed for every area check)."""
+        sealed = self.wall.copy()
+        border = np.ones_like(sealed)
+        border[1:-1, 1:-1] = False
+        sealed |= border & (self.codes == CORRIDOR_DOOR)
+        return sealed
+
     # Labelled layouts -------------------------------------------------------------------
 
     def labelled_rooms_and_doors(self) -> tuple[list[Room], list[Door]]:
@@ -432,8 +523,39 @@ class _SiteBuilder:
             rects = self._room_rects(room_id, where)
             is_digit = _DIGIT_FIRST <= code <= _DIGIT_LAST
             rooms.append(Room(room_id, rects, label=chr(code), has_victim=is_digit))
+        self._check_rooms_closed(rooms, components)
         self._check_rooms_have_openings(rooms, first_cell)
+        self._warn_room_shaped_departure_mark()
         return rooms, self._marked_doors()
+
+    def _ring(self, inside: np.ndarray) -> np.ndarray:
+        """(H, W) vertices around a vertex set: corners of the squares touching it, minus the
+        set itself."""
+        squares = inside[:-1, :-1] | inside[:-1, 1:] | inside[1:, :-1] | inside[1:, 1:]
+        corners = np.zeros_like(inside)
+        corners[:-1, :-1] |= squares
+        corners[:-1, 1:] |= squares
+        corners[1:, :-1] |= squares
+        corners[1:, 1:] |= squares
+        return corners & ~inside
+
+    def _warn_room_shaped_departure_mark(self) -> None:
+        """'D' marks the departure, never a room; a 'D' group walled in like a room (walls
+        and a door mark all round) is most likely a room lettered 'D', as the authors'
+        generator letters its fourth room."""
+        mark = self.codes == DEPARTURE
+        if not np.any(mark):
+            return
+        ring = self._ring(mark)
+        doors = (self.codes == CORRIDOR_DOOR) | (self.codes == ROOM_DOOR)
+        if np.all((self.wall | doors)[ring]) and np.any(doors[ring]):
+            row, col = (int(v) for v in np.argwhere(mark)[0])
+            msg = (
+                "the departure mark 'D' fills an area walled in like a room; 'D' is never a "
+                "room letter here (the authors' generator letters its fourth room 'D'): "
+                're-letter the room if it is one'
+            )
+            self.warn(row, col, msg)
 
     def _room_rects(self, room_id: int, where: tuple[slice, slice] | None) -> np.ndarray:
         """Rectangles of a room's squares; one rectangle when they fill their bounding box."""
@@ -486,6 +608,45 @@ class _SiteBuilder:
             msg = f'rooms {" and ".join(map(repr, labels))} touch without a wall between them'
             raise self.error(i, j, msg)
         self.square_rooms = square_rooms
+
+    def _check_rooms_closed(self, rooms: list[Room], components: np.ndarray) -> None:
+        """Every vertex around a room's letters is a wall or a door mark: a room open on a
+        side would spread its area (which spans its wall lines) over the corridor."""
+        closing = self.wall | (self.codes == CORRIDOR_DOOR) | (self.codes == ROOM_DOOR)
+        for room in rooms:
+            letters = components == room.room_id
+            holes = self._ring(letters) & ~closing
+            if np.any(holes):
+                raise self._open_room_error(room, letters, holes)
+
+    def _open_room_error(self, room: Room, letters: np.ndarray, holes: np.ndarray) -> LayoutError:
+        rows, cols = np.nonzero(letters)
+        r0, r1, c0, c1 = int(rows.min()), int(rows.max()), int(cols.min()), int(cols.max())
+        named = f'room {room.label!r} is not closed'
+        what = "neither '%' nor a door mark ('/' or '#')"
+        first = tuple(int(v) for v in np.argwhere(holes)[0])
+        if not np.all(letters[r0 : r1 + 1, c0 : c1 + 1]):  # not a rectangle
+            return self.error(*first, f'{named}: its wall has an opening here, {what}')
+        lines = {
+            'top': (r0 - 1, slice(c0, c1 + 1)),
+            'bottom': (r1 + 1, slice(c0, c1 + 1)),
+            'left': (slice(r0, r1 + 1), c0 - 1),
+            'right': (slice(r0, r1 + 1), c1 + 1),
+        }
+        for side in _SIDES:
+            row, col = lines[side]
+            if np.all(holes[row, col]):
+                if isinstance(row, int):
+                    span = f'line {row + 1}, columns {c0 + 1}-{c1 + 1}'
+                    place = (row, c0)
+                else:
+                    span = f'column {col + 1}, lines {r0 + 1}-{r1 + 1}'
+                    place = (r0, int(col))
+                return self.error(*place, f'{named}: its {side} wall ({span}) is missing')
+        r, c = first
+        sides = [s for s, hit in zip(_SIDES, (r < r0, r > r1, c < c0, c > c1), strict=True) if hit]
+        where = f'{sides[0]} wall' if len(sides) == 1 else f'{sides[0]}-{sides[1]} corner'
+        return self.error(r, c, f'{named}: its {where} has an opening here, {what}')
 
     def _check_rooms_have_openings(
         self, rooms: list[Room], first_cell: dict[int, tuple[int, int]]
@@ -561,28 +722,11 @@ class _SiteBuilder:
             raise LayoutError(self.layout.source, None, None, msg)
         return DeparturePoint(name, *self.xy(row, col))
 
-    # Unlabelled plans -------------------------------------------------------------------
-
-    def check_unlabelled_characters(self) -> None:
-        codes = self.codes
-        inner = np.zeros_like(self.wall)
-        inner[1:-1, 1:-1] = True
-        letters = (
-            (_is_label(codes) & (codes != DEPARTURE)) | _is_digit(codes) | (codes == ROOM_DOOR)
-        )
-        letters |= (codes == CORRIDOR_DOOR) & inner
-        if np.any(letters):
-            row, col = (int(v) for v in np.argwhere(letters)[0])
-            msg = (
-                f'{chr(int(codes[row, col]))!r} belongs to labelled layouts; an unlabelled plan '
-                "has only '%', ' ', 'D' and the entrance '/'"
-            )
-            raise self.error(row, col, msg)
-
-    def marked_departure_point(self, name: str) -> DeparturePoint:
+    def marked_departure_point(self, name: str) -> DeparturePoint | None:
+        """The point marked ``D`` (the centre of its group), or None without a mark."""
         marks, count = ndimage.label(self.codes == DEPARTURE)
         if count == 0:
-            raise self.error(None, None, "an unlabelled plan needs a departure point marked 'D'")
+            return None
         if count > 1:
             first = np.argwhere(marks == 1)[0]
             row, col = (int(v) for v in np.argwhere(marks == 2)[0])
@@ -595,14 +739,36 @@ class _SiteBuilder:
         row, col = cells.mean(axis=0)
         return DeparturePoint(name, *self.xy(float(row), float(col)))
 
+    def middle_departure_point(self) -> DeparturePoint:
+        """A plan without ``D``: the middle of the bounds, where the authors' simulator puts
+        its departure point then, named "center"."""
+        row, col = (self.n_rows - 1) / 2, (self.n_cols - 1) / 2
+        point = DeparturePoint('center', *self.xy(row, col))
+        place = f'line {row + 1:g}, column {col + 1:g}'
+        squares = self._squares_at(row, col)
+        on_wall = len({int(a) for a in self._areas_at(squares)}) != 1
+        if on_wall or all(self._solid[s] for s in squares):
+            msg = (
+                f"the plan has no departure mark 'D' and its middle ({place}), where the "
+                "authors' simulator starts then, is in a wall; mark the departure with 'D'"
+            )
+            raise self.error(_nearest(row), _nearest(col), msg)
+        msg = (
+            f"no departure mark 'D': departure point 'center' is the middle of the plan "
+            f"({place}), as in the authors' simulator"
+        )
+        self.warn(row, col, msg)
+        return point
+
+    # Unlabelled plans -------------------------------------------------------------------
+
     def rooms_behind_door_gaps(
         self, departure: DeparturePoint, max_door_cells: int
     ) -> tuple[list[Room], list[Door]]:
         blocked = self.codes == DEPARTURE  # a departure mark is never a door
         gaps = find_door_gaps(self.wall, blocked, max_door_cells)
         closed, closed_h, closed_v = closing_masks(gaps, self.wall.shape)
-        sealed = self.wall | (self.codes == CORRIDOR_DOOR)  # the entrance is closed too
-        areas, _ = lattice.square_labels(sealed, closed, closed_h, closed_v)
+        areas, _ = lattice.square_labels(self._sealed(), closed, closed_h, closed_v)
         row, col = lattice.xy_to_vertex(departure.x_m, departure.y_m, self.n_rows, self.cell_m)
         start_area = int(areas[min(int(row), self.n_rows - 2), min(int(col), self.n_cols - 2)])
         sides: list[tuple[int, int]] = []
@@ -613,7 +779,6 @@ class _SiteBuilder:
             else:
                 sides.append((int(areas[r, c - 1]), int(areas[r, c])))
         behind_doors = {a for pair in sides if pair[0] != pair[1] for a in pair} - {start_area}
-        self._check_enclosed_areas(areas, behind_doors | {start_area})
         ordered = sorted(behind_doors, key=lambda a: int(np.flatnonzero(areas == a)[0]))
         room_of_area = {area: index + 1 for index, area in enumerate(ordered)}
         rooms = []
@@ -634,13 +799,110 @@ class _SiteBuilder:
             doors.append(Door(segment, room_ids))
         return rooms, doors
 
-    def _check_enclosed_areas(self, areas: np.ndarray, known: set[int]) -> None:
-        """Every area that is neither solid wall mesh, nor the departure's, nor behind a door
-        gap is a closed room without a door."""
-        solid = lattice.solid_squares(self.wall | (self.codes == CORRIDOR_DOOR))
-        stray = ~solid & ~np.isin(areas, list(known))
-        if np.any(stray):
-            i, j = (int(v) for v in np.argwhere(stray)[0])
-            corners = [(i, j), (i, j + 1), (i + 1, j), (i + 1, j + 1)]
-            row, col = next(((r, c) for r, c in corners if not self.wall[r, c]), (i, j))
-            raise self.error(row, col, 'an enclosed area has no door (no gap in its walls)')
+    # Free areas: sealed voids and where the departure points are -------------------------
+
+    @cached_property
+    def _solid(self) -> np.ndarray:
+        """(H-1, W-1) squares with four wall corners (the entrance counts as wall)."""
+        return lattice.solid_squares(self._sealed())
+
+    @cached_property
+    def _areas(self) -> np.ndarray:
+        """(H-1, W-1) labels of the free areas as the walls close them (doors open)."""
+        return lattice.square_labels(self._sealed())[0]
+
+    def _areas_at(self, squares: list[tuple[int, int]]) -> list[int]:
+        areas, solid = self._areas, self._solid
+        return [int(areas[s]) for s in squares if not solid[s]]
+
+    def _squares_at(self, row: float, col: float) -> list[tuple[int, int]]:
+        """The squares whose closed area holds the (fractional) vertex position."""
+
+        def span(value: float, count: int) -> list[int]:
+            low = math.floor(value)
+            cells = [low - 1, low] if value == low else [low]
+            return [i for i in cells if 0 <= i < count]
+
+        rows = span(row, self.n_rows - 1)
+        cols = span(col, self.n_cols - 1)
+        return [(i, j) for i in rows for j in cols]
+
+    def sealed_voids(self, points: list[DeparturePoint]) -> np.ndarray:
+        """(H-1, W-1) squares of the sealed voids: free areas enclosed by walls that hold no
+        room and no departure point. They are read as solid, with a warning each."""
+        areas, solid = self._areas, self._solid
+        keep = set(np.unique(areas[self.square_rooms != NO_ROOM]).tolist())
+        for point in points:
+            keep.update(self._areas_at(self._point_squares(point)))
+        candidates = np.unique(areas[~solid]).tolist()
+        voids = np.zeros_like(solid)
+        for area in candidates:
+            if area in keep:
+                continue
+            mask = (areas == area) & ~solid
+            voids |= mask
+            self.voids_found += 1
+            rows, cols = np.nonzero(mask)
+            row, col = self._area_place(mask)
+            size = int(mask.sum())
+            span = (
+                f'lines {rows.min() + 1}-{rows.max() + 2}, '
+                f'columns {cols.min() + 1}-{cols.max() + 2}'
+            )
+            msg = (
+                f'an enclosed area with no door ({size} cell{"s" if size > 1 else ""}, {span}) '
+                'holds no room and no departure point; it is read as solid'
+            )
+            self.warn(row, col, msg)
+        return voids
+
+    def _area_place(self, squares: np.ndarray) -> tuple[int, int]:
+        """A free corner vertex of an area's first square (in reading order)."""
+        i, j = (int(v) for v in np.argwhere(squares)[0])
+        corners = ((i, j), (i, j + 1), (i + 1, j), (i + 1, j + 1))
+        return next(((r, c) for r, c in corners if not self.wall[r, c]), (i + 1, j + 1))
+
+    def _point_squares(self, point: DeparturePoint) -> list[tuple[int, int]]:
+        row, col = lattice.xy_to_vertex(point.x_m, point.y_m, self.n_rows, self.cell_m)
+        return self._squares_at(row, col)
+
+    def check_departure_places(self, points: list[DeparturePoint], voids: np.ndarray) -> None:
+        """A departure point inside a solid block (an island of the plan), or in an enclosed
+        area that no room can be reached from while the plan has rooms, or that is smaller
+        than a sealed void, is an error. (One on a wall line is left to the validation,
+        which reports it as inside a wall.)"""
+        areas, solid = self._areas, self._solid
+        has_rooms = bool(np.any(self.square_rooms != NO_ROOM))
+        for point in points:
+            row, col = lattice.xy_to_vertex(point.x_m, point.y_m, self.n_rows, self.cell_m)
+            squares = self._squares_at(row, col)
+            place = (_nearest(row), _nearest(col))
+            named = f'departure point {point.name!r}'
+            if squares and all(solid[s] for s in squares):
+                msg = (
+                    f'{named} lies inside a solid block of wall (an island of the plan, with '
+                    "no free space around it); move it to a corridor, e.g. with a 'D' mark"
+                )
+                raise self.error(*place, msg)
+            held = set(self._areas_at(squares))
+            if len(held) != 1:
+                continue  # on a wall line
+            mine = areas == held.pop()
+            size = int(mine.sum())
+            if has_rooms and not np.any(self.square_rooms[mine] != NO_ROOM):
+                msg = (
+                    f'{named} lies in an enclosed area of {size} cells that leads to no room '
+                    '(no door in its walls); move it to a corridor'
+                )
+                raise self.error(*place, msg)
+            if np.any(voids):
+                void_ids, sizes = np.unique(areas[voids], return_counts=True)
+                largest = int(np.argmax(sizes))
+                if sizes[largest] > size:
+                    i, j = self._area_place((areas == void_ids[largest]) & voids)
+                    msg = (
+                        f'{named} lies in an enclosed area of {size} cells with no door, cut '
+                        f'off from a larger one of {int(sizes[largest])} cells (line {i + 1}, '
+                        f'column {j + 1}); move it there'
+                    )
+                    raise self.error(*place, msg)

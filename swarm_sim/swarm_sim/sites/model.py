@@ -226,6 +226,10 @@ class Site:
         grid_m: spacing of the grid the site was drawn on (4/15 m for generated and ``.lay``
             sites), or None for free-form sites. Room lookups use it as their resolution.
         seed: seed of the generator run that produced the site, or None.
+        warnings: one-line notes on problems the site was made usable despite (a sealed void
+            read as solid, a departure point inside a room, characters read as free space),
+            each naming its place; set by the importers and the site-file loader, logged by
+            the command-line tools. Not written to site files.
     """
 
     name: str
@@ -238,6 +242,7 @@ class Site:
     departure_points: Mapping[str, DeparturePoint] = field(default_factory=dict)
     grid_m: float | None = None
     seed: int | None = None
+    warnings: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         width, height = float(self.width_m), float(self.height_m)
@@ -279,6 +284,10 @@ class Site:
             object.__setattr__(self, 'grid_m', grid)
         if self.seed is not None:
             object.__setattr__(self, 'seed', int(self.seed))
+        warnings = self.warnings
+        if isinstance(warnings, str) or not all(isinstance(w, str) for w in warnings):
+            raise SiteError('warnings must be a sequence of strings')
+        object.__setattr__(self, 'warnings', tuple(warnings))
 
     def __repr__(self) -> str:
         points = ', '.join(self.departure_points)

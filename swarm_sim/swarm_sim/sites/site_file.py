@@ -11,6 +11,7 @@ gives the same site to that precision.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Callable
 from pathlib import Path
@@ -124,10 +125,13 @@ def parse_site(text: str, source: str = '<site>') -> Site:
     reader = _Reader(source, lines)
     site = reader.site(data)
     try:
-        validate_site(site)
+        warnings = validate_site(site)
     except SiteValidationError as err:
         raise reader.error(err.key_path, err.message) from err
-    return site
+    if not warnings:
+        return site
+    texts = tuple(str(reader.error(w.key_path, w.message)) for w in warnings)
+    return dataclasses.replace(site, warnings=texts)
 
 
 def _compose(text: str, source: str) -> tuple[Any, dict[KeyPath, int]]:

@@ -11,6 +11,9 @@ sites.
 4. Every room is reachable from every departure point through its doors; a room that cannot
    be reached and is named by no door is reported as a room with no door.
 
+A departure point inside a room is not an error (robots can leave through its door) but a
+warning, which says whether the room is *nested* (its doors open only into other rooms).
+
 Reachability is decided on a raster of the free space in which the walls are drawn as
 8-connected lines and flooded 4-connected, so no path slips between two wall cells. Sites on
 a grid are rasterized at a quarter of their grid spacing with wall lines in the middle of
@@ -25,12 +28,13 @@ from typing import Final
 import numpy as np
 from scipy import ndimage
 
-from swarm_sim.sites.errors import SiteValidationError
-from swarm_sim.sites.model import NO_ROOM, Door, Site
+from swarm_sim.sites.errors import SiteValidationError, SiteWarning
+from swarm_sim.sites.model import NO_ROOM, Door, Room, Site
 
 __all__ = [
     'DEFAULT_ROBOT_RADIUS_M',
     'FreeSpaceRaster',
+    'departure_room_warnings',
     'free_space_raster',
     'point_segment_distances',
     'validate_site',
@@ -113,8 +117,13 @@ def free_space_raster(site: Site, *, sealed: bool = True) -> FreeSpaceRaster:
     return FreeSpaceRaster(walls, site.width_m, site.height_m, resolution)
 
 
-def validate_site(site: Site, *, robot_radius_m: float = DEFAULT_ROBOT_RADIUS_M) -> None:
+def validate_site(
+    site: Site, *, robot_radius_m: float = DEFAULT_ROBOT_RADIUS_M
+) -> tuple[SiteWarning, ...]:
     """Check the invariants listed in the module docstring.
+
+    Returns:
+        the warnings: departure points that lie inside a room.
 
     Raises:
         SiteValidationError: the first violated invariant, with the place (metres) and the
@@ -188,6 +197,40 @@ def validate_site(site: Site, *, robot_radius_m: float = DEFAULT_ROBOT_RADIUS_M)
             raise SiteValidationError(msg, position_m=(lx, ly), key_path=('rooms', index))
     if site.entrance is not None:
         _check_entrance_opens(site, site.entrance)
+    return tuple(departure_room_warnings(site))
+
+
+def departure_room_warnings(site: Site) -> list[SiteWarning]:
+    """A warning for every departure point that lies inside a room (robots would start in
+    that room, not in a corridor), saying whether the room is nested in other rooms."""
+    points = list(site.departure_points.values())
+    if not points or not site.rooms:
+        return []
+    room_ids = site.room_ids_at(np.array([p.xy for p in points], dtype=np.float64))
+    warnings = []
+    for point, room_id in zip(points, room_ids.tolist(), strict=True):
+        if room_id == NO_ROOM:
+            continue
+        room = site.room(room_id)
+        doors = [door for door in site.doors if room_id in door.room_ids]
+        outer = sorted({i for door in doors for i in door.room_ids} - {room_id})
+        nested = bool(doors) and all(len(door.room_ids) == 2 for door in doors)
+        x, y = point.xy
+        where = f'departure point {point.name!r} at ({x:.3f}, {y:.3f}) m lies inside '
+        if nested:
+            into = ', '.join(_room_name(site.room(i)) for i in outer)
+            what = f'{_room_name(room)}, a room nested in {into} (its doors open only into rooms)'
+        else:
+            what = _room_name(room)
+        msg = f'{where}{what}: robots start in that room, not in a corridor'
+        warnings.append(
+            SiteWarning(msg, position_m=point.xy, key_path=('departure_points', point.name))
+        )
+    return warnings
+
+
+def _room_name(room: Room) -> str:
+    return f'room {room.room_id}' + (f' ({room.label!r})' if room.label else '')
 
 
 def _check_door_widths(site: Site, robot_radius_m: float) -> None:

@@ -363,6 +363,14 @@ class NodeParameters:
             return result
         for callback in self._on_set_parameters_callbacks:
             result = callback(parameter_list)
+            if not isinstance(result, set_result_class):
+                warnings.warn(
+                    'Callback returned an invalid type, it should return SetParameterResult.',
+                    stacklevel=2,
+                )
+                return set_result_class(
+                    successful=False, reason='Callback returned an invalid type'
+                )
             if not result.successful:
                 return result
         new: list[Parameter] = []
@@ -541,7 +549,14 @@ class NodeParameters:
         self._pre_set_parameters_callbacks.insert(0, callback)
 
     def add_on_set_parameters_callback(self, callback: Callable[[list[Parameter]], Any]) -> None:
-        """Call ``callback(parameters) -> SetParametersResult`` to accept or reject values."""
+        """Call ``callback(parameters) -> SetParametersResult`` to accept or reject values.
+
+        Raises:
+            TypeError: ``callback`` is not callable.
+        """
+        if not callable(callback):
+            msg = f'Callback must be callable, got {type(callback)}'
+            raise TypeError(msg)
         self._on_set_parameters_callbacks.insert(0, callback)
 
     def add_post_set_parameters_callback(self, callback: Callable[[list[Parameter]], None]) -> None:
