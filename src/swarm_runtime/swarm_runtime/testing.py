@@ -274,7 +274,8 @@ class NodeTestBed:
         """The nodes' time in seconds: the probe's ``/clock`` if it runs one, else wall time."""
         return self.probe.now_s()
 
-    def _wall_now_s(self) -> float:
+    def wall_time_s(self) -> float:
+        """Wall time in seconds: the built-in runtime's virtual wall clock, or the host's."""
         if using_real_rclpy():
             return time.monotonic()
         from swarm_runtime.simulation import wall_time_s
@@ -312,9 +313,9 @@ class NodeTestBed:
                 lambda: self.probe.sim_time_s() >= end - 1e-9, timeout_s=10.0 + 20.0 * seconds
             )
         else:
-            end = self._wall_now_s() + seconds
+            end = self.wall_time_s() + seconds
             reached = self.spin_until(
-                lambda: self._wall_now_s() >= end - 1e-9, timeout_s=seconds + 1.0
+                lambda: self.wall_time_s() >= end - 1e-9, timeout_s=seconds + 1.0
             )
         if not reached:
             msg = f'spin_for({seconds}) did not get that far'
