@@ -13,8 +13,7 @@ number, or the next id no other test process on the machine holds) and discovery
 this host (``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST``); both are set before rclpy is
 imported, and child processes that tests start inherit them (swarm_runtime.dds_isolation).
 Tests marked ``builtin_only(reason)`` hold only on the built-in runtime (bit-exact
-determinism, virtual wall time) and are skipped on real rclpy with their reason; tests listed
-in tests/rclpy_pending.txt are not ported to real rclpy yet and are skipped there too.
+determinism, virtual wall time) and are skipped on real rclpy with their reason.
 
 The workspace's Python packages are imported here, from wherever they are installed (the
 development virtualenv or a colcon overlay), before pytest collects anything: pytest's
@@ -88,24 +87,8 @@ def pytest_configure(config: pytest.Config) -> None:
     settings.load_profile('ci')
 
 
-PENDING_FILE = Path(__file__).resolve().parent / 'tests' / 'rclpy_pending.txt'
-
-
-def _pending_on_rclpy() -> dict[str, str]:
-    """``{'<file name>::<function>': reason}`` from tests/rclpy_pending.txt."""
-    pending: dict[str, str] = {}
-    section = ''
-    for raw in PENDING_FILE.read_text().splitlines():
-        line = raw.split('#', 1)[0].strip()
-        if line.startswith('[') and line.endswith(']'):
-            section = line[1:-1]
-        elif line:
-            pending[line] = section
-    return pending
-
-
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
-    """On real rclpy, skip ``builtin_only`` tests and those pending a port, with the reason."""
+    """On real rclpy, skip ``builtin_only`` tests, with their reason."""
     marked = [(item, item.get_closest_marker('builtin_only')) for item in items]
     marked = [(item, marker) for item, marker in marked if marker is not None]
     for item, marker in marked:
@@ -120,9 +103,3 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
     for item, marker in marked:
         reason = marker.kwargs.get('reason') or marker.args[0]
         item.add_marker(pytest.mark.skip(reason=f'built-in runtime only: {reason}'))
-    pending = _pending_on_rclpy()
-    for item in items:
-        name = getattr(item, 'originalname', item.name)
-        reason = pending.get(f'{Path(str(item.path)).name}::{name}')
-        if reason is not None:
-            item.add_marker(pytest.mark.skip(reason=f'not ported to real rclpy yet: {reason}'))

@@ -158,14 +158,14 @@ def test_oabug_runs_on_the_drivers_and_its_pump_pulses_reach_the_line(robot):
         )
         moving = bed.spin_until(
             lambda: any(c.linear.x != 0.0 or c.angular.z != 0.0 for c in commands),
-            timeout_s=10.0,
+            timeout_s=30.0,
         )
         assert moving, f'OA-Bug never moved; last state: {states[-1] if states else None}'
         bed.spin_for(0.5)
         # The node publishes its state on every staleness change, so the last one is current.
         assert states, 'OA-Bug published no state'
         assert not states[-1].inputs_stale
-        bed.spin_until(lambda: len(pump_output.transitions) >= 2, timeout_s=10.0)
+        bed.spin_until(lambda: len(pump_output.transitions) >= 2, timeout_s=20.0)
         bed.probe.node.destroy_timer(heartbeat)
     finally:
         locator.close()
