@@ -42,6 +42,7 @@ from swarm_experiments.mission import (
     run_mission,
 )
 from swarm_experiments.node_overrides import parse_overrides
+from swarm_experiments.runtime_option import add_runtime_arguments, check_runtime
 
 __all__ = [
     'ACTION_LENGTH_M',
@@ -110,6 +111,7 @@ class SpawnSettings:
     out_dir: Path | None = None
     robot_parameters: dict[str, object] = field(default_factory=dict)
     engine: EngineConfig = field(default_factory=EngineConfig)
+    time_scale: float = 1.0
 
     def __post_init__(self) -> None:
         if self.variant not in VARIANTS:
@@ -229,6 +231,7 @@ def build_mission(config: SpawnSettings) -> tuple[MissionSpec, float]:
         max_sim_time_s=config.budget_s,
         engine_config=engine,
         recording=recording,
+        time_scale=config.time_scale,
     )
     return spec, bias
 
@@ -345,6 +348,7 @@ def _parser() -> argparse.ArgumentParser:
         help='set an OA-Bug node parameter for every robot (repeatable), e.g. '
         'gas_threshold=300 or sound_turn_rule=toward; names and defaults: docs/oabug.md',
     )
+    add_runtime_arguments(parser)
     return parser
 
 
@@ -352,6 +356,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Command line entry point; returns the process exit code."""
     args = _parser().parse_args(argv)
     try:
+        check_runtime(args.runtime)
         config = SpawnSettings(
             robot_parameters=oabug_parameter_overrides(args.param),
             site=args.site,
@@ -365,6 +370,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             record=args.record,
             record_scans=args.record_scans,
             out_dir=None if args.no_plots else args.out,
+            time_scale=args.time_scale,
         )
         site_warnings = load_site(config.site, seed=config.site_seed).warnings
     except SwarmError as err:

@@ -48,6 +48,11 @@ from swarm_experiments.mission import (
 )
 from swarm_experiments.node_overrides import parse_overrides
 from swarm_experiments.open_field import point_robot_engine_config
+from swarm_experiments.runtime_option import (
+    RuntimeOptionError,
+    add_runtime_arguments,
+    check_runtime,
+)
 
 __all__ = [
     'ALGORITHMS',
@@ -101,6 +106,7 @@ class SpawnSettings:
         record: bag directory to write, or None.
         out_dir: where the PNGs go (None: no plots).
         extra_parameters: further node parameters (name -> value).
+        time_scale: on real rclpy, sim seconds per wall second (MissionSpec.time_scale).
     """
 
     algorithm: str = 'bayes_swarm_p'
@@ -117,6 +123,7 @@ class SpawnSettings:
     record: Path | None = None
     out_dir: Path | None = None
     extra_parameters: dict[str, Any] = field(default_factory=dict)
+    time_scale: float = 1.0
 
 
 @dataclass
@@ -340,6 +347,7 @@ def run(settings: SpawnSettings, progress: Any = None) -> BayesSwarmRun:
         max_sim_time_s=case.max_mission_time_s + 2.0,
         engine_config=_engine_config(case, settings.seed),
         bridge_parameters=bridge_parameters,
+        time_scale=settings.time_scale,
         extensions=[SignalExtension(model)],
         stop_when_all_rooms_covered=False,
         recording=recording,
@@ -451,6 +459,7 @@ def build_parser() -> argparse.ArgumentParser:
         help='set a bayes_swarm node parameter for every robot (repeatable), e.g. '
         'horizon_s=20; names and defaults: ros2 param describe, or bayes_swarm.node_settings',
     )
+    add_runtime_arguments(parser)
     return parser
 
 
@@ -458,8 +467,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``spawn_bayes_swarm``; returns the exit status."""
     args = build_parser().parse_args(argv)
     try:
+        check_runtime(args.runtime)
         extra = node_parameter_overrides(args.param)
-    except ConfigurationError as err:
+    except (ConfigurationError, RuntimeOptionError) as err:
         return fail('spawn_bayes_swarm', err)
     settings = SpawnSettings(
         extra_parameters=extra,
@@ -476,6 +486,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         outer_optimizer=args.outer_optimizer,
         record=args.record,
         out_dir=None if args.no_plots else args.out,
+        time_scale=args.time_scale,
     )
 
     def progress(report: Any) -> None:

@@ -47,6 +47,11 @@ from swarm_experiments.mission import (
 )
 from swarm_experiments.node_overrides import parse_overrides
 from swarm_experiments.open_field import point_robot_engine_config
+from swarm_experiments.runtime_option import (
+    RuntimeOptionError,
+    add_runtime_arguments,
+    check_runtime,
+)
 
 __all__ = ['SCHEMES', 'MscPfRun', 'SpawnSettings', 'controller_parameter_overrides', 'main', 'run']
 
@@ -84,6 +89,7 @@ class SpawnSettings:
         record: bag directory to write, or None.
         out_dir: where the PNGs go (None: no plots).
         extra_parameters: further msc_pf node parameters (name -> value).
+        time_scale: on real rclpy, sim seconds per wall second (MissionSpec.time_scale).
     """
 
     scheme: str = 'proposed'
@@ -100,6 +106,7 @@ class SpawnSettings:
     record: Path | None = None
     out_dir: Path | None = None
     extra_parameters: dict[str, Any] = field(default_factory=dict)
+    time_scale: float = 1.0
 
 
 @dataclass
@@ -238,6 +245,7 @@ def run(settings: SpawnSettings, progress: Any = None) -> MscPfRun:
             'comm_range_m': float(settings.comm_range_m),
             'peer_loss_probability': float(settings.loss_probability),
         },
+        time_scale=settings.time_scale,
         extensions=[extension],
         stop_when_all_rooms_covered=False,
         recording=recording,
@@ -354,6 +362,7 @@ def build_parser() -> argparse.ArgumentParser:
         help='set an msc_pf controller parameter for every robot (repeatable), e.g. '
         'msc.leader_rule=pbest; names and defaults: msc_pf/config/msc_pf.yaml',
     )
+    add_runtime_arguments(parser)
     return parser
 
 
@@ -362,8 +371,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     targets = args.targets if args.target_positions is None else len(args.target_positions)
     try:
+        check_runtime(args.runtime)
         extra = controller_parameter_overrides(args.param)
-    except ConfigurationError as err:
+    except (ConfigurationError, RuntimeOptionError) as err:
         return fail('spawn_msc_pf', err)
     settings = SpawnSettings(
         extra_parameters=extra,
@@ -377,6 +387,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         target_positions_m=args.target_positions,
         record=args.record,
         out_dir=None if args.no_plots else args.out,
+        time_scale=args.time_scale,
     )
 
     def report(p: MissionProgress) -> None:
