@@ -7,18 +7,34 @@ VARIANT ?= gas_sound
 SEED ?= 1
 OUT ?= runs/demo
 
-.PHONY: bootstrap demo test lint typecheck colcon-check bench clean
+# Extra pytest arguments for the test targets, e.g. make test PYTEST_ARGS='-k oabug'.
+PYTEST_ARGS ?=
+
+.PHONY: bootstrap demo test test-builtin test-rclpy lint typecheck colcon-check bench clean
 
 bootstrap:
 	@scripts/bootstrap.sh
 
+# The demo is a single-process simulation: the built-in runtime's deterministic sim time.
 demo: bootstrap
 	rm -rf $(OUT)
-	$(VENV)/bin/spawn --site small --robots $(ROBOTS) --variant $(VARIANT) --seed $(SEED) \
+	SWARM_RUNTIME=builtin $(VENV)/bin/spawn --site small --robots $(ROBOTS) --variant $(VARIANT) --seed $(SEED) \
 		--record $(OUT)/bag --out $(OUT)
 
-test: bootstrap
-	$(PY) -m pytest -n 2 -q
+# The whole suite on both ROS runtimes (docs/runtime.md): the built-in one, then real rclpy
+# on DDS where scripts/install_ros_wheels.sh could install it.
+test: test-builtin test-rclpy
+
+test-builtin: bootstrap
+	SWARM_RUNTIME=builtin $(PY) -m pytest -n 2 -q $(PYTEST_ARGS)
+
+test-rclpy: bootstrap
+	@if $(PY) -c 'import rclpy' 2>/dev/null; then \
+		echo "SWARM_RUNTIME=rclpy $(PY) -m pytest -n 2 -q $(PYTEST_ARGS)"; \
+		SWARM_RUNTIME=rclpy $(PY) -m pytest -n 2 -q $(PYTEST_ARGS); \
+	else \
+		echo "[test-rclpy] no real rclpy in $(VENV) (see scripts/install_ros_wheels.sh): skipped"; \
+	fi
 
 lint: bootstrap
 	$(VENV)/bin/ruff check .

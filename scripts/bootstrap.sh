@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Prepare a development machine: Debian packages the tests need, then one virtualenv (.venv)
 # with every ament_python package of the workspace installed editable from its own setup.py,
-# all third-party versions taken from constraints.txt.
+# all third-party versions taken from constraints.txt, then real ROS 2 Jazzy from its wheels
+# where they exist (scripts/install_ros_wheels.sh).
 #
 # Safe to run repeatedly: it does nothing when the virtualenv is already up to date.
 # Environment: PYTHON (interpreter for the virtualenv, default python3), VENV (default .venv).
@@ -54,4 +55,6 @@ install_python_packages() {
 
 install_debian_packages
 install_python_packages
+# Real ROS 2 Jazzy (rclpy and the generated interfaces) where wheels exist; else one line.
+VENV="$VENV" scripts/install_ros_wheels.sh
 log "ready: $VENV"

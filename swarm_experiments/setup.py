@@ -43,9 +43,9 @@ setup(
     license='Apache-2.0',
     entry_points={
         'console_scripts': [
-            'spawn = swarm_experiments.spawn:main',
-            'spawn_bayes_swarm = swarm_experiments.spawn_bayes_swarm:main',
-            'spawn_msc_pf = swarm_experiments.spawn_msc_pf:main',
+            'spawn = swarm_experiments.runtime_option:spawn_main',
+            'spawn_bayes_swarm = swarm_experiments.runtime_option:spawn_bayes_swarm_main',
+            'spawn_msc_pf = swarm_experiments.runtime_option:spawn_msc_pf_main',
             'swarm_study = swarm_experiments.study.cli:main',
         ],
         'swarm_experiments.studies': [

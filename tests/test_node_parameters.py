@@ -3,9 +3,7 @@
 from __future__ import annotations
 
 import pytest
-from swarm_runtime.ros import Parameter, rclpy, using_real_rclpy
-
-pytestmark = pytest.mark.skipif(using_real_rclpy(), reason='nodes need the built-in messages')
+from swarm_runtime.ros import Parameter, rclpy
 
 
 @pytest.fixture

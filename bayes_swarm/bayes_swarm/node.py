@@ -21,14 +21,12 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-from swarm_common.cli import fail
-from swarm_runtime.parameters import ParameterFileError, check_parameter_arguments, declare_config
+from swarm_runtime.node_main import run_node
+from swarm_runtime.parameters import declare_config
 from swarm_runtime.ros import (
-    ExternalShutdownException,
     Node,
     message_module,
     qos_profile_sensor_data,
-    rclpy,
 )
 
 from bayes_swarm import conversions
@@ -160,22 +158,16 @@ class BayesSwarmNode(Node):
             )
 
 
-def main(args: list[str] | None = None) -> None:
+def main(args: list[str] | None = None) -> int:
     """Entry point of ``ros2 run bayes_swarm bayes_swarm_node``."""
-    try:
-        check_parameter_arguments(BAYES_SWARM_PARAMETERS, NODE_NAME, args)
-    except ParameterFileError as err:
-        raise SystemExit(fail(NODE_NAME, err)) from None
-    rclpy.init(args=args)
-    node = None
-    try:
-        node = BayesSwarmNode()
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    except BayesSwarmError as err:
-        rclpy.logging.get_logger('bayes_swarm').error(str(err))
-    finally:
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
+    return run_node(
+        BayesSwarmNode,
+        args,
+        name=NODE_NAME,
+        fatal_errors=(BayesSwarmError,),
+        parameters=BAYES_SWARM_PARAMETERS,
+    )
+
+
+if __name__ == '__main__':
+    raise SystemExit(main())

@@ -19,7 +19,8 @@ from bayes_swarm.errors import ConfigError, ObservationError
 from bayes_swarm.follower import FollowerConfig, WaypointFollower
 from bayes_swarm.messages import Decision, DecisionKind, PeerUpdate
 from bayes_swarm.node_settings import settings_from_values
-from swarm_runtime.messages import cdr_roundtrip, get_message_module
+from swarm_runtime.ros import message_module
+from swarm_runtime.testing import cdr_roundtrip
 
 
 def test_peer_update_survives_a_cdr_round_trip():
@@ -50,7 +51,7 @@ def test_empty_peer_update_round_trips_with_empty_arrays():
 
 
 def test_peer_message_with_mismatched_arrays_is_rejected():
-    msg = get_message_module('swarm_interfaces').BayesSwarmPeer(
+    msg = message_module('swarm_interfaces').BayesSwarmPeer(
         robot='r1', sample_x=[1.0, 2.0], sample_y=[1.0], sample_value=[0.5, 0.6]
     )
     with pytest.raises(ObservationError, match='r1'):
@@ -85,7 +86,7 @@ def test_stamps_convert_both_ways():
 
 
 def test_odometry_yaw_comes_from_the_quaternion():
-    nav = get_message_module('nav_msgs')
+    nav = message_module('nav_msgs')
     msg = nav.Odometry()
     msg.pose.pose.position.x = 1.0
     msg.pose.pose.orientation.z = math.sin(0.6 / 2)

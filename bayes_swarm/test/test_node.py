@@ -1,4 +1,7 @@
-"""The node on the built-in runtime: fail-safe stop, bad samples, duplicated peer messages."""
+"""The node through its topics: fail-safe stop, bad samples, duplicated peer messages.
+
+Runs on either runtime (real DDS with rclpy): inputs go out once the graph has matched.
+"""
 
 import math
 
@@ -7,43 +10,29 @@ import pytest
 from bayes_swarm.conversions import peer_update_to_ros
 from bayes_swarm.messages import PeerUpdate
 from bayes_swarm.node import BayesSwarmNode
-from swarm_runtime.messages import get_message_module
-from swarm_runtime.ros import Parameter, SingleThreadedExecutor, rclpy, using_real_rclpy
+from swarm_runtime.ros import Parameter, message_module, qos_profile_sensor_data
+from swarm_runtime.testing import NodeTestBed
 
-pytestmark = pytest.mark.skipif(using_real_rclpy(), reason='drives the built-in runtime')
-
-nav = get_message_module('nav_msgs')
-geometry = get_message_module('geometry_msgs')
-swarm = get_message_module('swarm_interfaces')
+nav = message_module('nav_msgs')
+geometry = message_module('geometry_msgs')
+swarm = message_module('swarm_interfaces')
 
 
 @pytest.fixture
 def graph():
-    from swarm_runtime.simulation import spin_until, wall_time_s
-
-    rclpy.init(args=[])
-    node = BayesSwarmNode(namespace='/r0', parameter_overrides=[Parameter('robot_index', value=0)])
-    probe = rclpy.create_node('probe')
-    commands = []
-    probe.create_subscription(geometry.Twist, '/r0/cmd_vel', commands.append, 10)
-    pubs = {
-        'odom': probe.create_publisher(nav.Odometry, '/r0/odom', 10),
-        'signal': probe.create_publisher(swarm.SignalSample, '/r0/signal', 10),
-        'peers': probe.create_publisher(swarm.BayesSwarmPeer, '/r0/peers/in', 10),
-    }
-    executor = SingleThreadedExecutor()
-    executor.add_node(node)
-    executor.add_node(probe)
-
-    def spin_for(seconds):
-        end = wall_time_s() + seconds
-        spin_until(executor, lambda: wall_time_s() >= end)
-
-    yield node, pubs, commands, spin_for
-    executor.shutdown()
-    node.destroy_node()
-    probe.destroy_node()
-    rclpy.try_shutdown()
+    with NodeTestBed() as bed:
+        node = bed.add_node(
+            BayesSwarmNode, namespace='/r0', parameter_overrides=[Parameter('robot_index', value=0)]
+        )
+        commands = bed.probe.collect('/r0/cmd_vel', geometry.Twist)
+        sensor_qos = qos_profile_sensor_data
+        pubs = {
+            'odom': bed.probe.player('/r0/odom', nav.Odometry, sensor_qos),
+            'signal': bed.probe.player('/r0/signal', swarm.SignalSample, sensor_qos),
+            'peers': bed.probe.player('/r0/peers/in', swarm.BayesSwarmPeer, 10),
+        }
+        bed.wait_for_graph()
+        yield node, pubs, commands, bed
 
 
 def odom(x=0.0, y=0.0):
@@ -55,34 +44,41 @@ def odom(x=0.0, y=0.0):
 
 
 def test_node_decides_with_fresh_odometry_and_stops_when_it_goes_stale(graph):
-    node, pubs, commands, spin_for = graph
+    node, pubs, commands, bed = graph
     pubs['odom'].publish(odom())
-    spin_for(0.2)
+    assert bed.spin_until(lambda: node.decisions)
+    assert bed.spin_until(lambda: any(c.linear.x > 0.0 or c.angular.z != 0.0 for c in commands))
     assert len(node.decisions) == 1
-    assert any(c.linear.x > 0.0 or c.angular.z != 0.0 for c in commands)
-    spin_for(1.0)  # no odometry for 1 s > odom_timeout_s
+    timeout_s = node.settings.odom_timeout_s
+    assert bed.spin_until(
+        lambda: commands[-1].linear.x == 0.0 and commands[-1].angular.z == 0.0,
+        timeout_s=timeout_s + 2.0,
+    ), 'no odometry for longer than odom_timeout_s: stop'
+    bed.spin_for(0.3)
     assert commands[-1].linear.x == 0.0
     assert commands[-1].angular.z == 0.0
 
 
 def test_non_finite_signal_samples_are_dropped_and_finite_ones_kept(graph):
-    node, pubs, _, spin_for = graph
-    pubs['odom'].publish(odom(0.2, 0.1))
-    spin_for(0.1)
+    node, pubs, _, bed = graph
+    pubs['odom'].play(odom(0.2, 0.1))
+    assert bed.spin_until(lambda: node.decisions)
     for value in (0.5, math.nan, math.inf, 0.6):
         pubs['signal'].publish(swarm.SignalSample(value=value))
-    spin_for(0.1)
+    assert bed.spin_until(lambda: node.planner.n_observations >= 2)
+    bed.spin_for(0.2)
     assert node.planner.n_observations == 2
 
 
 def test_duplicated_and_stale_peer_messages_are_ignored(graph):
-    node, pubs, _, spin_for = graph
+    node, pubs, _, bed = graph
     update = PeerUpdate('r1', 2, np.zeros(2), np.ones(2), np.array([[0.1, 0.1]]), np.array([0.3]))
     msg = peer_update_to_ros(update, 1.0)
     pubs['peers'].publish(msg)
     pubs['peers'].publish(msg)
     msg.decision_index = 1
     pubs['peers'].publish(msg)
-    spin_for(0.1)
+    assert bed.spin_until(lambda: 'r1' in node.planner.peer_waypoints)
+    bed.spin_for(0.2)
     assert node.planner.n_observations == 1
     assert node.planner.peer_waypoints['r1'] == pytest.approx([1.0, 1.0])

@@ -180,9 +180,9 @@ def _is_loopback(host: str) -> bool:
         return False
 
 
-def main(args: list[str] | None = None) -> None:
+def main(args: list[str] | None = None) -> int:
     """Entry point of ``ros2 run hw_drivers aoa_receiver_node``."""
-    run_driver_node(
+    return run_driver_node(
         AoaReceiverNode,
         'aoa_receiver_node',
         args,
@@ -192,4 +192,4 @@ def main(args: list[str] | None = None) -> None:
 
 
 if __name__ == '__main__':
-    main()
+    raise SystemExit(main())

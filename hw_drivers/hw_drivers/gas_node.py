@@ -201,10 +201,12 @@ class GasNode(Node):
         super().destroy_node()
 
 
-def main(args: list[str] | None = None) -> None:
+def main(args: list[str] | None = None) -> int:
     """Entry point of ``ros2 run hw_drivers gas_adc_node``."""
-    run_driver_node(GasNode, 'gas_adc_node', args, summary=__doc__ or '', parameters=GAS_PARAMETERS)
+    return run_driver_node(
+        GasNode, 'gas_adc_node', args, summary=__doc__ or '', parameters=GAS_PARAMETERS
+    )
 
 
 if __name__ == '__main__':
-    main()
+    raise SystemExit(main())

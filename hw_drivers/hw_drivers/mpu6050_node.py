@@ -190,12 +190,12 @@ class Mpu6050Node(Node):
         super().destroy_node()
 
 
-def main(args: list[str] | None = None) -> None:
+def main(args: list[str] | None = None) -> int:
     """Entry point of ``ros2 run hw_drivers mpu6050_node``."""
-    run_driver_node(
+    return run_driver_node(
         Mpu6050Node, 'mpu6050_node', args, summary=__doc__ or '', parameters=MPU6050_PARAMETERS
     )
 
 
 if __name__ == '__main__':
-    main()
+    raise SystemExit(main())

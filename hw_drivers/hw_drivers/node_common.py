@@ -2,7 +2,7 @@
 
 * The parameters of each driver are a spec in :mod:`hw_drivers.parameters`, declared with
   :func:`swarm_runtime.parameters.declare_config`; ``--help`` lists them and
-  :func:`start_driver_process` checks the parameter files of the command line.
+  :func:`run_driver_node` checks the parameter files of the command line.
 * :class:`DevicePoller` runs a :class:`~hw_drivers.worker.DeviceWorker` in its own thread
   (robots) or from a node timer (deterministic tests on the built-in runtime).
 * :class:`DeviceMonitor` turns the worker's status plus data freshness into one
@@ -11,23 +11,21 @@
 * :class:`TimerGate` pauses a node's fast publishing timer while its device is missing, so
   an unplugged driver idles.
 * :func:`run_driver_node` is the body of every driver's ``main()``: ``--help``, the runtime
-  check, the parameter-file check, line-buffered output, init, spin, clean shutdown.
+  check, the parameter-file check, line-buffered output, then
+  :func:`swarm_runtime.node_main.run_node` (init, spin, clean stop on SIGINT / SIGTERM).
 """
 
 from __future__ import annotations
 
 import os
-import signal
 import sys
 import time
 from collections.abc import Callable, Mapping, Sequence
-from types import FrameType
-from typing import Any
+from typing import Any, TypeVar
 
-from swarm_common.cli import fail
 from swarm_common.params import ParameterSpec, render_value
-from swarm_runtime.parameters import ParameterFileError, check_parameter_arguments
-from swarm_runtime.ros import ExternalShutdownException, rclpy, using_real_rclpy
+from swarm_runtime.node_main import run_node
+from swarm_runtime.ros import rclpy, using_real_rclpy
 from swarm_runtime.standalone import standalone_runtime_problem
 
 from hw_drivers.conversions import DiagnosticEntry, diagnostics_to_ros
@@ -50,6 +48,7 @@ __all__ = [
     'start_driver_process',
 ]
 
+NodeT = TypeVar('NodeT')
 DIAGNOSTICS_TOPIC = '/diagnostics'
 #: While a status stays WARN or worse, it is logged again this often [s].
 REMINDER_PERIOD_S = 30.0
@@ -283,16 +282,6 @@ def _line_buffered_output() -> None:
             reconfigure(line_buffering=True)
 
 
-def _sigterm_as_interrupt() -> None:
-    """Where nothing handles SIGTERM (the built-in runtime), let it unwind like Ctrl-C."""
-
-    def handler(signum: int, _frame: FrameType | None) -> None:
-        raise KeyboardInterrupt(f'signal {signum}')
-
-    if not using_real_rclpy() and signal.getsignal(signal.SIGTERM) == signal.SIG_DFL:
-        signal.signal(signal.SIGTERM, handler)
-
-
 def spin_node(node: Any, *, tick_s: float = 0.05) -> None:
     """``rclpy.spin(node)``; on the built-in runtime paced to the real clock.
 
@@ -323,8 +312,7 @@ def start_driver_process(
 
     ``--help`` prints the help and exits 0 without touching ROS; on the built-in runtime
     without an explicit ``SWARM_RUNTIME=builtin`` the process exits 2 with a one-line
-    reason, and so does a bad parameter file or ``-p`` value (naming the file and the
-    parameter); otherwise output becomes line-buffered and SIGTERM stops the node cleanly.
+    reason; otherwise output becomes line-buffered.
     """
     own = _own_arguments(args)
     if '-h' in own or '--help' in own:
@@ -334,40 +322,38 @@ def start_driver_process(
     if problem is not None:
         sys.stderr.write(f'{name}: {problem}\n')
         raise SystemExit(2)
-    try:
-        check_parameter_arguments(parameters, name, args)
-    except ParameterFileError as err:
-        raise SystemExit(fail(name, err)) from None
     _line_buffered_output()
-    _sigterm_as_interrupt()
 
 
 def run_driver_node(
-    node_factory: Callable[[], Any],
+    node_factory: Callable[[], NodeT],
     name: str,
     args: list[str] | None,
     *,
     summary: str = '',
     parameters: ParameterSpec,
-) -> None:
-    """The body of a sensor driver's ``main()``: checks, init, spin until shutdown, clean up.
+    fatal_errors: tuple[type[Exception], ...] = (ConfigurationError,),
+    on_signal: Callable[[NodeT], None] | None = None,
+) -> int:
+    """The body of a driver's ``main()``: checks, init, spin until stopped, clean up.
 
-    See :func:`start_driver_process` for ``--help`` and the runtime check. Invalid parameters
-    end the process with exit code 2 and a fatal log line naming them; Ctrl-C, SIGTERM and an
-    external shutdown end it normally. The node is destroyed in every case.
+    See :func:`start_driver_process` for ``--help`` and the runtime check, and
+    :func:`swarm_runtime.node_main.run_node` for the stop: Ctrl-C, SIGTERM and an external
+    shutdown end the process with status 0 and no traceback (``on_signal`` runs first);
+    ``fatal_errors`` (invalid parameters) with status 2 and one fatal log line naming them,
+    and so does a bad parameter file or ``-p`` value (one line naming the file and the
+    parameter, before ``rclpy.init``).
+    The node is destroyed in every case. On the built-in runtime the node is paced to the
+    real clock (:func:`spin_node`).
     """
     start_driver_process(name, args, summary=summary, parameters=parameters)
-    rclpy.init(args=args)
-    node = None
-    try:
-        node = node_factory()
-        spin_node(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    except ConfigurationError as err:
-        rclpy.logging.get_logger(name).fatal(f'invalid parameters: {err}')
-        raise SystemExit(2) from None
-    finally:
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
+    return run_node(
+        node_factory,
+        args,
+        name=name,
+        fatal_errors=fatal_errors,
+        describe_fatal=lambda err: f'invalid parameters: {err}',
+        on_signal=on_signal,
+        spin=spin_node,
+        parameters=parameters,
+    )

@@ -9,7 +9,8 @@ between pulses. Besides the 50 Hz control timer, every pulse arms an independent
 A missing or failing GPIO is not fatal: the pump stays off, /diagnostics says why, and the
 line is requested again with back-off. The line goes off on every exit path Python can see:
 normal shutdown (``destroy_node``), KeyboardInterrupt/ExternalShutdownException, SIGTERM and
-SIGINT (handlers turn the line off first), an exception in a callback, and ``atexit``.
+SIGINT (``main()``'s handlers turn the line off first), an exception in a callback, and
+``atexit``.
 SIGKILL and power loss cannot be caught:
 the hardware gate pull-down and the systemd ``ExecStopPost=`` line (docs/hardware.md) cover
 those.
@@ -23,15 +24,13 @@ Run: ``ros2 run hw_drivers pump_node --ros-args -r __ns:=/r0 -p line:=GPIO17``.
 from __future__ import annotations
 
 import atexit
-import signal
 import threading
 import time
 from collections.abc import Callable
-from types import FrameType
 from typing import Any
 
 from swarm_runtime.parameters import declare_config
-from swarm_runtime.ros import ExternalShutdownException, Node, message_module, rclpy
+from swarm_runtime.ros import Node, message_module
 
 from hw_drivers.backoff import Backoff, BackoffConfig
 from hw_drivers.conversions import DiagnosticEntry, pump_state_to_ros
@@ -42,15 +41,14 @@ from hw_drivers.node_common import (
     StatusLog,
     TimerGate,
     publish_diagnostics,
-    spin_node,
-    start_driver_process,
+    run_driver_node,
 )
 from hw_drivers.parameters import PUMP_PARAMETERS
 from hw_drivers.pump_control import PumpController, PumpLimits
 from hw_drivers.pump_output import GpiodPumpOutput, PumpOutput, SafePumpLine, parse_line_id
 from hw_drivers.worker import DiagnosticLevel
 
-__all__ = ['PumpNode', 'install_signal_handlers', 'main']
+__all__ = ['PumpNode', 'main']
 
 std_msgs = message_module('std_msgs')
 diagnostic_msgs = message_module('diagnostic_msgs')
@@ -272,45 +270,22 @@ class PumpNode(Node):
         super().destroy_node()
 
 
-def install_signal_handlers(turn_off: Callable[[], None]) -> None:
-    """On SIGTERM/SIGINT: turn the pump off first, then leave ``rclpy.spin`` by an exception.
+def main(args: list[str] | None = None) -> int:
+    """Entry point of ``ros2 run hw_drivers pump_node``.
 
-    A handler installed before ours (e.g. from rclpy) is chained after the pump is off.
+    SIGINT and SIGTERM turn the pump off first (from the signal handler), then stop the
+    node; every other exit path turns it off in ``destroy_node`` or ``atexit``.
     """
-
-    def handler(signum: int, frame: FrameType | None) -> None:
-        turn_off()
-        previous = previous_handlers.get(signum)
-        if callable(previous):
-            previous(signum, frame)
-        raise KeyboardInterrupt(f'signal {signum}')
-
-    previous_handlers = {}
-    for signum in (signal.SIGTERM, signal.SIGINT):
-        previous_handlers[signum] = signal.getsignal(signum)
-        signal.signal(signum, handler)
-
-
-def main(args: list[str] | None = None) -> None:
-    """Entry point of ``ros2 run hw_drivers pump_node``."""
-    start_driver_process('pump_node', args, summary=__doc__ or '', parameters=PUMP_PARAMETERS)
-    rclpy.init(args=args)
-    node = None
-    try:
-        node = PumpNode()
-        install_signal_handlers(node.shutdown_pump)
-        spin_node(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    except FatalDeviceError as err:  # invalid parameters (ConfigurationError)
-        rclpy.logging.get_logger('pump_node').fatal(f'invalid parameters: {err}')
-        raise SystemExit(2) from None
-    finally:
-        if node is not None:
-            node.shutdown_pump()
-            node.destroy_node()
-        rclpy.try_shutdown()
+    return run_driver_node(
+        PumpNode,
+        'pump_node',
+        args,
+        summary=__doc__ or '',
+        parameters=PUMP_PARAMETERS,
+        fatal_errors=(FatalDeviceError,),
+        on_signal=PumpNode.shutdown_pump,
+    )
 
 
 if __name__ == '__main__':
-    main()
+    raise SystemExit(main())

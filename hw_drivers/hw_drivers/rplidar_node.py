@@ -180,12 +180,12 @@ class RPLidarNode(Node):
         super().destroy_node()
 
 
-def main(args: list[str] | None = None) -> None:
+def main(args: list[str] | None = None) -> int:
     """Entry point of ``ros2 run hw_drivers rplidar_node``."""
-    run_driver_node(
+    return run_driver_node(
         RPLidarNode, 'rplidar_node', args, summary=__doc__ or '', parameters=RPLIDAR_PARAMETERS
     )
 
 
 if __name__ == '__main__':
-    main()
+    raise SystemExit(main())

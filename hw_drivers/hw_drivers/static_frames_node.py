@@ -85,7 +85,7 @@ class StaticFramesNode(Node):
         )
 
 
-def main(args: list[str] | None = None) -> None:
+def main(args: list[str] | None = None) -> int:
     """Entry point of ``ros2 run hw_drivers static_frames_node``; exits 2 with one line where
     tf2_msgs is not installed."""
     argv = list(sys.argv[1:] if args is None else args)
@@ -96,7 +96,7 @@ def main(args: list[str] | None = None) -> None:
         except TfUnavailableError as err:
             sys.stderr.write(f'static_frames_node: {err}\n')
             raise SystemExit(2) from None
-    run_driver_node(
+    return run_driver_node(
         StaticFramesNode,
         'static_frames_node',
         args,
@@ -106,4 +106,4 @@ def main(args: list[str] | None = None) -> None:
 
 
 if __name__ == '__main__':
-    main()
+    raise SystemExit(main())

@@ -4,7 +4,7 @@ Every test runs real processes. Where a test needs ROS 2 it runs on the real rcl
 skipped when rclpy is not installed; the same checks also run on the built-in runtime,
 which the processes get only by asking for it (``SWARM_RUNTIME=builtin``). A "no ROS"
 machine is simulated by an import hook that hides rclpy. DDS traffic stays on this machine
-(``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST``, a domain id of its own per test process).
+(``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST``, the domain id of the test process).
 
 Whether a bringup leaves processes behind is checked by a token in the environment that
 every descendant inherits: once the bringup has exited, no live process may carry it.
@@ -75,13 +75,8 @@ _FAKE_ROS2 = textwrap.dedent(
 
 
 def _env(tmp_path: Path, runtime: str, *, hide_rclpy: bool = False, **extra: str) -> dict:
-    env = {
-        **os.environ,
-        'ROS_AUTOMATIC_DISCOVERY_RANGE': 'LOCALHOST',
-        'ROS_DOMAIN_ID': str(120 + os.getpid() % 90),
-        TOKEN_VAR: uuid.uuid4().hex,
-        **extra,
-    }
+    # ROS_DOMAIN_ID and ROS_AUTOMATIC_DISCOVERY_RANGE come from the root conftest.py.
+    env = {**os.environ, TOKEN_VAR: uuid.uuid4().hex, **extra}
     env.pop('PYTHONUNBUFFERED', None)  # the drivers must line-buffer by themselves
     if runtime:
         env['SWARM_RUNTIME'] = runtime

@@ -1,5 +1,7 @@
 """What drivers share: status logging without a line per retry, timer gating, diagnostics text."""
 
+import time
+
 import pytest
 from hw_drivers.aoa_receiver_node import AoaReceiverNode
 from hw_drivers.errors import DeviceUnavailableError
@@ -9,10 +11,11 @@ from hw_drivers.node_common import DeviceMonitor, StatusLog, TimerGate, driver_h
 from hw_drivers.parameters import RPLIDAR_PARAMETERS
 from hw_drivers.worker import DeviceWorker, DiagnosticLevel
 from swarm_common.params import render_value
-from swarm_runtime.ros import Node, Parameter, SingleThreadedExecutor, message_module, rclpy
-from swarm_runtime.simulation import spin_until
+from swarm_runtime.ros import Parameter, message_module
+from swarm_runtime.testing import NodeTestBed
 
 diagnostic_msgs = message_module('diagnostic_msgs')
+OK = diagnostic_msgs.DiagnosticStatus.OK
 
 
 class Logger:
@@ -124,41 +127,23 @@ def test_help_lists_every_parameter_with_its_default():
 
 
 @pytest.fixture
-def ros():
-    rclpy.init()
-    executor = SingleThreadedExecutor()
-    probe = Node('probe')
-    executor.add_node(probe)
-    diagnostics = []
-    probe.create_subscription(
-        diagnostic_msgs.DiagnosticArray, '/diagnostics', diagnostics.append, 10
+def bed():
+    with NodeTestBed() as bed:
+        yield bed
+
+
+def test_the_aoa_node_says_the_locator_is_missing_not_connected(bed):
+    diagnostics = bed.probe.collect('/diagnostics', diagnostic_msgs.DiagnosticArray)
+    node = bed.add_node(
+        AoaReceiverNode,
+        parameter_overrides=[
+            Parameter('device_thread', value=False),
+            Parameter('listen_port', value=0),
+            Parameter('stale_timeout_s', value=1.0),
+        ],
     )
-    nodes = []
-
-    def add(node):
-        nodes.append(node)
-        executor.add_node(node)
-        return node
-
-    yield executor, add, diagnostics
-    for node in nodes:
-        node.destroy_node()
-    probe.destroy_node()
-    rclpy.try_shutdown()
-
-
-def test_the_aoa_node_says_the_locator_is_missing_not_connected(ros):
-    executor, add, diagnostics = ros
-    node = add(
-        AoaReceiverNode(
-            parameter_overrides=[
-                Parameter('device_thread', value=False),
-                Parameter('listen_port', value=0),
-                Parameter('stale_timeout_s', value=1.0),
-            ]
-        )
-    )
-    spin_until(executor, lambda: False, max_wall_time_s=2.5)
+    bed.wait_for_graph()
+    bed.spin_for(2.5)
     status = diagnostics[-1].status[0]
     assert status.level == diagnostic_msgs.DiagnosticStatus.ERROR
     port = node.server.port
@@ -168,21 +153,28 @@ def test_the_aoa_node_says_the_locator_is_missing_not_connected(ros):
     assert 'connected (' not in status.message.replace('not connected (', '')
     client = FakeLocatorClient(port)
     try:
-        for k in range(15):
+        # Bearings at 10 Hz until the next diagnostics report them (the socket delivers in
+        # host time, which the built-in runtime's virtual clock may outrun).
+        deadline = time.monotonic() + 20.0
+        count = len(diagnostics)
+        k = 0
+        while len(diagnostics) <= count or diagnostics[-1].status[0].level != OK:
+            assert time.monotonic() < deadline, diagnostics[-1].status[0].message
             client.send(ndjson_payload(k, 'AC', 10.0))
-            spin_until(executor, lambda: False, max_wall_time_s=0.1)
+            k += 1
+            time.sleep(0.005)
+            bed.spin_for(0.1)
         status = diagnostics[-1].status[0]
-        assert status.level == diagnostic_msgs.DiagnosticStatus.OK
         assert status.message == f'locator connected (listening on 127.0.0.1:{port})'
     finally:
         client.close()
     # Disconnected: first a warning, then, once the last bearing is too old, stale.
     count = len(diagnostics)
-    spin_until(executor, lambda: len(diagnostics) > count, max_wall_time_s=1.1)
+    assert bed.spin_until(lambda: len(diagnostics) > count, timeout_s=3.0)
     status = diagnostics[-1].status[0]
     assert status.level == diagnostic_msgs.DiagnosticStatus.WARN
     assert status.message == f'AoA locator not connected (listening on 127.0.0.1:{port})'
-    spin_until(executor, lambda: False, max_wall_time_s=2.5)
+    bed.spin_for(2.5)
     status = diagnostics[-1].status[0]
     assert status.level == diagnostic_msgs.DiagnosticStatus.ERROR
     assert status.message.startswith('stale: no data for ')

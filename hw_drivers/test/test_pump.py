@@ -14,13 +14,12 @@ from hw_drivers.pump_control import PumpController, PumpLimits
 from hw_drivers.pump_node import PumpNode
 from hw_drivers.pump_output import GpiodPumpOutput, SafePumpLine, parse_line_id
 from swarm_runtime.ros import (
-    Node,
     Parameter,
-    SingleThreadedExecutor,
     message_module,
     rclpy,
+    using_real_rclpy,
 )
-from swarm_runtime.simulation import spin_until, wall_time_s
+from swarm_runtime.testing import NodeTestBed
 
 std_msgs = message_module('std_msgs')
 diagnostic_msgs = message_module('diagnostic_msgs')
@@ -116,72 +115,74 @@ def test_a_missing_gpio_chip_is_a_recoverable_error():
         GpiodPumpOutput('/dev/gpiochip99', 17)
 
 
+# How late a timed output may be: one control tick on the built-in runtime's virtual clock;
+# on real DDS a loaded 2-core host also delays the executor's timers and deliveries.
+LATE_S = 0.2 if using_real_rclpy() else 0.03
+
+
 @pytest.fixture
-def pump_setup():
-    rclpy.init()
-    output = FakePumpOutput(lambda: wall_time_s())
-    node = PumpNode(
-        output=output,
-        parameter_overrides=[Parameter('max_on_s', value=0.5), Parameter('min_off_s', value=0.5)],
-    )
-    controller = Node('controller')
-    pub = controller.create_publisher(std_msgs.Bool, 'pump', 10)
-    executor = SingleThreadedExecutor()
-    executor.add_node(node)
-    executor.add_node(controller)
-    yield node, output, pub, controller, executor
-    node.destroy_node()
-    controller.destroy_node()
-    rclpy.try_shutdown()
+def pump_bed():
+    with NodeTestBed() as bed:
+        output = FakePumpOutput(bed.now_s)
+        node = bed.add_node(
+            PumpNode,
+            output=output,
+            parameter_overrides=[
+                Parameter('max_on_s', value=0.5),
+                Parameter('min_off_s', value=0.5),
+            ],
+        )
+        command = bed.probe.player('/pump', std_msgs.Bool, period_s=0.1)
+        bed.wait_for_graph()
+        yield bed, node, output, command
 
 
-def _publish_for(executor, controller, pub, level, duration_s, period_s=0.1):
-    """Republish a level every period for a duration (a controller's heartbeat)."""
-    start = wall_time_s()
-    timer = controller.create_timer(period_s, lambda: pub.publish(std_msgs.Bool(data=level)))
-    pub.publish(std_msgs.Bool(data=level))
-    spin_until(executor, lambda: wall_time_s() - start >= duration_s, max_wall_time_s=duration_s)
-    controller.destroy_timer(timer)
+def _command_for(bed, command, level, duration_s):
+    """Republish a level every 0.1 s for a duration (a controller's heartbeat), then stop."""
+    command.play(std_msgs.Bool(data=level))
+    bed.spin_for(duration_s)
+    command.play(None)
 
 
-def test_node_follows_commands_within_limits_and_fails_safe_when_they_stop(pump_setup):
-    _node, output, pub, controller, executor = pump_setup
-    _publish_for(executor, controller, pub, True, 0.3)
-    assert output.level is True
-    _publish_for(executor, controller, pub, True, 0.5)
+def test_node_follows_commands_within_limits_and_fails_safe_when_they_stop(pump_bed):
+    bed, _node, output, command = pump_bed
+    _command_for(bed, command, True, 0.3)
+    assert bed.spin_until(lambda: output.level is True, timeout_s=LATE_S)
+    _command_for(bed, command, True, 0.5 + LATE_S)
     assert output.level is False  # max_on_s = 0.5 cut the pulse
-    _publish_for(executor, controller, pub, False, 0.6)
-    _publish_for(executor, controller, pub, True, 0.2)
-    assert output.level is True
-    # The controller goes silent: off within command_timeout_s (0.5 s) + one tick.
-    start = wall_time_s()
-    spin_until(executor, lambda: not output.level, max_wall_time_s=2.0)
-    assert wall_time_s() - start <= 0.5 + 0.03
+    _command_for(bed, command, False, 0.6)
+    _command_for(bed, command, True, 0.2)
+    assert bed.spin_until(lambda: output.level is True, timeout_s=LATE_S)
+    # The controller goes silent: off within command_timeout_s (0.5 s) of the last command.
+    start = bed.now_s()
+    assert bed.spin_until(lambda: not output.level, timeout_s=2.0)
+    assert bed.now_s() - start <= 0.5 + LATE_S
     on_times = [t for t, level in output.transitions if level]
     off_times = [t for t, level in output.transitions if not level]
-    assert all(off - on <= 0.5 + 0.03 for on, off in zip(on_times, off_times, strict=False))
+    assert len(on_times) == len(off_times) == 2
+    assert all(off - on <= 0.5 + LATE_S for on, off in zip(on_times, off_times, strict=True))
 
 
-def test_destroying_the_node_turns_the_pump_off(pump_setup):
-    node, output, pub, controller, executor = pump_setup
-    _publish_for(executor, controller, pub, True, 0.2)
-    assert output.level is True
+def test_destroying_the_node_turns_the_pump_off(pump_bed):
+    bed, node, output, command = pump_bed
+    command.play(std_msgs.Bool(data=True))
+    assert bed.spin_until(lambda: output.level is True, timeout_s=2.0)
     node.shutdown_pump()
     assert output.level is False
     assert output.closed
 
 
-def test_exception_in_a_callback_leaves_the_pump_off(pump_setup):
-    node, output, pub, controller, executor = pump_setup
-    _publish_for(executor, controller, pub, True, 0.2)
-    assert output.level is True
+def test_exception_in_a_callback_leaves_the_pump_off(pump_bed):
+    bed, node, output, command = pump_bed
+    command.play(std_msgs.Bool(data=True))
+    assert bed.spin_until(lambda: output.level is True, timeout_s=2.0)
 
     def broken(now_s):
         raise RuntimeError('controller bug')
 
     node._controller.update = broken
     with pytest.raises(RuntimeError, match='controller bug'):
-        spin_until(executor, lambda: False, max_wall_time_s=0.1)
+        bed.spin_for(0.5)
     assert output.level is False
 
 
@@ -209,124 +210,123 @@ def test_guard_thread_cuts_a_pulse_when_the_executor_stalls():
 class FlakyLine:
     """Opens a FakePumpOutput only after ``failures`` failed attempts; records them."""
 
-    def __init__(self, failures, error=None):
+    def __init__(self, clock, failures, error=None):
+        self.clock = clock
         self.failures = failures
         self.error = error or DeviceUnavailableError('no GPIO chip /dev/gpiochip0')
         self.attempts = []
         self.outputs = []
 
     def __call__(self):
-        self.attempts.append(wall_time_s())
+        self.attempts.append(self.clock())
         if len(self.attempts) <= self.failures:
             raise self.error
-        self.outputs.append(FakePumpOutput(lambda: wall_time_s()))
+        self.outputs.append(FakePumpOutput(self.clock))
         return self.outputs[-1]
 
 
 @pytest.fixture
 def flaky_pump():
-    rclpy.init()
-    nodes = []
-    executor = SingleThreadedExecutor()
-    controller = Node('controller')
-    executor.add_node(controller)
-    pub = controller.create_publisher(std_msgs.Bool, 'pump', 10)
-    diagnostics = []
-    controller.create_subscription(
-        diagnostic_msgs.DiagnosticArray, '/diagnostics', diagnostics.append, 10
-    )
+    with NodeTestBed() as bed:
+        command = bed.probe.player('/pump', std_msgs.Bool, period_s=0.1)
+        diagnostics = bed.probe.collect('/diagnostics', diagnostic_msgs.DiagnosticArray, 10)
 
-    def make(opener):
-        node = PumpNode(open_output=opener, retry_clock=wall_time_s)
-        nodes.append(node)
-        executor.add_node(node)
-        return node
+        def make(failures, error=None):
+            opener = FlakyLine(bed.wall_time_s, failures, error)
+            node = bed.add_node(PumpNode, open_output=opener, retry_clock=bed.wall_time_s)
+            bed.wait_for_graph()
+            return node, opener
 
-    yield make, executor, controller, pub, diagnostics
-    for node in nodes:
-        node.destroy_node()
-    controller.destroy_node()
-    rclpy.try_shutdown()
+        yield bed, make, command, diagnostics
 
 
 def test_a_missing_gpio_backs_off_keeps_the_pump_off_and_recovers(flaky_pump):
-    make, executor, controller, pub, diagnostics = flaky_pump
-    opener = FlakyLine(failures=3)
-    node = make(opener)
+    bed, make, command, diagnostics = flaky_pump
+    node, opener = make(failures=3)
     # Commands while the line is missing change nothing (and no exception).
-    _publish_for(executor, controller, pub, True, 2.5)
+    _command_for(bed, command, True, 2.5)
     assert not node.line_available
+    assert diagnostics
     status = diagnostics[-1].status[0]
     assert status.level == diagnostic_msgs.DiagnosticStatus.ERROR
     assert status.message.startswith('pump line unavailable (error): no GPIO chip')
     assert 'retrying in' in status.message
-    spin_until(executor, lambda: node.line_available, max_wall_time_s=10.0)
-    # Back-off 1, 2, 4 s between the four attempts (checked at the 1 Hz diagnostics tick).
+    assert bed.spin_until(lambda: node.line_available, timeout_s=10.0)
+    # Back-off 1, 2, 4 s between the four attempts, checked at the 1 Hz diagnostics tick: on
+    # the virtual clock exactly on it; in real time a late tick defers an attempt to the next.
     gaps = [b - a for a, b in zip(opener.attempts, opener.attempts[1:], strict=False)]
-    assert [round(g) for g in gaps] == [1, 2, 4]
+    slack_s = 1.0 + LATE_S if using_real_rclpy() else LATE_S
+    assert len(gaps) == 3
+    for gap, backoff in zip(gaps, [1.0, 2.0, 4.0], strict=True):
+        assert backoff - LATE_S <= gap <= backoff + slack_s
     output = opener.outputs[0]
     assert output.transitions == []  # came up off, stayed off without a fresh "on"
-    _publish_for(executor, controller, pub, True, 0.3)
-    assert output.level is True
-    spin_until(executor, lambda: False, max_wall_time_s=1.2)
+    _command_for(bed, command, True, 0.3)
+    assert bed.spin_until(lambda: output.level is True, timeout_s=LATE_S)
+    bed.spin_for(1.2)
     assert output.level is False  # stale commands
-    assert diagnostics[-1].status[0].level == diagnostic_msgs.DiagnosticStatus.OK
+    assert bed.spin_until(
+        lambda: diagnostics[-1].status[0].level == diagnostic_msgs.DiagnosticStatus.OK,
+        timeout_s=2.0,
+    )
 
 
 def test_a_line_that_fails_in_use_goes_off_is_released_and_is_requested_again(flaky_pump):
-    make, executor, controller, pub, _ = flaky_pump
-    opener = FlakyLine(failures=0)
-    node = make(opener)
-    _publish_for(executor, controller, pub, True, 0.2)
+    bed, make, command, _ = flaky_pump
+    node, opener = make(failures=0)
+    _command_for(bed, command, True, 0.2)
     first, line = opener.outputs[0], node.line
-    assert first.level is True
+    assert bed.spin_until(lambda: first.level is True, timeout_s=LATE_S)
     first.fail_on_set = False  # the line can no longer be driven (e.g. chip gone)
-    _publish_for(executor, controller, pub, False, 0.1)
-    assert not node.line_available
+    _command_for(bed, command, False, 0.1)
+    assert bed.spin_until(lambda: not node.line_available, timeout_s=LATE_S)
     assert node.line_failures == 1
     assert line.closed  # released (its off failed and was counted, nothing raised)
     assert line.off_failures >= 1
-    spin_until(executor, lambda: node.line_available, max_wall_time_s=3.0)
+    assert bed.spin_until(lambda: node.line_available, timeout_s=3.0)
     assert len(opener.outputs) == 2
     assert opener.outputs[1].level is False
 
 
+@pytest.mark.builtin_only(reason='virtual wall time: waits 35 s for the fatal back-off')
 def test_a_busy_line_is_retried_slowly(flaky_pump):
-    make, executor, _, _, diagnostics = flaky_pump
-    opener = FlakyLine(failures=100, error=FatalDeviceError('cannot request line 17: busy'))
-    make(opener)
-    spin_until(executor, lambda: False, max_wall_time_s=35.0)
+    bed, make, _, diagnostics = flaky_pump
+    _, opener = make(failures=100, error=FatalDeviceError('cannot request line 17: busy'))
+    bed.spin_for(35.0)
     assert len(opener.attempts) == 2  # at start, then after the 30 s fatal back-off
     assert 'fatal error' in diagnostics[-1].status[0].message
 
 
 _CHILD = textwrap.dedent(
     """
-    import sys, time
-    from swarm_runtime.ros import rclpy, Parameter
+    import sys
+    from hw_drivers import pump_node
     from hw_drivers.fakes.gpio import FakePumpOutput
-    from hw_drivers.pump_node import PumpNode, install_signal_handlers
 
     class Reporting(FakePumpOutput):
         def set(self, on):
             super().set(on)
             print('LEVEL', int(on), flush=True)
 
-    rclpy.init()
-    node = PumpNode(output=Reporting())
-    node._controller.command(True, node._now_s())
-    node._apply(node._controller.update)
+    class OnAtStart(pump_node.PumpNode):
+        # The pump_node executable with a line that reports its level, commanded on.
+        def __init__(self, **kwargs):
+            super().__init__(output=Reporting(), **kwargs)
+            self._controller.command(True, self._now_s())
+            self._apply(self._controller.update)
+            print('READY', flush=True)
+
     mode = sys.argv[1]
     if mode == 'signal':
-        install_signal_handlers(node.shutdown_pump)
-        try:
-            print('READY', flush=True)
-            while True:
-                time.sleep(0.01)
-        except KeyboardInterrupt:
-            print('INTERRUPTED', flush=True)
+        pump_node.PumpNode = OnAtStart
+        # Long limits: only the signal may turn the pump off.
+        limits = ['-p', 'max_on_s:=60.0', '-p', 'command_timeout_s:=60.0']
+        status = pump_node.main(['--ros-args', *limits])
+        print('EXIT', status, flush=True)
     elif mode == 'atexit':
-        print('READY', flush=True)
+        from swarm_runtime.ros import rclpy
+        rclpy.init()
+        node = OnAtStart()
         sys.exit(3)
     """
 )
@@ -335,9 +335,14 @@ _CHILD = textwrap.dedent(
 def _child(mode, tmp_path):
     script = tmp_path / 'pump_child.py'
     script.write_text(_CHILD)
-    env = {**os.environ, 'PYTHONUNBUFFERED': '1'}
+    runtime = 'rclpy' if using_real_rclpy() else 'builtin'
+    env = {**os.environ, 'PYTHONUNBUFFERED': '1', 'SWARM_RUNTIME': runtime}
     return subprocess.Popen(
-        [sys.executable, str(script), mode], stdout=subprocess.PIPE, text=True, env=env
+        [sys.executable, str(script), mode],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=env,
     )
 
 
@@ -349,17 +354,21 @@ def test_signals_turn_the_pump_off_before_the_process_exits(tmp_path, signum):
     for line in child.stdout:
         lines.append(line.strip())
         if line.startswith('READY'):
+            time.sleep(0.3)  # spinning
             child.send_signal(signum)
-    child.wait(10)
-    assert lines[0] == 'LEVEL 1'
-    assert 'LEVEL 0' in lines
-    assert lines.index('LEVEL 0') < lines.index('INTERRUPTED')
+    stderr = child.stderr.read()
+    assert child.wait(30) == 0, stderr
+    assert 'Traceback' not in stderr, stderr
+    assert lines[:2] == ['LEVEL 1', 'READY']
+    assert lines[-1] == 'EXIT 0'
+    assert lines[2:-1], 'the pump went off'
+    assert set(lines[2:-1]) == {'LEVEL 0'}, 'and never on again'
 
 
 @pytest.mark.slow
 def test_atexit_turns_the_pump_off_on_an_unplanned_exit(tmp_path):
     child = _child('atexit', tmp_path)
-    out, _ = child.communicate(timeout=10)
+    out, _ = child.communicate(timeout=30)
     assert child.returncode == 3
     lines = out.splitlines()
     assert lines[:2] == ['LEVEL 1', 'READY']

@@ -10,7 +10,7 @@ from hw_drivers.errors import ConfigurationError
 from hw_drivers.parameters import STATIC_FRAMES_PARAMETERS, StaticFramesNodeConfig
 from hw_drivers.robot_bringup.cli import BringupOptions, build_plan, driver_parameters
 from hw_drivers.static_frames_node import StaticFramesNode, mount_transforms
-from swarm_runtime.bag.testing import dds_test_environment, domain_id_for_tests, spin_until
+from swarm_runtime.bag.testing import spin_until
 from swarm_runtime.ros import Node, Parameter, SingleThreadedExecutor, message_module, rclpy
 from swarm_runtime.tf import tf_static_qos
 
@@ -21,10 +21,9 @@ except ImportError as err:
 
 
 @pytest.fixture
-def executor(monkeypatch):
-    for name, value in dds_test_environment().items():
-        monkeypatch.setenv(name, value)
-    rclpy.init(domain_id=domain_id_for_tests())
+def executor():
+    # The DDS domain and the discovery range are the test process's (conftest.py).
+    rclpy.init()
     executor = SingleThreadedExecutor()
     yield executor
     for node in list(executor.get_nodes()):

@@ -25,14 +25,12 @@ from __future__ import annotations
 
 from typing import Any
 
-from swarm_common.cli import fail
-from swarm_runtime.parameters import ParameterFileError, check_parameter_arguments, declare_config
+from swarm_runtime.node_main import run_node
+from swarm_runtime.parameters import declare_config
 from swarm_runtime.ros import (
-    ExternalShutdownException,
     Node,
     message_module,
     qos_profile_sensor_data,
-    rclpy,
 )
 
 from msc_pf import conversions
@@ -168,24 +166,16 @@ class MscPfNode(Node):
         self._cmd_pub.publish(conversions.twist_to_ros(speed, yaw_rate, _geometry))
 
 
-def main(args: list[str] | None = None) -> None:
+def main(args: list[str] | None = None) -> int:
     """Entry point of ``ros2 run msc_pf msc_pf_node``."""
-    try:
-        check_parameter_arguments(MSC_PF_PARAMETERS, NODE_NAME, args)
-    except ParameterFileError as err:
-        raise SystemExit(fail(NODE_NAME, err)) from None
-    rclpy.init(args=args)
-    node = None
-    try:
-        node = MscPfNode()
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
+    return run_node(
+        MscPfNode,
+        args,
+        name=NODE_NAME,
+        fatal_errors=(ConfigError,),
+        parameters=MSC_PF_PARAMETERS,
+    )
 
 
 if __name__ == '__main__':
-    main()
+    raise SystemExit(main())

@@ -7,14 +7,14 @@ import pytest
 from msc_pf.particle_filter import TargetEstimate
 from msc_pf.peers import PeerInfo, Phase, Role
 from msc_pf.robot import RobotStatus
-from swarm_runtime.messages import get_message_module
+from swarm_runtime.ros import message_module
 
 from msc_pf import conversions
 
-swarm = get_message_module('swarm_interfaces')
-builtin = get_message_module('builtin_interfaces')
-nav = get_message_module('nav_msgs')
-geometry = get_message_module('geometry_msgs')
+swarm = message_module('swarm_interfaces')
+builtin = message_module('builtin_interfaces')
+nav = message_module('nav_msgs')
+geometry = message_module('geometry_msgs')
 
 PEER = PeerInfo(
     robot_id=4,

@@ -1,4 +1,9 @@
-"""The node on the built-in runtime: odom + rssi + peers in, cmd_vel + peers/out + state out."""
+"""The node through its topics: odom + rssi + peers in, cmd_vel + peers/out + state out.
+
+Runs on either runtime (real DDS with rclpy). The node runs on sim time: the probe publishes
+/clock four times faster than the wall clock and plays odometry (and RSSI) every 0.1 s of
+it, so the formation timeouts below take a quarter of their length on real DDS.
+"""
 
 from __future__ import annotations
 
@@ -7,14 +12,16 @@ import math
 import pytest
 from msc_pf.errors import ConfigError
 from msc_pf.node import MscPfNode
-from swarm_runtime.messages import get_message_module
-from swarm_runtime.ros import Parameter, SingleThreadedExecutor, rclpy, using_real_rclpy
+from swarm_runtime.ros import Parameter, message_module, qos_profile_sensor_data
+from swarm_runtime.testing import NodeTestBed
 
-pytestmark = pytest.mark.skipif(using_real_rclpy(), reason='drives the built-in runtime')
+nav = message_module('nav_msgs')
+geometry = message_module('geometry_msgs')
+swarm = message_module('swarm_interfaces')
+builtin = message_module('builtin_interfaces')
 
-nav = get_message_module('nav_msgs')
-geometry = get_message_module('geometry_msgs')
-swarm = get_message_module('swarm_interfaces')
+# Sim time per probe tick (0.01 s of wall time).
+CLOCK_STEP_S = 0.04
 
 
 def odom_at(x: float, y: float) -> object:
@@ -26,66 +33,47 @@ def odom_at(x: float, y: float) -> object:
 
 
 class Harness:
-    """The node plus a probe that plays odom/rssi at 10 Hz and records the node's output."""
+    """The node in /r2 on sim time, a probe that plays odom/rssi, and the node's output."""
 
-    def __init__(self, **parameters: object) -> None:
-        from swarm_runtime.simulation import spin_until, wall_time_s
-
-        self._spin_until = spin_until
-        self._wall_time_s = wall_time_s
+    def __init__(self, bed: NodeTestBed, **parameters: object) -> None:
         overrides = [Parameter(k, value=v) for k, v in parameters.items()]
-        self.node = MscPfNode(namespace='/r2', parameter_overrides=overrides)
-        self.probe = rclpy.create_node('probe')
-        self.commands: list = []
-        self.states: list = []
-        self.peers: list = []
-        self.probe.create_subscription(geometry.Twist, '/r2/cmd_vel', self.commands.append, 10)
-        self.probe.create_subscription(swarm.MscPfState, '/r2/state', self.states.append, 10)
-        self.probe.create_subscription(swarm.MscPeer, '/r2/peers/out', self.peers.append, 10)
-        self.odom_pub = self.probe.create_publisher(nav.Odometry, '/r2/odom', 10)
-        self.rssi_pub = self.probe.create_publisher(swarm.RssiArray, '/r2/rssi', 10)
-        self.odom: object | None = odom_at(1000.0, 1000.0)
-        self.rssi: object | None = None
-        self.probe.create_timer(0.1, self._play)
-        self.executor = SingleThreadedExecutor()
-        self.executor.add_node(self.node)
-        self.executor.add_node(self.probe)
-
-    def _play(self) -> None:
-        if self.odom is not None:
-            self.odom_pub.publish(self.odom)
-        if self.rssi is not None:
-            self.rssi_pub.publish(self.rssi)
+        overrides.append(Parameter('use_sim_time', value=True))
+        self.bed = bed
+        self.node = bed.add_node(MscPfNode, namespace='/r2', parameter_overrides=overrides)
+        probe = bed.probe
+        self.commands = probe.collect('/r2/cmd_vel', geometry.Twist)
+        self.states = probe.collect('/r2/state', swarm.MscPfState)
+        self.peers = probe.collect('/r2/peers/out', swarm.MscPeer)
+        self.odom = probe.player('/r2/odom', nav.Odometry, qos_profile_sensor_data)
+        self.rssi = probe.player('/r2/rssi', swarm.RssiArray, qos_profile_sensor_data)
+        bed.wait_for_graph()
+        self.odom.play(odom_at(1000.0, 1000.0))
 
     def spin_for(self, seconds: float) -> None:
-        end = self._wall_time_s() + seconds
-        self._spin_until(self.executor, lambda: self._wall_time_s() >= end)
+        """Run for ``seconds`` of sim time."""
+        self.bed.spin_for(seconds)
 
-    def close(self) -> None:
-        self.executor.shutdown()
-        self.node.destroy_node()
-        self.probe.destroy_node()
+    def spin_until(self, predicate, timeout_s: float = 10.0) -> bool:
+        return self.bed.spin_until(predicate, timeout_s)
 
 
 @pytest.fixture
 def make_harness():
-    rclpy.init(args=[])
-    made: list[Harness] = []
+    beds: list[NodeTestBed] = []
 
     def make(**parameters: object) -> Harness:
-        harness = Harness(**parameters)
-        made.append(harness)
-        return harness
+        bed = NodeTestBed(clock_step_s=CLOCK_STEP_S)
+        beds.append(bed)
+        return Harness(bed, **parameters)
 
     yield make
-    for harness in made:
-        harness.close()
-    rclpy.try_shutdown()
+    for bed in beds:
+        bed.close()
 
 
 def test_node_takes_its_id_from_the_namespace_and_reports_its_scheme(make_harness):
     h = make_harness(scheme='msc_pf')
-    h.spin_for(1.05)
+    assert h.spin_until(lambda: h.states and h.peers)
     assert h.node.controller.robot_id == 2
     assert h.states[-1].scheme == 'msc_pf'
     assert h.states[-1].robot == 'r2'
@@ -96,6 +84,7 @@ def test_alone_robot_starts_searching_after_the_formation_timeout(make_harness):
     h = make_harness(scheme='msc')
     h.spin_for(3.05)
     assert h.states[-1].phase == swarm.MscPfState.PHASE_FORMING
+    assert h.commands
     assert all(c.linear.x == 0.0 for c in h.commands)
     h.spin_for(4.0)
     assert h.states[-1].phase == swarm.MscPfState.PHASE_SEARCH
@@ -105,8 +94,10 @@ def test_alone_robot_starts_searching_after_the_formation_timeout(make_harness):
 def test_robot_stops_when_odometry_goes_stale(make_harness):
     h = make_harness(scheme='msc')
     h.spin_for(7.0)
-    h.odom = None
-    h.spin_for(2.0)
+    assert any(c.linear.x > 0.0 or c.angular.z != 0.0 for c in h.commands[-10:])
+    h.odom.play(None)
+    timeout_s = h.node.get_parameter('odom_timeout_s').value
+    h.spin_for(timeout_s + 1.0)
     last = h.commands[-1]
     assert last.linear.x == 0.0
     assert last.angular.z == 0.0
@@ -114,29 +105,36 @@ def test_robot_stops_when_odometry_goes_stale(make_harness):
 
 def test_unknown_and_non_finite_rssi_is_ignored(make_harness):
     h = make_harness(scheme='msc_pf', target_ids=[5, 6])
-    h.rssi = swarm.RssiArray(
-        readings=[
-            swarm.EmitterRssi(emitter_id=5, rssi_dbm=-80.0),
-            swarm.EmitterRssi(emitter_id=9, rssi_dbm=-70.0),  # a peer's tag, not a target
-            swarm.EmitterRssi(emitter_id=6, rssi_dbm=math.nan),
-        ]
+    h.rssi.play(
+        swarm.RssiArray(
+            readings=[
+                swarm.EmitterRssi(emitter_id=5, rssi_dbm=-80.0),
+                swarm.EmitterRssi(emitter_id=9, rssi_dbm=-70.0),  # a peer's tag, not a target
+                swarm.EmitterRssi(emitter_id=6, rssi_dbm=math.nan),
+            ]
+        )
     )
-    h.spin_for(2.05)
+    assert h.spin_until(lambda: h.peers and list(h.peers[-1].reading_ids) == [5])
+    h.spin_for(1.0)
     assert list(h.peers[-1].reading_ids) == [5]
     assert h.node.controller.filters.tracked_ids == (5,)
 
 
 def test_rssi_stamped_before_the_last_accepted_message_is_ignored(make_harness):
     h = make_harness(scheme='msc_pf')
-    builtin = get_message_module('builtin_interfaces')
     newer = swarm.RssiArray(readings=[swarm.EmitterRssi(emitter_id=1, rssi_dbm=-80.0)])
     newer.header.stamp = builtin.Time(sec=5, nanosec=0)
     older = swarm.RssiArray(readings=[swarm.EmitterRssi(emitter_id=2, rssi_dbm=-80.0)])
     older.header.stamp = builtin.Time(sec=3, nanosec=0)
-    h.rssi_pub.publish(newer)
-    h.rssi_pub.publish(older)
+    h.rssi.publish(newer)
+    h.rssi.publish(older)
+
+    def reported() -> set[tuple[int, ...]]:
+        return {tuple(p.reading_ids) for p in h.peers if len(p.reading_ids)}
+
+    assert h.spin_until(reported)
     h.spin_for(1.05)
-    assert list(h.peers[-1].reading_ids) == [1]
+    assert reported() == {(1,)}, 'the older message never counted'
 
 
 def test_invalid_parameters_stop_the_node_at_start(make_harness):

@@ -22,14 +22,12 @@ import math
 from collections.abc import Sequence
 from typing import Any
 
-from swarm_common.cli import fail
-from swarm_runtime.parameters import ParameterFileError, check_parameter_arguments, declare_config
+from swarm_runtime.node_main import run_node
+from swarm_runtime.parameters import declare_config
 from swarm_runtime.ros import (
-    ExternalShutdownException,
     Node,
     message_module,
     qos_profile_sensor_data,
-    rclpy,
 )
 
 from oabug_robot.conversions import (
@@ -207,24 +205,15 @@ class OABugNode(Node):
 
 def main(args: list[str] | None = None) -> int:
     """Console entry point: ``ros2 run oabug_robot oabug``."""
-    try:
-        check_parameter_arguments(OABUG_PARAMETERS, NODE_NAME, args)
-    except ParameterFileError as err:
-        return fail(NODE_NAME, err)
-    rclpy.init(args=args)
-    try:
-        node = OABugNode()
-    except ConfigError:
-        rclpy.try_shutdown()
-        return 2
-    try:
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        node.destroy_node()
-        rclpy.try_shutdown()
-    return 0
+    # The node logs its configuration errors itself (describe_fatal None: no second line).
+    return run_node(
+        OABugNode,
+        args,
+        name=NODE_NAME,
+        fatal_errors=(ConfigError,),
+        describe_fatal=lambda _: None,
+        parameters=OABUG_PARAMETERS,
+    )
 
 
 if __name__ == '__main__':

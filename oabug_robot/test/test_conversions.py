@@ -18,11 +18,12 @@ from oabug_robot.conversions import (
 )
 from oabug_robot.fsm import Command, Event, OABugFsm
 from oabug_robot.settings import OABugConfig, Variant
-from swarm_runtime.messages import cdr_roundtrip, get_message_module
+from swarm_runtime.ros import message_module
+from swarm_runtime.testing import cdr_roundtrip
 
-sensor = get_message_module('sensor_msgs')
-swarm = get_message_module('swarm_interfaces')
-builtin = get_message_module('builtin_interfaces')
+sensor = message_module('sensor_msgs')
+swarm = message_module('swarm_interfaces')
+builtin = message_module('builtin_interfaces')
 
 
 def test_scan_ranges_keep_nan_and_inf_and_their_geometry() -> None:

@@ -1,4 +1,8 @@
-"""The node on the built-in runtime: sensor topics in, cmd_vel / pump / state out."""
+"""The node through its topics: sensor topics in, cmd_vel / pump / state out.
+
+Runs on either runtime (real DDS with rclpy): the probe plays the sensors at 10 Hz after
+the graph has matched, and the assertions hold whatever the delivery timing.
+"""
 
 from __future__ import annotations
 
@@ -7,17 +11,21 @@ import math
 import pytest
 from oabug_robot.errors import ConfigError
 from oabug_robot.node import OABugNode
-from swarm_runtime.messages import get_message_module
-from swarm_runtime.ros import Parameter, SingleThreadedExecutor, rclpy, using_real_rclpy
+from swarm_runtime.ros import Parameter, message_module, qos_profile_sensor_data
+from swarm_runtime.testing import NodeTestBed
 
-pytestmark = pytest.mark.skipif(using_real_rclpy(), reason='drives the built-in runtime')
-
-sensor = get_message_module('sensor_msgs')
-geometry = get_message_module('geometry_msgs')
-std = get_message_module('std_msgs')
-swarm = get_message_module('swarm_interfaces')
+sensor = message_module('sensor_msgs')
+geometry = message_module('geometry_msgs')
+std = message_module('std_msgs')
+swarm = message_module('swarm_interfaces')
 
 RAYS = 360
+SENSOR_TOPICS = {
+    'scan': sensor.LaserScan,
+    'imu': sensor.Imu,
+    'gas': swarm.GasReading,
+    'bearings': swarm.PeerBearingArray,
+}
 
 
 def scan_msg(front_m: float = 5.0, fill: float = math.inf) -> object:
@@ -43,70 +51,58 @@ def imu_msg(yaw_rad: float = 0.0) -> object:
 
 
 class Harness:
-    """The node, a probe that plays the sensors at 10 Hz, and everything the node published."""
+    """The node in /r0, a probe that plays its sensors at 10 Hz, and what the node published."""
 
-    def __init__(self, **parameters: object) -> None:
-        from swarm_runtime.simulation import spin_until, wall_time_s
-
-        self._spin_until = spin_until
-        self._wall_time_s = wall_time_s
+    def __init__(self, bed: NodeTestBed, **parameters: object) -> None:
         overrides = [Parameter(k, value=v) for k, v in parameters.items()]
-        self.node = OABugNode(namespace='/r0', parameter_overrides=overrides)
-        self.probe = rclpy.create_node('probe')
-        self.commands: list = []
-        self.pump: list = []
-        self.states: list = []
-        self.probe.create_subscription(geometry.Twist, '/r0/cmd_vel', self.commands.append, 10)
-        self.probe.create_subscription(std.Bool, '/r0/pump', self.pump.append, 10)
-        self.probe.create_subscription(swarm.OABugState, '/r0/state', self.states.append, 10)
-        self.pubs = {
-            'scan': self.probe.create_publisher(sensor.LaserScan, '/r0/scan', 10),
-            'imu': self.probe.create_publisher(sensor.Imu, '/r0/imu', 10),
-            'gas': self.probe.create_publisher(swarm.GasReading, '/r0/gas', 10),
-            'bearings': self.probe.create_publisher(swarm.PeerBearingArray, '/r0/bearings', 10),
+        self.bed = bed
+        self.node = bed.add_node(OABugNode, namespace='/r0', parameter_overrides=overrides)
+        probe = bed.probe
+        self.commands = probe.collect('/r0/cmd_vel', geometry.Twist)
+        self.pump = probe.collect('/r0/pump', std.Bool)
+        self.states = probe.collect('/r0/state', swarm.OABugState)
+        self.players = {
+            topic: probe.player(f'/r0/{topic}', msg_type, qos_profile_sensor_data)
+            for topic, msg_type in SENSOR_TOPICS.items()
         }
-        self.playing: dict[str, object] = {}
-        self.probe.create_timer(0.1, self._play)
-        self.executor = SingleThreadedExecutor()
-        self.executor.add_node(self.node)
-        self.executor.add_node(self.probe)
-
-    def _play(self) -> None:
-        for topic, msg in self.playing.items():
-            self.pubs[topic].publish(msg)
+        bed.wait_for_graph()
 
     def play(self, **messages: object) -> None:
         """Publish these messages every 0.1 s from now on (None stops a topic)."""
         for topic, msg in messages.items():
-            if msg is None:
-                self.playing.pop(topic, None)
-            else:
-                self.playing[topic] = msg
+            self.players[topic].play(msg)
 
     def spin_for(self, seconds: float) -> None:
-        end = self._wall_time_s() + seconds
-        self._spin_until(self.executor, lambda: self._wall_time_s() >= end)
+        self.bed.spin_for(seconds)
 
-    def close(self) -> None:
-        self.executor.shutdown()
-        self.node.destroy_node()
-        self.probe.destroy_node()
+    def spin_until(self, predicate, timeout_s: float = 10.0) -> bool:
+        return self.bed.spin_until(predicate, timeout_s)
 
 
 @pytest.fixture
 def make_harness():
-    rclpy.init(args=[])
-    made: list[Harness] = []
+    beds: list[NodeTestBed] = []
 
     def make(**parameters: object) -> Harness:
-        harness = Harness(**parameters)
-        made.append(harness)
-        return harness
+        bed = NodeTestBed()
+        beds.append(bed)
+        return Harness(bed, **parameters)
 
     yield make
-    for harness in made:
-        harness.close()
-    rclpy.try_shutdown()
+    for bed in beds:
+        bed.close()
+
+
+def driving(h: Harness) -> bool:
+    return bool(h.commands) and h.commands[-1].linear.x > 0.0
+
+
+def reported_stale(h: Harness) -> bool:
+    return bool(h.states) and h.states[-1].inputs_stale
+
+
+def stopped(h: Harness) -> bool:
+    return bool(h.commands) and h.commands[-1].linear.x == 0.0 and h.commands[-1].angular.z == 0.0
 
 
 def all_sensors(front_m: float = 5.0, gas_raw: int = 60) -> dict[str, object]:
@@ -126,9 +122,10 @@ def test_without_sensor_data_the_robot_holds_still_with_the_pump_off(make_harnes
 def test_with_fresh_sensors_the_robot_heads_out_and_pumps(make_harness) -> None:
     h = make_harness(variant='gas', robot_index=0, robot_count=1)
     h.play(**all_sensors())
-    h.spin_for(1.0)
-    assert h.commands[-1].linear.x > 0.0
-    assert any(p.data for p in h.pump), 'a gas variant pumps while it drives'
+    assert h.spin_until(lambda: driving(h) and any(p.data for p in h.pump))
+    h.spin_for(0.3)
+    assert driving(h)
+    assert h.pump[-1].data, 'a gas variant pumps while it drives'
     state = h.states[-1]
     assert not state.inputs_stale
     assert state.variant == 'gas'
@@ -139,8 +136,9 @@ def test_with_fresh_sensors_the_robot_heads_out_and_pumps(make_harness) -> None:
 def test_variants_without_scent_never_pump(make_harness) -> None:
     h = make_harness(variant='sound', robot_count=1)
     h.play(scan=scan_msg(), imu=imu_msg())
-    h.spin_for(1.0)
-    assert h.commands[-1].linear.x > 0.0, 'a non-gas variant does not need the gas topic'
+    assert h.spin_until(lambda: driving(h)), 'a non-gas variant does not need the gas topic'
+    h.spin_for(0.5)
+    assert driving(h)
     assert h.pump
     assert not any(p.data for p in h.pump)
 
@@ -148,11 +146,13 @@ def test_variants_without_scent_never_pump(make_harness) -> None:
 def test_a_wall_ahead_starts_wall_following(make_harness) -> None:
     h = make_harness(variant='gas', robot_count=1)
     h.play(**all_sensors(front_m=5.0))
-    h.spin_for(0.5)
+    assert h.spin_until(lambda: driving(h))
     h.play(scan=scan_msg(front_m=0.22))
-    h.spin_for(0.5)
+    following = swarm.OABugState.STATE_FOLLOWING_WALL
+    assert h.spin_until(lambda: h.states and h.states[-1].state == following)
+    h.spin_for(0.3)
     state = h.states[-1]
-    assert state.state == swarm.OABugState.STATE_FOLLOWING_WALL
+    assert state.state == following
     assert state.wall_hits == 1
     assert state.wall_side == swarm.OABugState.SIDE_LEFT, 'turned right: wall on the left'
     assert h.commands[-1].angular.z < 0.0
@@ -162,33 +162,35 @@ def test_a_wall_ahead_starts_wall_following(make_harness) -> None:
 def test_a_stale_input_stops_the_robot_and_the_pump_until_it_returns(make_harness, lost) -> None:
     h = make_harness(variant='gas_sound', robot_count=1, stale_timeout_s=0.5)
     h.play(**all_sensors())
-    h.spin_for(0.6)
-    assert h.commands[-1].linear.x > 0.0
+    assert h.spin_until(lambda: driving(h))
     h.play(**{lost: None})
-    h.spin_for(0.8)
-    assert h.commands[-1].linear.x == 0.0
-    assert h.commands[-1].angular.z == 0.0
+    assert h.spin_until(
+        lambda: stopped(h) and h.states and h.states[-1].inputs_stale, timeout_s=2.0
+    )
+    h.spin_for(0.3)
+    assert stopped(h), 'and it stays stopped'
     assert h.pump[-1].data is False
     assert h.states[-1].inputs_stale
     h.play(**all_sensors())
-    h.spin_for(0.5)
-    assert h.commands[-1].linear.x > 0.0
-    assert not h.states[-1].inputs_stale
+    assert h.spin_until(lambda: driving(h) and not h.states[-1].inputs_stale, timeout_s=2.0)
 
 
 def test_a_lost_gas_sensor_does_not_stop_variants_that_do_not_smell(make_harness) -> None:
     h = make_harness(variant='minimum', robot_count=1, stale_timeout_s=0.5)
     h.play(scan=scan_msg(), imu=imu_msg())
-    h.spin_for(1.5)
-    assert h.commands[-1].linear.x > 0.0
+    assert h.spin_until(lambda: driving(h))
+    h.spin_for(1.0)
+    assert driving(h)
+    assert not h.states[-1].inputs_stale
 
 
 def test_nan_and_infinite_ranges_do_not_stop_the_controller(make_harness) -> None:
     h = make_harness(variant='gas_sound', robot_count=1)
     scan = scan_msg(front_m=5.0, fill=math.nan)
     h.play(scan=scan, imu=imu_msg(), gas=swarm.GasReading(raw=60))
-    h.spin_for(1.0)
-    assert h.commands[-1].linear.x > 0.0
+    assert h.spin_until(lambda: driving(h))
+    h.spin_for(0.3)
+    assert driving(h)
     assert not h.states[-1].inputs_stale
 
 
@@ -197,14 +199,13 @@ def test_an_imu_without_orientation_counts_as_missing(make_harness) -> None:
     h.play(scan=scan_msg(), imu=sensor.Imu(orientation=geometry.Quaternion(w=0.0)))
     h.spin_for(1.0)
     assert h.states[-1].inputs_stale
-    assert h.commands[-1].linear.x == 0.0
+    assert all(c.linear.x == 0.0 for c in h.commands)
 
 
 def test_scent_above_the_threshold_shows_in_the_state(make_harness) -> None:
     h = make_harness(variant='gas', robot_count=1, gas_threshold=200)
     h.play(**all_sensors(gas_raw=350))
-    h.spin_for(0.5)
-    assert h.states[-1].scent_detected
+    assert h.spin_until(lambda: h.states and h.states[-1].scent_detected)
     assert h.states[-1].gas_raw == 350
 
 
@@ -233,25 +234,37 @@ def test_the_parameter_file_starts_a_node_and_command_line_overrides_win() -> No
     from pathlib import Path
 
     path = Path(__file__).resolve().parents[1] / 'config' / 'oabug.yaml'
-    rclpy.init(args=['--ros-args', '--params-file', str(path), '-p', 'variant:=minimum'])
-    try:
-        node = OABugNode(namespace='/r3')
+    args = ['--ros-args', '--params-file', str(path), '-p', 'variant:=minimum']
+    with NodeTestBed(args) as bed:
+        node = bed.add_node(OABugNode, namespace='/r3')
         assert node.fsm.config.variant.value == 'minimum'
         assert node.fsm.config.gas_threshold == 200
-        node.destroy_node()
-    finally:
-        rclpy.try_shutdown()
+
+
+def stamp_s(msg: object) -> float:
+    return msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
 
 
 def test_state_is_published_at_its_own_rate_and_at_every_event(make_harness) -> None:
     h = make_harness(variant='gas', robot_count=1, state_rate_hz=2.0)
     h.play(**all_sensors(front_m=5.0))
-    h.spin_for(0.5)
+    assert h.spin_until(lambda: driving(h))
+    h.spin_for(0.3)
     h.states.clear()
+    h.commands.clear()
     h.spin_for(2.0)
+    intervals = [stamp_s(b) - stamp_s(a) for a, b in zip(h.states, h.states[1:], strict=False)]
     assert 3 <= len(h.states) <= 5, 'about 2 Hz while nothing happens'
-    assert len(h.commands) >= 19, 'while cmd_vel goes out every control step'
+    assert min(intervals) >= 0.5 - 1e-6, 'never faster than state_rate_hz'
+    assert len(h.commands) >= 3 * len(h.states), 'while cmd_vel goes out every control step'
+
+    # A long state period, so that no periodic state falls into the window below.
+    h = make_harness(variant='gas', robot_count=1, state_rate_hz=0.2)
+    h.play(**all_sensors(front_m=5.0))
+    assert h.spin_until(lambda: driving(h))
+    h.spin_for(0.3)
     h.states.clear()
     h.play(scan=scan_msg(front_m=0.22))
-    h.spin_for(0.15)
-    assert [s.event for s in h.states] == ['hit_wall']
+    assert h.spin_until(lambda: h.states, timeout_s=1.5)
+    h.spin_for(0.3)
+    assert [s.event for s in h.states] == ['hit_wall'], 'published at once, off the period'

@@ -14,14 +14,9 @@ from typing import Any
 
 import numpy as np
 from swarm_common.params import ParameterSpec, parameter
+from swarm_runtime.node_main import run_node
 from swarm_runtime.parameters import declare_config
-from swarm_runtime.ros import (
-    ExternalShutdownException,
-    Node,
-    message_module,
-    qos_profile_sensor_data,
-    rclpy,
-)
+from swarm_runtime.ros import Node, message_module, qos_profile_sensor_data
 
 __all__ = ['BOUNCER_PARAMETERS', 'BouncerConfig', 'WallBouncer', 'main']
 
@@ -65,20 +60,10 @@ class WallBouncer(Node):
         self._pub.publish(cmd)
 
 
-def main(args: list[str] | None = None) -> None:
+def main(args: list[str] | None = None) -> int:
     """Entry point: ``python -m sim_bridge.bouncer --ros-args -r __ns:=/r0``."""
-    rclpy.init(args=args)
-    node = None
-    try:
-        node = WallBouncer()
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
+    return run_node(WallBouncer, args, name='bouncer', parameters=BOUNCER_PARAMETERS)
 
 
 if __name__ == '__main__':
-    main()
+    raise SystemExit(main())

@@ -26,16 +26,14 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
-from swarm_common.cli import EXIT_SUCCESS, EXIT_USAGE, fail
-from swarm_runtime.parameters import ParameterFileError, check_parameter_arguments, declare_config
+from swarm_runtime.node_main import run_node
+from swarm_runtime.parameters import declare_config
 from swarm_runtime.ros import (
-    ExternalShutdownException,
     Node,
     QoSDurabilityPolicy,
     QoSProfile,
     message_module,
     qos_profile_sensor_data,
-    rclpy,
 )
 from swarm_sim.departure import place_starts
 from swarm_sim.engine import EngineConfig, SimEngine, SiteGeometry, StepOutput
@@ -348,34 +346,16 @@ class SimBridgeNode(Node):
         return any(ext.is_done() for ext in self.extensions)
 
 
-def main(args: list[str] | None = None) -> None:
+def main(args: list[str] | None = None) -> int:
     """Entry point of ``ros2 run sim_bridge sim_bridge``."""
-    try:
-        check_parameter_arguments(BRIDGE_PARAMETERS, NODE_NAME, args)
-    except ParameterFileError as err:
-        raise SystemExit(fail(NODE_NAME, err)) from None
-    rclpy.init(args=args)
-    node = None
-    code = EXIT_SUCCESS
-    try:
-        node = SimBridgeNode()
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    except SimulationError as err:
-        if node is None:
-            # The world could not be built (a bad parameter, pybullet missing): exit 2.
-            rclpy.logging.get_logger('sim_bridge').error(str(err))
-            code = EXIT_USAGE
-        else:
-            node.get_logger().error(str(err))
-    finally:
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
-    if code != EXIT_SUCCESS:
-        raise SystemExit(code)
+    return run_node(
+        SimBridgeNode,
+        args,
+        name=NODE_NAME,
+        fatal_errors=(SimulationError,),
+        parameters=BRIDGE_PARAMETERS,
+    )
 
 
 if __name__ == '__main__':
-    main()
+    raise SystemExit(main())

@@ -17,7 +17,7 @@ from sim_bridge.bridge_node import SimBridgeNode
 from sim_bridge.frames import compose
 from swarm_common.angles import yaw_from_quaternion
 from swarm_common.stamps import stamp_to_seconds
-from swarm_runtime.bag.testing import dds_test_environment, domain_id_for_tests, spin_until
+from swarm_runtime.bag.testing import spin_until
 from swarm_runtime.ros import (
     Node,
     Parameter,
@@ -49,10 +49,9 @@ swarm = message_module('swarm_interfaces')
 
 
 @pytest.fixture
-def executor(monkeypatch: pytest.MonkeyPatch):
-    for name, value in dds_test_environment().items():
-        monkeypatch.setenv(name, value)
-    rclpy.init(domain_id=domain_id_for_tests())
+def executor():
+    # The DDS domain and the discovery range are the test process's (conftest.py).
+    rclpy.init()
     executor = SingleThreadedExecutor()
     yield executor
     for node in list(executor.get_nodes()):

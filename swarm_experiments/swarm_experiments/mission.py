@@ -133,6 +133,10 @@ class MissionSpec:
         recording: optional bag recording.
         progress_period_s: sim-time interval between progress reports [s].
         trajectory_period_s: sim-time interval between stored true poses [s].
+        time_scale: sim seconds per wall second of the bridge's physics timer (its
+            ``real_time_factor``, unless ``bridge_parameters`` sets that). On real rclpy the
+            mission runs this much faster than real time, as far as the nodes keep up; the
+            built-in runtime runs as fast as it can whatever it is.
     """
 
     site: Any
@@ -146,6 +150,7 @@ class MissionSpec:
     recording: RecordingSpec | None = None
     progress_period_s: float = 10.0
     trajectory_period_s: float = 0.5
+    time_scale: float = 1.0
 
     def __post_init__(self) -> None:
         poses = np.asarray(self.initial_poses, dtype=float)
@@ -160,6 +165,9 @@ class MissionSpec:
             raise ConfigurationError(msg)
         if not (self.progress_period_s > 0.0 and self.trajectory_period_s > 0.0):
             raise ConfigurationError('progress_period_s and trajectory_period_s must be > 0')
+        if not (math.isfinite(self.time_scale) and self.time_scale > 0.0):
+            msg = f'time_scale must be positive and finite, got {self.time_scale}'
+            raise ConfigurationError(msg)
 
 
 @dataclass(frozen=True)
@@ -346,7 +354,8 @@ def run_mission(
     wall_start = time.perf_counter()
     interrupt = _InterruptRequest()
     try:
-        bridge_overrides = [Parameter(k, value=v) for k, v in spec.bridge_parameters.items()]
+        bridge_values = {'real_time_factor': float(spec.time_scale), **spec.bridge_parameters}
+        bridge_overrides = [Parameter(k, value=v) for k, v in bridge_values.items()]
         bridge = SimBridgeNode(
             site=spec.site,
             initial_poses=np.asarray(spec.initial_poses, dtype=float),

@@ -66,6 +66,7 @@ from swarm_experiments.mission import (
 )
 from swarm_experiments.node_overrides import parse_overrides
 from swarm_experiments.progress import MissionProgressBar, progress_wanted
+from swarm_experiments.runtime_option import add_runtime_arguments, check_runtime
 
 __all__ = [
     'ACTION_LENGTH_M',
@@ -144,6 +145,7 @@ class SpawnSettings:
     profile: str = 'tuned'
     robot_parameters: dict[str, object] = field(default_factory=dict)
     engine: EngineConfig = field(default_factory=EngineConfig)
+    time_scale: float = 1.0
 
     def __post_init__(self) -> None:
         if self.variant not in VARIANTS:
@@ -304,6 +306,7 @@ def build_mission(
         engine_config=engine,
         recording=recording,
         progress_period_s=min(10.0, max(1.0, config.budget_s / 100.0)),
+        time_scale=config.time_scale,
     )
     return spec, bias
 
@@ -435,6 +438,7 @@ def _parser() -> argparse.ArgumentParser:
     )
     add_physics_option(parser)
     add_render_option(parser)
+    add_runtime_arguments(parser)
     return parser
 
 
@@ -459,9 +463,11 @@ def _main(argv: list[str]) -> int:
         record=args.record,
         record_scans=args.record_scans,
         out_dir=None if args.no_plots else args.out,
+        time_scale=args.time_scale,
         engine=EngineConfig(physics=args.physics, render=render_config(args.render)),
     )
     require_backend(args.physics)
+    check_runtime(args.runtime)
     check_run_outputs(config.record, config.out_dir)
     spec, bias = build_mission(config, max_robots=MAX_ROBOTS)
     for warning in spec.site.warnings:

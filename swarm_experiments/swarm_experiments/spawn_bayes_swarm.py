@@ -68,6 +68,10 @@ from swarm_experiments.mission import (
 from swarm_experiments.node_overrides import parse_overrides
 from swarm_experiments.open_field import point_robot_engine_config
 from swarm_experiments.progress import MissionProgressBar, progress_wanted
+from swarm_experiments.runtime_option import (
+    add_runtime_arguments,
+    check_runtime,
+)
 
 __all__ = [
     'ALGORITHMS',
@@ -125,6 +129,7 @@ class SpawnSettings:
         out_dir: where the PNGs go (None: no plots).
         extra_parameters: further node parameters (name -> value).
         physics: the engine's physics backend ('numpy' or 'pybullet').
+        time_scale: on real rclpy, sim seconds per wall second (MissionSpec.time_scale).
     """
 
     algorithm: str = 'bayes_swarm_p'
@@ -142,6 +147,7 @@ class SpawnSettings:
     out_dir: Path | None = None
     extra_parameters: dict[str, Any] = field(default_factory=dict)
     physics: str = 'numpy'
+    time_scale: float = 1.0
 
 
 @dataclass
@@ -386,6 +392,7 @@ def run(settings: SpawnSettings, progress: Any = None) -> BayesSwarmRun:
         max_sim_time_s=case.max_mission_time_s + 2.0,
         engine_config=_engine_config(case, settings.seed, settings.physics),
         bridge_parameters=bridge_parameters,
+        time_scale=settings.time_scale,
         extensions=[SignalExtension(model)],
         stop_when_all_rooms_covered=False,
         recording=recording,
@@ -510,6 +517,7 @@ def build_parser() -> argparse.ArgumentParser:
         'horizon_s=20; names and defaults: ros2 param describe, or bayes_swarm.node_settings',
     )
     add_physics_option(parser)
+    add_runtime_arguments(parser)
     return parser
 
 
@@ -521,6 +529,7 @@ def main(argv: Sequence[str] | None = None) -> int:
 def _main(argv: list[str]) -> int:
     args = build_parser().parse_args(argv)
     require_backend(args.physics)
+    check_runtime(args.runtime)
     extra = node_parameter_overrides(args.param)
     settings = SpawnSettings(
         extra_parameters=extra,
@@ -537,6 +546,7 @@ def _main(argv: list[str]) -> int:
         profile=args.profile,
         record=args.record,
         physics=args.physics,
+        time_scale=args.time_scale,
     )
     case = check_settings(settings)
     out_dir = None if args.no_plots else args.out

@@ -68,6 +68,10 @@ from swarm_experiments.msc_pf_batch import scenario_start
 from swarm_experiments.node_overrides import parse_overrides
 from swarm_experiments.open_field import point_robot_engine_config
 from swarm_experiments.progress import MissionProgressBar, progress_wanted
+from swarm_experiments.runtime_option import (
+    add_runtime_arguments,
+    check_runtime,
+)
 
 __all__ = ['SCHEMES', 'MscPfRun', 'SpawnSettings', 'controller_parameter_overrides', 'main', 'run']
 
@@ -109,6 +113,7 @@ class SpawnSettings:
         out_dir: where the PNGs go (None: no plots).
         extra_parameters: further msc_pf node parameters (name -> value).
         physics: the engine's physics backend ('numpy' or 'pybullet').
+        time_scale: on real rclpy, sim seconds per wall second (MissionSpec.time_scale).
     """
 
     scheme: str = 'proposed'
@@ -126,6 +131,7 @@ class SpawnSettings:
     out_dir: Path | None = None
     extra_parameters: dict[str, Any] = field(default_factory=dict)
     physics: str = 'numpy'
+    time_scale: float = 1.0
 
 
 @dataclass
@@ -293,6 +299,7 @@ def run(settings: SpawnSettings, progress: Any = None) -> MscPfRun:
             'comm_range_m': float(settings.comm_range_m),
             'peer_loss_probability': float(settings.loss_probability),
         },
+        time_scale=settings.time_scale,
         extensions=[extension],
         stop_when_all_rooms_covered=False,
         recording=recording,
@@ -419,6 +426,7 @@ def build_parser() -> argparse.ArgumentParser:
         'msc.leader_rule=pbest; names and defaults: msc_pf/config/msc_pf.yaml',
     )
     add_physics_option(parser)
+    add_runtime_arguments(parser)
     return parser
 
 
@@ -431,6 +439,7 @@ def _main(argv: list[str]) -> int:
     args = build_parser().parse_args(argv)
     targets = args.targets if args.target_positions is None else len(args.target_positions)
     require_backend(args.physics)
+    check_runtime(args.runtime)
     extra = controller_parameter_overrides(args.param)
     settings = SpawnSettings(
         extra_parameters=extra,
@@ -444,6 +453,7 @@ def _main(argv: list[str]) -> int:
         target_positions_m=args.target_positions,
         record=args.record,
         physics=args.physics,
+        time_scale=args.time_scale,
     )
     check_settings(settings)
     out_dir = None if args.no_plots else args.out

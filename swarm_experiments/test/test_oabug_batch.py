@@ -21,6 +21,9 @@ from swarm_sim.sensors.bearings import BearingConfig, BearingModel
 from swarm_sim.sensors.lidar import LidarConfig
 
 FIVE_ROOMS = Path(__file__).parent / 'data' / 'five_rooms.lay'
+# The ROS path equals the batch path bit for bit only on the deterministic executor: on DDS
+# the delivery order and timing of the robots' messages vary from run to run.
+BIT_EXACT = pytest.mark.builtin_only(reason='bit-exact determinism of the in-process ROS path')
 
 
 @pytest.mark.parametrize(
@@ -31,6 +34,7 @@ FIVE_ROOMS = Path(__file__).parent / 'data' / 'five_rooms.lay'
     ],
     ids=['small-10-robots', 'five-rooms-all-covered'],
 )
+@BIT_EXACT
 def test_batch_and_ros_paths_give_the_same_poses_and_first_entries(
     site, robots, variant, departure, actions
 ):
@@ -86,6 +90,7 @@ def test_a_robot_holds_still_until_scan_and_imu_arrive_and_when_they_go_stale():
     assert robot.control(0.2 + robot.stale_timeout_s + 0.1) == stop
 
 
+@BIT_EXACT
 def test_without_the_cdr_round_trip_both_paths_still_agree(monkeypatch):
     # In-process messages then keep Python floats in their float32 fields; the batch path
     # follows the runtime's setting.

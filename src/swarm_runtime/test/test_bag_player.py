@@ -15,7 +15,7 @@ from rosbags.interfaces import Qos, QosDurability, QosHistory, QosLiveliness, Qo
 from rosbags.interfaces import QosTime as Time
 from swarm_runtime.bag import BagPlayer, BagWriter
 from swarm_runtime.bag.player import replay_qos
-from swarm_runtime.bag.testing import dds_test_environment, domain_id_for_tests, spin_until
+from swarm_runtime.bag.testing import spin_until
 from swarm_runtime.messages import get_message_module
 from swarm_runtime.ros import (
     Node,
@@ -48,11 +48,9 @@ SENSOR = _qos(QosReliability.BEST_EFFORT, QosDurability.VOLATILE, depth=5)
 
 
 @pytest.fixture
-def ros(monkeypatch: pytest.MonkeyPatch) -> Iterator[None]:
-    """An initialised ROS context for one test (on DDS: a domain of this process, localhost)."""
-    for name, value in dds_test_environment().items():
-        monkeypatch.setenv(name, value)
-    rclpy.init(domain_id=domain_id_for_tests())
+def ros() -> Iterator[None]:
+    """An initialised ROS context for one test (on DDS: the domain of this test process)."""
+    rclpy.init()
     yield
     rclpy.try_shutdown()
 

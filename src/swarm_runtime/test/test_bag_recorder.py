@@ -8,7 +8,6 @@ on DDS with the reason.
 
 from __future__ import annotations
 
-import os
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -17,7 +16,7 @@ import pytest
 import yaml
 from swarm_runtime.bag import BagRecorder, TruncatedBagWarning, read_bag_info, read_messages
 from swarm_runtime.bag.recorder import SYSTEM_TOPICS
-from swarm_runtime.bag.testing import dds_test_environment, domain_id_for_tests, spin_until
+from swarm_runtime.bag.testing import spin_until
 from swarm_runtime.ros import (
     Node,
     Parameter,
@@ -34,17 +33,15 @@ std_msgs = message_module('std_msgs')
 REAL = using_real_rclpy()
 # Host-time budget for one wait; DDS discovery on a loaded machine can take a few seconds.
 WAIT_S = 20.0
-builtin_only = pytest.mark.skipif(
-    REAL, reason='exact delivery timing: the built-in runtime delivers without discovery delay'
+builtin_only = pytest.mark.builtin_only(
+    reason='exact delivery timing: the built-in runtime delivers without discovery delay'
 )
 
 
 @pytest.fixture
-def ros(monkeypatch: pytest.MonkeyPatch) -> Iterator[None]:
-    """An initialised ROS context for one test (on DDS: a domain of this process, localhost)."""
-    for name, value in dds_test_environment().items():
-        monkeypatch.setenv(name, value)
-    rclpy.init(domain_id=domain_id_for_tests())
+def ros() -> Iterator[None]:
+    """An initialised ROS context for one test (on DDS: the domain of this test process)."""
+    rclpy.init()
     yield
     rclpy.try_shutdown()
 
@@ -232,7 +229,7 @@ def test_a_latched_topic_published_in_another_process_before_recording_is_record
         'import rclpy, sys\n'
         'from rclpy.qos import QoSProfile, DurabilityPolicy\n'
         'from std_msgs.msg import String\n'
-        f'rclpy.init(domain_id={domain_id_for_tests()})\n'
+        'rclpy.init()\n'
         "node = rclpy.create_node('latcher')\n"
         'qos = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL)\n'
         "pub = node.create_publisher(String, '/sim/site', qos)\n"
@@ -241,12 +238,10 @@ def test_a_latched_topic_published_in_another_process_before_recording_is_record
         'sys.stdin.read()  # DDS serves the history from its own threads until stdin closes\n'
         'rclpy.try_shutdown()\n'
     )
-    env = {**os.environ, **dds_test_environment()}
     process = subprocess.Popen(
         [sys.executable, '-c', script],
         stdin=subprocess.PIPE,
         stdout=subprocess.PIPE,
-        env=env,
         text=True,
     )
     try:

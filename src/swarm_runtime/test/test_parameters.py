@@ -12,7 +12,7 @@ from swarm_runtime.parameters import (
     check_parameter_arguments,
     declare_config,
 )
-from swarm_runtime.ros import Node, Parameter, rclpy, using_real_rclpy
+from swarm_runtime.ros import Node, Parameter, rclpy
 
 
 @dataclass(frozen=True)
@@ -215,7 +215,7 @@ def test_command_line_values_are_checked_too() -> None:
     check('--ros-args', '-p', 'other:gain:=oops')  # for another node
 
 
-@pytest.mark.skipif(using_real_rclpy(), reason='drives the built-in runtime')
+@pytest.mark.builtin_only(reason="checks the built-in runtime's own conformance to rclpy")
 def test_the_builtin_runtime_rejects_what_rclpy_rejects(init) -> None:
     node = make_node()
     with pytest.raises(TypeError, match='callable'):

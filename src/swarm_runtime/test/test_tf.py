@@ -11,7 +11,7 @@ from collections.abc import Iterator
 from typing import Any
 
 import pytest
-from swarm_runtime.bag.testing import dds_test_environment, domain_id_for_tests, spin_until
+from swarm_runtime.bag.testing import spin_until
 from swarm_runtime.ros import Node, SingleThreadedExecutor, message_module, rclpy
 from swarm_runtime.tf import (
     TF_STATIC_TOPIC,
@@ -51,10 +51,9 @@ JAZZY_HASHES = {
 
 
 @pytest.fixture
-def executor(monkeypatch: pytest.MonkeyPatch) -> Iterator[Any]:
-    for name, value in dds_test_environment().items():
-        monkeypatch.setenv(name, value)
-    rclpy.init(domain_id=domain_id_for_tests())
+def executor() -> Iterator[Any]:
+    # The DDS domain and the discovery range are the test process's (conftest.py).
+    rclpy.init()
     executor = SingleThreadedExecutor()
     yield executor
     for node in list(executor.get_nodes()):

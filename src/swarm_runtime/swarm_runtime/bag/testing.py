@@ -1,20 +1,17 @@
-"""Helpers for tests that run recorders, players and other nodes on either runtime.
+"""Helpers for tests of bags, recorders and players on either runtime.
 
 The same test runs on the built-in runtime (virtual time, immediate discovery) and on real
-rclpy over DDS (real time, discovery takes a while). On DDS a test process needs a domain of
-its own, with traffic kept on this machine, and must wait for the graph to match before it
-publishes; these helpers do both::
+rclpy over DDS (real time, discovery takes a while), so tests wait for what they expect
+with a budget of host time::
 
-    os.environ.update(dds_test_environment())       # before rclpy.init
-    rclpy.init(domain_id=domain_id_for_tests())
-    ...
     assert spin_until(executor, lambda: recorder.message_count >= 5, timeout_s=10.0)
+
+The DDS domain of each test process is set up before rclpy is imported, by the root
+conftest.py with :mod:`swarm_runtime.dds_isolation`.
 """
 
 from __future__ import annotations
 
-import os
-import re
 import struct
 import time
 from collections.abc import Callable
@@ -22,37 +19,10 @@ from pathlib import Path
 from typing import Any
 
 __all__ = [
-    'DOMAIN_BASE_ENV_VAR',
-    'dds_test_environment',
-    'domain_id_for_tests',
     'message_record_ends',
     'spin_for',
     'spin_until',
 ]
-
-#: Environment variable that moves the block of domain ids the tests use.
-DOMAIN_BASE_ENV_VAR = 'SWARM_TEST_DOMAIN_BASE'
-_DEFAULT_DOMAIN_BASE = 40
-_MAX_DOMAIN_ID = 101  # the highest id Fast DDS and Cyclone map to valid ports on every host
-
-
-def domain_id_for_tests() -> int:
-    """A ROS domain id for this test process: base + the pytest-xdist worker number.
-
-    The base is ``SWARM_TEST_DOMAIN_BASE`` (default 40); a run without xdist uses the base.
-    """
-    base = int(os.environ.get(DOMAIN_BASE_ENV_VAR, _DEFAULT_DOMAIN_BASE))
-    match = re.search(r'(\d+)$', os.environ.get('PYTEST_XDIST_WORKER', ''))
-    domain = base + (int(match.group(1)) if match else 0)
-    if not 0 <= domain <= _MAX_DOMAIN_ID:
-        msg = f'test domain id {domain} is outside 0..{_MAX_DOMAIN_ID} ({DOMAIN_BASE_ENV_VAR})'
-        raise ValueError(msg)
-    return domain
-
-
-def dds_test_environment() -> dict[str, str]:
-    """Environment that keeps DDS discovery on this machine (set before ``rclpy.init``)."""
-    return {'ROS_AUTOMATIC_DISCOVERY_RANGE': 'LOCALHOST'}
 
 
 def spin_until(
