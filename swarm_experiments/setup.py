@@ -48,5 +48,6 @@ setup(
             'spawn_msc_pf = swarm_experiments.spawn_msc_pf:main',
             'swarm_study = swarm_experiments.study.cli:main',
         ],
+        'swarm_experiments.studies': ['reliability = swarm_experiments.reliability:studies'],
     },
 )

@@ -34,6 +34,7 @@ from bayes_swarm.settings import (
     GlowwormConfig,
     LevyConfig,
 )
+from swarm_sim.faults import FaultConfig, FaultPlan
 from swarm_sim.point_robots import FieldFunction, PointRobotField
 
 __all__ = [
@@ -64,6 +65,8 @@ class MissionSpec:
         relative_noise: std of measurement noise as a fraction of |f| (Table 7's |A| / k).
         comm_range_m: peer-message range [m]; None is unlimited.
         loss_probability: probability that one peer message to one receiver is lost.
+        faults: faults injected on purpose (:mod:`swarm_sim.faults`): robot dropouts, a
+            shorter or lossier peer link, stuck or drifting signal sensors.
     """
 
     field: FieldFunction
@@ -78,6 +81,7 @@ class MissionSpec:
     glowworm: GlowwormConfig = field(default_factory=GlowwormConfig)
     levy: LevyConfig = field(default_factory=LevyConfig)
     exhaustive: ExhaustiveConfig = field(default_factory=ExhaustiveConfig)
+    faults: FaultConfig = field(default_factory=FaultConfig)
 
     def __post_init__(self) -> None:
         if self.noise_std < 0.0 or self.relative_noise < 0.0:
@@ -181,13 +185,17 @@ def run_mission(
     if n_robots < 1:
         msg = f'n_robots must be >= 1, got {n_robots}'
         raise ConfigError(msg)
+    plan = FaultPlan(spec.faults, n_robots, seed) if spec.faults.active else None
     seeds = np.random.SeedSequence(seed).spawn(n_robots + 1)
     world_rng = np.random.default_rng(seeds[0])
     world = _world(spec, n_robots, world_rng)
     if algorithm == 'glowworm':
+        if plan is not None:
+            msg = 'faults are not simulated for glowworm (a synchronous swarm iteration)'
+            raise ConfigError(msg)
         return _run_glowworm(spec, world, n_robots, seeds)
     agents = _make_agents(spec, algorithm, n_robots, seeds, world)
-    return _run_events(spec, world, agents, keep_planners)
+    return _run_events(spec, world, agents, keep_planners, plan)
 
 
 # --------------------------------------------------------------------------- agents
@@ -291,22 +299,34 @@ def _make_agents(
 
 # ----------------------------------------------------------------------- event loop
 def _deliver(
-    spec: MissionSpec, world: PointRobotField, agents: list[_Agent], sender: int, update: PeerUpdate
+    spec: MissionSpec,
+    world: PointRobotField,
+    agents: list[_Agent],
+    sender: int,
+    update: PeerUpdate,
+    links: tuple[float | None, float, np.ndarray | None] | None = None,
 ) -> None:
+    """Deliver ``sender``'s update; ``links``: range [m] (None: unlimited), loss and the
+    dropped robots that receive nothing, when faults change them."""
+    comm_range_m, loss, dropped = links or (spec.comm_range_m, spec.loss_probability, None)
     for j, agent in enumerate(agents):
-        if j == sender:
+        if j == sender or (dropped is not None and dropped[j]):
             continue
-        if spec.comm_range_m is not None:
+        if comm_range_m is not None:
             gap = world.positions[j] - world.positions[sender]
-            if np.hypot(*gap) > spec.comm_range_m:
+            if np.hypot(*gap) > comm_range_m:
                 continue
-        if spec.loss_probability > 0.0 and world.rng.uniform() < spec.loss_probability:
+        if loss > 0.0 and world.rng.uniform() < loss:
             continue
         agent.receive(update)
 
 
 def _run_events(
-    spec: MissionSpec, world: PointRobotField, agents: list[_Agent], keep_planners: bool
+    spec: MissionSpec,
+    world: PointRobotField,
+    agents: list[_Agent],
+    keep_planners: bool,
+    plan: FaultPlan | None = None,
 ) -> MissionResult:
     cfg = spec.planner
     n = len(agents)
@@ -317,11 +337,31 @@ def _run_events(
     waypoints = world.positions.copy()
     tick = 0
     t = 0.0
+    # Faults: the dropout instant is an event; dropped robots stop, sample, decide and talk
+    # no more; faulty sensors read what the plan says.
+    dropout_s = math.inf if plan is None else plan.config.dropout_time_s
+    dropped = np.zeros(n, dtype=bool)
+    held: dict[int, float] = {}
+
+    def links() -> tuple[float | None, float, np.ndarray | None] | None:
+        if plan is None:
+            return None
+        comm_range_m = plan.combined_range_m(spec.comm_range_m)
+        return comm_range_m, plan.combined_loss(spec.loss_probability), dropped
 
     def sample_all() -> None:
         values = world.sample(world.positions)
-        for agent, p, v in zip(agents, world.positions, values, strict=True):
-            agent.observe(p, float(v))
+        for i, (agent, p, v) in enumerate(zip(agents, world.positions, values, strict=True)):
+            if plan is None:
+                agent.observe(p, float(v))
+            elif not dropped[i]:
+                agent.observe(p, plan.signal(i, float(v), t, held))
+
+    def drop_out() -> None:
+        nonlocal dropped
+        assert plan is not None
+        dropped = plan.dropped(t).copy()
+        waypoints[dropped] = world.positions[dropped]
 
     def decide(i: int) -> None:
         decision = agents[i].decide(world.positions[i].copy(), t)
@@ -330,14 +370,17 @@ def _run_events(
         world.trajectories[i].append(world.positions[i].copy())
         update = agents[i].broadcast(world.positions[i].copy())
         if update is not None:
-            _deliver(spec, world, agents, i, update)
+            _deliver(spec, world, agents, i, update, links())
 
+    if dropout_s <= 0.0:
+        drop_out()
     sample_all()
     if world.move(waypoints, 0.0, 0.0, speed):
         pass
     else:
         for i in range(n):
-            decide(i)
+            if not dropped[i]:
+                decide(i)
     while world.finder < 0 and t < t_max - _TIME_EPS:
         remaining = np.hypot(*(waypoints - world.positions).T)
         arrivals = t + remaining / speed
@@ -345,16 +388,21 @@ def _run_events(
         moving = remaining > 1e-12
         t_next = min(next_tick, float(np.min(arrivals[moving])) if np.any(moving) else math.inf)
         t_next = min(t_next, t_max)
+        if t < dropout_s - _TIME_EPS:
+            t_next = min(t_next, dropout_s)
         if world.move(waypoints, t, t_next, speed):
             t = world.found_time_s
             break
         t = t_next
+        if plan is not None and abs(t - dropout_s) <= _TIME_EPS:
+            drop_out()
         if abs(t - next_tick) <= _TIME_EPS:
             tick += 1
             sample_all()
         arrived = np.flatnonzero(np.hypot(*(waypoints - world.positions).T) <= 1e-9)
         for i in arrived:
-            decide(int(i))
+            if not dropped[i]:
+                decide(int(i))
     for i in range(n):
         world.trajectories[i].append(world.positions[i].copy())
     planners = [a.planner for a in agents if a.planner is not None] if keep_planners else []

@@ -30,6 +30,7 @@ from msc_pf.peers import PeerInfo
 from msc_pf.robot import RobotController, StepOutput
 from msc_pf.schemes import Scheme
 from msc_pf.settings import MscPfConfig
+from swarm_sim.faults import FaultConfig, FaultPlan
 from swarm_sim.rssi_targets import RssiTargetConfig, RssiTargetField, place_robots
 
 __all__ = ['BatchResult', 'BatchScenario', 'SearchCoverage', 'run_batch', 'search_coverage']
@@ -49,6 +50,9 @@ class BatchScenario:
         comm_loss: probability that one peer message is lost.
         controller: controller configuration (its scheme is replaced by ``scheme``).
         target_positions_m: (n_targets, 2) fixed target positions; None places them randomly.
+        faults: faults injected on purpose (:mod:`swarm_sim.faults`): robot dropouts (a
+            dropped robot stands still, hears, works and talks no more) and a shorter or
+            lossier peer link.
     """
 
     scheme: Scheme = Scheme.PROPOSED
@@ -60,6 +64,7 @@ class BatchScenario:
     comm_loss: float = 0.0
     controller: MscPfConfig = field(default_factory=MscPfConfig)
     target_positions_m: np.ndarray | None = None
+    faults: FaultConfig = field(default_factory=FaultConfig)
 
 
 @dataclass
@@ -99,14 +104,19 @@ def _deliver(
     comm_range_m: float,
     loss: float,
     rng: np.random.Generator,
+    dropped: np.ndarray | None = None,
 ) -> list[list[PeerInfo]]:
-    """Peer messages each robot receives: senders within range, minus random losses."""
+    """Peer messages each robot receives: senders within range, minus random losses
+    (``dropped`` robots neither send nor receive)."""
     n = len(outputs)
     diff = positions[:, None, :] - positions[None, :, :]
     in_range = np.hypot(diff[..., 0], diff[..., 1]) <= comm_range_m
     if loss > 0.0:
         in_range &= rng.random((n, n)) >= loss
     np.fill_diagonal(in_range, False)
+    if dropped is not None and dropped.any():
+        in_range[dropped, :] = False
+        in_range[:, dropped] = False
     messages = [out.broadcast for out in outputs]
     return [
         [m for m, heard in zip(messages, row, strict=True) if heard] for row in in_range.tolist()
@@ -151,6 +161,16 @@ def run_batch(
     center = (config.field_size_m / 2.0, config.field_size_m / 2.0)
     positions = place_robots(scenario.n_robots, center, scenario.start_radius_m, world_rng)
     controllers = [RobotController(i, config, scenario.seed) for i in range(scenario.n_robots)]
+    plan = (
+        FaultPlan(scenario.faults, scenario.n_robots, scenario.seed)
+        if scenario.faults.active
+        else None
+    )
+    comm_range_m, comm_loss = config.swarm.comm_range_m, scenario.comm_loss
+    if plan is not None:
+        comm_range_m = min(comm_range_m, plan.comm_range_m)
+        comm_loss = plan.combined_loss(comm_loss)
+    dropped = None
     dt = config.period_s
     inbox: list[list[PeerInfo]] = [[] for _ in controllers]
     notices: list[list[int]] = [[] for _ in controllers]
@@ -163,7 +183,11 @@ def run_batch(
     search_only = scenario.n_targets == 0
     while (search_only or not targets.all_captured) and now < scenario.max_time_s:
         now += dt
+        if plan is not None:
+            dropped = plan.dropped(now)
         samples = targets.sample_rssi(positions, world_rng)
+        if dropped is not None and dropped.any():
+            samples[dropped] = np.nan  # a dropped robot hears nothing
         heard_now = ~np.isnan(samples).all(axis=0)
         first_time = heard_now & np.isnan(first_heard)
         if first_time.any():
@@ -181,15 +205,17 @@ def run_batch(
             )
         broadcast_positions = positions.copy()
         steps = np.array([out.displacement_m for out in outputs])
+        if dropped is not None and dropped.any():
+            steps[dropped] = 0.0
         positions = np.clip(positions + steps, 0.0, config.field_size_m)
         speeds = np.hypot(steps[:, 0], steps[:, 1]) / dt
+        if dropped is not None and dropped.any():
+            speeds[dropped] = np.inf  # a dropped robot works on no target
         notices = [[] for _ in controllers]
         for capture in targets.work(positions, speeds, dt, now):
             for robot in capture.robot_indices:
                 notices[robot].append(capture.target_id)
-        inbox = _deliver(
-            outputs, broadcast_positions, config.swarm.comm_range_m, scenario.comm_loss, world_rng
-        )
+        inbox = _deliver(outputs, broadcast_positions, comm_range_m, comm_loss, world_rng, dropped)
         if paths is not None and phases is not None:
             paths.append(positions.copy())
             phases.append([int(out.status.phase) for out in outputs])

@@ -31,6 +31,7 @@ from swarm_sim.engine import EngineConfig
 from swarm_sim.errors import ConfigurationError
 from swarm_sim.site_loading import load_site, site_budget_actions
 
+from swarm_experiments.cli_args import add_fault_arguments, add_sensor_arguments, engine_options
 from swarm_experiments.errors import ExperimentError
 from swarm_experiments.mission import (
     VIEWER_TOPICS,
@@ -345,6 +346,8 @@ def _parser() -> argparse.ArgumentParser:
         help='set an OA-Bug node parameter for every robot (repeatable), e.g. '
         'gas_threshold=300 or sound_turn_rule=toward; names and defaults: docs/oabug.md',
     )
+    add_sensor_arguments(parser)
+    add_fault_arguments(parser)
     return parser
 
 
@@ -365,6 +368,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             record=args.record,
             record_scans=args.record_scans,
             out_dir=None if args.no_plots else args.out,
+            engine=engine_options(args, EngineConfig()),
         )
         site_warnings = load_site(config.site, seed=config.site_seed).warnings
     except SwarmError as err:
@@ -385,6 +389,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         f'= {config.budget_s:.0f} s at {config.speed_mps} m/s',
         flush=True,
     )
+    if args.sensors != 'ideal' or config.engine.faults.active:
+        print(f'sensors {args.sensors}; faults: {config.engine.faults.describe()}', flush=True)
     if config.robot_parameters:
         settings = ', '.join(f'{k}={v}' for k, v in sorted(config.robot_parameters.items()))
         print(f'OA-Bug parameters other than the defaults: {settings}', flush=True)

@@ -19,6 +19,7 @@ including those the case sets.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import math
 import sys
 from collections.abc import Sequence
@@ -32,12 +33,13 @@ from swarm_common.cli import EXIT_SUCCESS, fail
 from swarm_common.errors import SwarmError
 from swarm_sim.engine import EngineConfig, SiteGeometry
 from swarm_sim.errors import ConfigurationError
+from swarm_sim.faults import FaultConfig
 from swarm_sim.signal_fields import CASE_NAMES, SignalCase, UnknownCaseError, get_case
 from swarm_sim.signal_mission import SignalMissionModel
 
 from swarm_experiments.bayes_batch import MissionSpec as BatchMissionSpec
 from swarm_experiments.bayes_batch import depot_fan
-from swarm_experiments.cli_args import points_argument
+from swarm_experiments.cli_args import add_fault_arguments, fault_config, points_argument
 from swarm_experiments.errors import ExperimentError
 from swarm_experiments.mission import (
     VIEWER_TOPICS,
@@ -100,6 +102,8 @@ class SpawnSettings:
         outer_optimizer: Bayes-Swarm's Eq. 1 solver (grid, cobyla, pso).
         record: bag directory to write, or None.
         out_dir: where the PNGs go (None: no plots).
+        faults: faults injected on purpose (robot dropouts and link faults act through
+            the bridge: a dropped robot stops and its peer messages are lost).
         extra_parameters: further node parameters (name -> value).
     """
 
@@ -117,6 +121,7 @@ class SpawnSettings:
     record: Path | None = None
     out_dir: Path | None = None
     extra_parameters: dict[str, Any] = field(default_factory=dict)
+    faults: FaultConfig = field(default_factory=FaultConfig)
 
 
 @dataclass
@@ -338,7 +343,9 @@ def run(settings: SpawnSettings, progress: Any = None) -> BayesSwarmRun:
         initial_poses=poses,
         robots=[RobotNodeSpec(factory, node_parameters(case, settings, n, i)) for i in range(n)],
         max_sim_time_s=case.max_mission_time_s + 2.0,
-        engine_config=_engine_config(case, settings.seed),
+        engine_config=dataclasses.replace(
+            _engine_config(case, settings.seed), faults=settings.faults
+        ),
         bridge_parameters=bridge_parameters,
         extensions=[SignalExtension(model)],
         stop_when_all_rooms_covered=False,
@@ -451,6 +458,7 @@ def build_parser() -> argparse.ArgumentParser:
         help='set a bayes_swarm node parameter for every robot (repeatable), e.g. '
         'horizon_s=20; names and defaults: ros2 param describe, or bayes_swarm.node_settings',
     )
+    add_fault_arguments(parser)
     return parser
 
 
@@ -458,10 +466,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``spawn_bayes_swarm``; returns the exit status."""
     args = build_parser().parse_args(argv)
     try:
+        faults = fault_config(args.fault)
         extra = node_parameter_overrides(args.param)
     except ConfigurationError as err:
         return fail('spawn_bayes_swarm', err)
     settings = SpawnSettings(
+        faults=faults,
         extra_parameters=extra,
         algorithm=args.algorithm,
         case=args.case,

@@ -20,6 +20,7 @@ node parameter for every robot (names: ``msc_pf/config/msc_pf.yaml``).
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import math
 import sys
 from collections.abc import Sequence
@@ -33,9 +34,10 @@ from swarm_common.cli import EXIT_SUCCESS, EXIT_UNFINISHED, fail
 from swarm_common.errors import SwarmError
 from swarm_sim.engine import EngineConfig, SiteGeometry
 from swarm_sim.errors import ConfigurationError
+from swarm_sim.faults import FaultConfig
 from swarm_sim.rssi_targets import RssiTargetConfig, RssiTargetField, place_robots
 
-from swarm_experiments.cli_args import points_argument
+from swarm_experiments.cli_args import add_fault_arguments, fault_config, points_argument
 from swarm_experiments.errors import ExperimentError
 from swarm_experiments.mission import (
     VIEWER_TOPICS,
@@ -83,6 +85,8 @@ class SpawnSettings:
         target_positions_m: (targets, 2) fixed target positions, or None.
         record: bag directory to write, or None.
         out_dir: where the PNGs go (None: no plots).
+        faults: faults injected on purpose (robot dropouts and link faults act through
+            the bridge: a dropped robot stops and its peer messages are lost).
         extra_parameters: further msc_pf node parameters (name -> value).
     """
 
@@ -100,6 +104,7 @@ class SpawnSettings:
     record: Path | None = None
     out_dir: Path | None = None
     extra_parameters: dict[str, Any] = field(default_factory=dict)
+    faults: FaultConfig = field(default_factory=FaultConfig)
 
 
 @dataclass
@@ -232,7 +237,7 @@ def run(settings: SpawnSettings, progress: Any = None) -> MscPfRun:
         initial_poses=poses,
         robots=[RobotNodeSpec(factory, node_parameters(settings, i)) for i in range(len(poses))],
         max_sim_time_s=settings.max_time_s,
-        engine_config=_engine_config(settings),
+        engine_config=dataclasses.replace(_engine_config(settings), faults=settings.faults),
         bridge_parameters={
             'peer_msg_type': PEER_TYPE,
             'comm_range_m': float(settings.comm_range_m),
@@ -354,6 +359,7 @@ def build_parser() -> argparse.ArgumentParser:
         help='set an msc_pf controller parameter for every robot (repeatable), e.g. '
         'msc.leader_rule=pbest; names and defaults: msc_pf/config/msc_pf.yaml',
     )
+    add_fault_arguments(parser)
     return parser
 
 
@@ -362,10 +368,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     targets = args.targets if args.target_positions is None else len(args.target_positions)
     try:
+        faults = fault_config(args.fault)
         extra = controller_parameter_overrides(args.param)
     except ConfigurationError as err:
         return fail('spawn_msc_pf', err)
     settings = SpawnSettings(
+        faults=faults,
         extra_parameters=extra,
         scheme=args.scheme,
         robots=args.robots,

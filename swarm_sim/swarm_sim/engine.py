@@ -23,8 +23,10 @@ from swarm_common.angles import wrap_angle
 from swarm_common.params import parameter, section
 
 from swarm_sim.errors import ConfigurationError, WorldGeometryError
+from swarm_sim.faults import FaultConfig, FaultInjector, FaultPlan
 from swarm_sim.geometry import RayCaster
 from swarm_sim.ground_truth import CoverageTracker, RoomEntry
+from swarm_sim.sensor_profiles import AoaRealism, AoaRealismConfig
 from swarm_sim.sensors.bearings import BearingConfig, BearingCycle, BearingModel, PeerBearings
 from swarm_sim.sensors.gas_sensor import GasSensorConfig, Mp503Model
 from swarm_sim.sensors.imu import GyroYawModel, ImuConfig
@@ -74,6 +76,9 @@ class EngineConfig:
             Each model draws from its own random stream, so leaving one out changes none of
             the others; a sensor left out is not built and costs nothing. Without ``gas``
             there is no scent field either (pumps then lay nothing).
+        aoa: non-line-of-sight effects on the AoA bearings (off: the ideal profile; see
+            :mod:`swarm_sim.sensor_profiles`).
+        faults: faults injected on purpose (none by default; see :mod:`swarm_sim.faults`).
     """
 
     physics_rate_hz: float = parameter(
@@ -100,6 +105,8 @@ class EngineConfig:
     bearings: BearingConfig = section(BearingConfig, prefix='bearing_')
     imu: ImuConfig = section(ImuConfig, prefix='imu_')
     odometry: OdometryConfig = section(OdometryConfig, prefix='odom_')
+    aoa: AoaRealismConfig = section(AoaRealismConfig, prefix='aoa_')
+    faults: FaultConfig = section(FaultConfig, prefix='fault_')
 
     def __post_init__(self) -> None:
         for name in ('physics_rate_hz', 'cmd_vel_timeout_s', 'pump_timeout_s'):
@@ -140,6 +147,8 @@ class StepOutput:
         odometry: (N, 3) odometry poses and (N, 2) speed [m/s] / yaw rate [rad/s].
         ground_truth_due: True when the true poses should be published.
         new_room_entries: rooms first entered during this step.
+        withheld: per sensor name, (N,) bool of the robots whose reading of this step is
+            not published (a faulty device; see :mod:`swarm_sim.faults`).
     """
 
     time_s: float
@@ -152,6 +161,12 @@ class StepOutput:
     odometry: tuple[np.ndarray, np.ndarray] | None = None
     ground_truth_due: bool = False
     new_room_entries: list[RoomEntry] = field(default_factory=list)
+    withheld: dict[str, np.ndarray] = field(default_factory=dict)
+
+    def published(self, sensor: str, robot: int) -> bool:
+        """False when robot ``robot``'s reading of ``sensor`` this step is withheld."""
+        mask = self.withheld.get(sensor)
+        return mask is None or not mask[robot]
 
 
 def _headings(poses: np.ndarray) -> np.ndarray:
@@ -235,6 +250,16 @@ class SimEngine:
             self.imu = GyroYawModel(poses[:, 2], cfg.imu, rngs[3])
         if 'odometry' in self.sensors:
             self.odometry = WheelOdometry(poses, cfg.odometry, rngs[4])
+        # Step hooks: sensor realism, then faults; none in the ideal profile without faults.
+        self.fault_plan: FaultPlan | None = None
+        self._hooks: list[AoaRealism | FaultInjector] = []
+        if cfg.aoa.active and self.bearing_model is not None:
+            self._hooks.append(
+                AoaRealism(cfg.aoa, n, self.world.walls, cfg.bearings.rate_hz, cfg.seed)
+            )
+        if cfg.faults.active:
+            self.fault_plan = FaultPlan(cfg.faults, n, cfg.seed)
+            self._hooks.append(FaultInjector(self.fault_plan, cfg.seed))
         self.coverage = CoverageTracker(
             site.room_rects, cfg.body.robot_radius_m, site.room_index_at
         )
@@ -347,6 +372,8 @@ class SimEngine:
         dt = cfg.physics_period_s
         commands = self.active_commands()
         pumping = self.pumps_running()
+        for hook in self._hooks:
+            commands, pumping = hook.actuators(self.time_s, commands, pumping)
         before = self.world.poses
         self.world.step(commands, dt)
         self._step_index += 1
@@ -384,4 +411,6 @@ class SimEngine:
         if due and self.odometry is not None:
             out.odometry = self.odometry.update(poses, elapsed)
         out.ground_truth_due = sched['ground_truth'].due(self.time_s)[0]
+        for hook in self._hooks:
+            hook.readings(out)
         return out
