@@ -52,7 +52,6 @@ OABUG_FAULTS = (
     'stuck_gas_robots=3',
     'drifting_gas_robots=3',
     'imu_drift_robots=3',
-    'bearing_dropout_probability=0.5',
     'bearing_dropout_probability=0.9',
 )
 BAYES_FAULTS = (
@@ -71,7 +70,6 @@ MSC_FAULTS = (
     'dropout_robots=3',
     'dropout_robots=7',
     'comm_loss_probability=0.5',
-    'comm_loss_probability=0.9',
     'comm_range_m=75',
 )
 # A robot that stood still longer than this while it should work counts as stuck [s].
@@ -307,7 +305,7 @@ def studies() -> list[Study]:
             run=run_oabug_fault,
             axes={'departure': ('center', 'edge'), 'fault': OABUG_FAULTS},
             params={'site': 'small', 'robots': 10, 'variant': 'gas_sound', 'fault_time_s': 60.0},
-            runs=5,
+            runs=3,
             seed_label='site',
             description='OA-Bug Gas+Sound coverage under injected faults (onset at 60 s).',
             smoke=Smoke(
@@ -324,10 +322,10 @@ def studies() -> list[Study]:
                 'algorithm': 'bayes_swarm_p',
                 'robots': 0,
                 'noise_std': 0.0,
-                'outer_optimizer': 'cobyla',
+                'outer_optimizer': 'grid',
                 'fault_time_s': 10.0,
             },
-            runs=5,
+            runs=3,
             description='Bayes-Swarm-P tau under injected faults (onset at 10 s).',
             smoke=Smoke(runs=1, axes={'fault': ('none', 'dropout_robots=2')}),
             report=_report_bayes_faults,
@@ -343,7 +341,7 @@ def studies() -> list[Study]:
                 'max_time_s': 30000.0,
                 'fault_time_s': 500.0,
             },
-            runs=4,
+            runs=2,
             description='MSC + PF capture completion time under injected faults (onset 500 s).',
             smoke=Smoke(
                 runs=1,
@@ -361,7 +359,7 @@ def studies() -> list[Study]:
                 'profile': ('ideal', 'realistic'),
             },
             params={'site': 'small', 'robots': 10},
-            runs=5,
+            runs=3,
             seed_label='site',
             description='Every OA-Bug variant under the ideal and the realistic sensor profile.',
             smoke=Smoke(runs=1, axes={'variant': ('gas_sound',), 'departure': ('center',)}),

@@ -101,7 +101,7 @@ class FaultConfig:
     )
     comm_range_m: float = parameter(
         math.inf,
-        'Range of the peer messages (inf: the algorithm own).',
+        'Range of the peer messages (inf: only the algorithm limit applies).',
         unit='m',
         gt=0.0,
         finite=False,
