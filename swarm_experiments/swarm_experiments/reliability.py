@@ -61,9 +61,7 @@ BAYES_FAULTS = (
     'dropout_robots=4',
     'comm_loss_probability=0.5',
     'comm_loss_probability=0.9',
-    'comm_range_m=5',
-    'stuck_gas_robots=2',
-    'drifting_gas_robots=2',
+    'comm_range_m=0.5',
 )
 MSC_FAULTS = (
     'none',
@@ -206,6 +204,20 @@ def run_msc_fault(spec: RunSpec) -> dict[str, Any]:
     }
 
 
+def _planned(page: ReportPage, order: Sequence[str]) -> pd.DataFrame:
+    """The rows of the seeds of the last plan and, when ``order`` is given, of the fault
+    scenarios the study declares now (rows of older plans stay stored but are left out)."""
+    rows = page.rows
+    if rows.empty:
+        return rows
+    seeds = page.manifest.get('seeds')
+    if seeds:
+        rows = rows[rows['seed'].isin(seeds)]
+    if order and 'config.fault' in rows.columns:
+        rows = rows[rows['config.fault'].isin(order)]
+    return rows.reset_index(drop=True)
+
+
 def _summary(
     rows: pd.DataFrame, by: Sequence[str], metrics: Mapping[str, str], order: Sequence[str]
 ) -> pd.DataFrame:
@@ -218,11 +230,18 @@ def _summary(
         for column, label in metrics.items():
             values = pd.to_numeric(group[column], errors='coerce').astype(float)
             finite = values.dropna()
-            row[label] = (
-                f'{finite.mean():.3g} ± {finite.std(ddof=1) if len(finite) > 1 else 0.0:.2g}'
-                if len(finite)
-                else 'n/a'
-            )
+            if not len(finite):
+                row[label] = 'n/a'
+            elif label.startswith('runs ') and label.endswith('%'):  # a share of runs
+                row[label] = f'{finite.mean():.0f}'
+            elif label.startswith('runs with'):  # a count over the runs
+                row[label] = f'{int((finite > 0).sum())}'
+            else:
+                spread = finite.std(ddof=1) if len(finite) > 1 else 0.0
+                row[label] = f'{finite.mean():.3g} ± {spread:.2g}'
+            if label.endswith('(complete runs)'):
+                row[label] += f' ({len(finite)})'
+
         out.append(row)
     frame = pd.DataFrame(out)
     if 'fault' in frame.columns:
@@ -232,7 +251,7 @@ def _summary(
 
 
 def _report_oabug_faults(page: ReportPage) -> None:
-    rows = page.rows
+    rows = _planned(page, OABUG_FAULTS)
     if rows.empty:
         return
     rows = rows.assign(**{'metric.complete_pct': 100.0 * rows['metric.complete'].astype(float)})
@@ -241,9 +260,9 @@ def _report_oabug_faults(page: ReportPage) -> None:
         ['config.departure', 'config.fault'],
         {
             'metric.coverage': 'coverage %',
-            'metric.complete_pct': 'all rooms %',
+            'metric.complete_pct': 'runs covering all rooms %',
             'metric.max_still_s': 'longest still survivor s',
-            'metric.stuck_survivors': 'stuck survivors',
+            'metric.stuck_survivors': 'runs with a stuck survivor',
             'metric.faulty_moved_m': 'lidar-less robot moved m',
         },
         OABUG_FAULTS,
@@ -252,21 +271,21 @@ def _report_oabug_faults(page: ReportPage) -> None:
 
 
 def _report_bayes_faults(page: ReportPage) -> None:
-    rows = page.rows
+    rows = _planned(page, BAYES_FAULTS)
     if rows.empty:
         return
     rows = rows.assign(**{'metric.found_pct': 100.0 * rows['metric.found'].astype(float)})
     table = _summary(
         rows,
         ['config.fault'],
-        {'metric.tau': 'tau (found runs)', 'metric.found_pct': 'found %'},
+        {'metric.tau': 'tau (complete runs)', 'metric.found_pct': 'runs finding the source %'},
         BAYES_FAULTS,
     )
     page.add_table(table, title='Reliability: Bayes-Swarm-P, case 1')
 
 
 def _report_msc_faults(page: ReportPage) -> None:
-    rows = page.rows
+    rows = _planned(page, MSC_FAULTS)
     if rows.empty:
         return
     rows = rows.assign(**{'metric.all_pct': 100.0 * rows['metric.all_captured'].astype(float)})
@@ -275,7 +294,7 @@ def _report_msc_faults(page: ReportPage) -> None:
         ['config.fault'],
         {
             'metric.cct_s': 'CCT s (complete runs)',
-            'metric.all_pct': 'all captured %',
+            'metric.all_pct': 'runs capturing all %',
             'metric.captured': 'targets captured',
         },
         MSC_FAULTS,
@@ -284,14 +303,14 @@ def _report_msc_faults(page: ReportPage) -> None:
 
 
 def _report_sensors(page: ReportPage) -> None:
-    rows = page.rows
+    rows = _planned(page, ())
     if rows.empty:
         return
     rows = rows.assign(**{'metric.complete_pct': 100.0 * rows['metric.complete'].astype(float)})
     table = _summary(
         rows,
         ['config.variant', 'config.departure', 'config.profile'],
-        {'metric.coverage': 'coverage %', 'metric.complete_pct': 'all rooms %'},
+        {'metric.coverage': 'coverage %', 'metric.complete_pct': 'runs covering all rooms %'},
         (),
     )
     page.add_table(table, title='OA-Bug variants under both sensor profiles, Small, 10 robots')
