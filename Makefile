@@ -28,10 +28,15 @@ test: test-builtin test-rclpy
 test-builtin: bootstrap
 	SWARM_RUNTIME=builtin $(PY) -m pytest -n 2 -q $(PYTEST_ARGS)
 
+# Test folders that never touch ROS (the layer test keeps them ROS-free): the real-rclpy leg
+# leaves them out, since they would only repeat the built-in leg.
+ROS_FREE_TESTS := swarm_common/test swarm_sim/test swarm_experiments/test/study
+RCLPY_IGNORE := $(foreach d,$(ROS_FREE_TESTS),--ignore=$(d))
+
 test-rclpy: bootstrap
 	@if $(PY) -c 'import rclpy' 2>/dev/null; then \
-		echo "SWARM_RUNTIME=rclpy $(PY) -m pytest -n 2 -q $(PYTEST_ARGS)"; \
-		SWARM_RUNTIME=rclpy $(PY) -m pytest -n 2 -q $(PYTEST_ARGS); \
+		echo "SWARM_RUNTIME=rclpy $(PY) -m pytest -n 2 -q $(RCLPY_IGNORE) $(PYTEST_ARGS)"; \
+		SWARM_RUNTIME=rclpy $(PY) -m pytest -n 2 -q $(RCLPY_IGNORE) $(PYTEST_ARGS); \
 	else \
 		echo "[test-rclpy] no real rclpy in $(VENV) (see scripts/install_ros_wheels.sh): skipped"; \
 	fi

@@ -52,6 +52,7 @@ setup(
             'oabug = swarm_experiments.oabug_study:studies',
             'msc_pf = swarm_experiments.msc_pf_studies:studies',
             'bayes_swarm = swarm_experiments.bayes_studies:studies',
+            'reliability = swarm_experiments.reliability:studies',
         ],
     },
 )

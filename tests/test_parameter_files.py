@@ -23,9 +23,29 @@ from swarm_runtime.parameters import check_parameter_arguments
 REPO = Path(__file__).resolve().parents[1]
 BEFORE = Path(__file__).with_name('data') / 'node_parameter_defaults_before_specs.json'
 # Parameters added since the recording (name -> default).
+_SIM_BRIDGE_ADDED = {
+    'aoa_nlos_bias_std_rad_per_wall': 0.0,
+    'aoa_nlos_bias_correlation_s': 5.0,
+    'aoa_outlier_probability_los': 0.0,
+    'aoa_outlier_probability_per_wall': 0.0,
+    'aoa_outlier_probability_max': 0.5,
+    'aoa_wall_distance_factor': 1.0,
+    'fault_dropout_robots': 0,
+    'fault_dropout_time_s': 0.0,
+    'fault_sensor_time_s': 0.0,
+    'fault_stale_lidar_robots': 0,
+    'fault_stuck_gas_robots': 0,
+    'fault_drifting_gas_robots': 0,
+    'fault_gas_drift_per_s': 2.0,
+    'fault_imu_drift_robots': 0,
+    'fault_imu_drift_radps': math.radians(0.5),
+    'fault_bearing_dropout_probability': 0.0,
+    'fault_comm_range_m': 'inf',
+    'fault_comm_loss_probability': 0.0,
+}
 ADDED = {
     'oabug': {'min_turn_rate_radps': 0.3},
-    'sim_bridge': {'physics': 'numpy'},
+    'sim_bridge': {'physics': 'numpy', **_SIM_BRIDGE_ADDED},
     'msc_pf': {'swarm.search_alone': False, 'msc.turn_margin_db': 2.0},
     'bayes_swarm': {
         'inner_optimizer': 'lbfgsb',

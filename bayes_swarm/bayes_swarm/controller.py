@@ -180,23 +180,27 @@ class RobotController:
         if self._pose is None or time_s - self._pose_time_s > self.settings.odom_timeout_s:
             return ControlOutput(0.0, 0.0, stale=True)
         x, y, yaw = self._pose
+        position = np.array([x, y])
         decision: Decision | None = None
         broadcast: PeerUpdate | None = None
-        if self._waypoint is None:
+        waypoint = self._waypoint
+        if waypoint is None:
             self._start_time_s = time_s
-            decision, broadcast = self._decide(time_s)
-        cmd = self._follower.command(x, y, yaw, *self._waypoint)
+            decision, broadcast, waypoint = self._decide(time_s, position)
+        cmd = self._follower.command(x, y, yaw, *waypoint)
         if cmd.arrived and not self._glowworm_phase() and decision is None:
-            decision, broadcast = self._decide(time_s)
-            cmd = self._follower.command(x, y, yaw, *self._waypoint)
+            decision, broadcast, waypoint = self._decide(time_s, position)
+            cmd = self._follower.command(x, y, yaw, *waypoint)
         return ControlOutput(cmd.linear_mps, cmd.angular_radps, decision, broadcast)
 
     def _glowworm_phase(self) -> bool:
         return self._glow is not None and self._n_decisions > 0
 
-    def _decide(self, time_s: float) -> tuple[Decision, PeerUpdate | None]:
+    def _decide(
+        self, time_s: float, position: np.ndarray
+    ) -> tuple[Decision, PeerUpdate | None, np.ndarray]:
+        """Decide the next waypoint at ``position``; returns it with the decision."""
         s = self.settings
-        position = np.array(self._pose[:2])
         mission_time = time_s - (self._start_time_s if self._start_time_s is not None else time_s)
         broadcast = None
         if self._planner is not None:
@@ -227,9 +231,10 @@ class RobotController:
             )
             decision = Decision(waypoint, 0, DecisionKind.FIRST)
         self._n_decisions += 1
-        self._waypoint = np.asarray(decision.waypoint_m, dtype=float)
+        waypoint = np.asarray(decision.waypoint_m, dtype=float)
+        self._waypoint = waypoint
         self.decisions.append(decision)
-        return decision, broadcast
+        return decision, broadcast, waypoint
 
     def glowworm_step(self) -> GlowwormBroadcast | None:
         """One Glowworm iteration (after the dispersal leg); None when there is nothing to do."""

@@ -206,10 +206,14 @@ class SimBridgeNode(Node):
         )
 
     def _setup_relay(self) -> RelayModel | None:
+        comm_range_m, loss = self.settings.comm_range_m, self.settings.peer_loss_probability
+        plan = self.engine.fault_plan  # injected link faults limit the relay further
+        if plan is not None:
+            comm_range_m, loss = min(comm_range_m, plan.comm_range_m), plan.combined_loss(loss)
         config = RelayConfig(
             msg_type=self.settings.peer_msg_type,
-            comm_range_m=self.settings.comm_range_m,
-            loss_probability=self.settings.peer_loss_probability,
+            comm_range_m=comm_range_m,
+            loss_probability=loss,
         )
         if not config.enabled:
             return None
@@ -253,8 +257,13 @@ class SimBridgeNode(Node):
     def _make_relay_callback(self, sender: int) -> Callable[[Any], None]:
         def on_peer_out(msg: Any) -> None:
             assert self._relay is not None
+            plan = self.engine.fault_plan  # dropped robots neither send nor receive
+            dropped = None if plan is None else plan.dropped(self.engine.time_s)
+            if dropped is not None and dropped[sender]:
+                return
             for receiver in self._relay.receivers(sender, self.engine.world.poses):
-                self._peer_in_pubs[int(receiver)].publish(msg)
+                if dropped is None or not dropped[receiver]:
+                    self._peer_in_pubs[int(receiver)].publish(msg)
 
         return on_peer_out
 
@@ -268,12 +277,12 @@ class SimBridgeNode(Node):
         # computes every reading, so runs do not depend on who listens).
         if out.scans is not None:
             for i, name in enumerate(names):
-                if self._scan_pubs[i].get_subscription_count():
+                if self._scan_pubs[i].get_subscription_count() and out.published('scan', i):
                     msg = conversions.scan_to_ros(out.scans[i], t, f'{name}/laser', cfg.lidar)
                     self._scan_pubs[i].publish(msg)
         if out.gas_raw is not None:
             for i, name in enumerate(names):
-                if self._gas_pubs[i].get_subscription_count():
+                if self._gas_pubs[i].get_subscription_count() and out.published('gas', i):
                     self._gas_pubs[i].publish(
                         conversions.gas_to_ros(int(out.gas_raw[i]), t, f'{name}/gas_sensor')
                     )
@@ -289,7 +298,7 @@ class SimBridgeNode(Node):
             bias = cfg.imu.residual_bias_std_radps
             yaw_variance = density**2 * t + (bias * t) ** 2
             for i, name in enumerate(names):
-                if self._imu_pubs[i].get_subscription_count():
+                if self._imu_pubs[i].get_subscription_count() and out.published('imu', i):
                     self._imu_pubs[i].publish(
                         conversions.imu_to_ros(
                             float(yaw[i]), float(rate[i]), t, f'{name}/imu_link', yaw_variance

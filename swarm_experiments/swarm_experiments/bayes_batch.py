@@ -36,6 +36,7 @@ from bayes_swarm.settings import (
     GlowwormConfig,
     LevyConfig,
 )
+from swarm_sim.faults import BODY_SENSOR_FAULTS, FaultConfig, FaultPlan
 from swarm_sim.point_robots import FieldFunction, PointRobotField
 
 __all__ = [
@@ -73,6 +74,8 @@ class MissionSpec:
         loss_probability: probability that one peer message to one receiver is lost.
         stop_time_s: when the world stops the run [s] (None: the planners' T_max, which is
             also what their alpha schedule uses).
+        faults: faults injected on purpose (:mod:`swarm_sim.faults`): robot dropouts, a
+            shorter or lossier peer link, stuck or drifting signal sensors.
     """
 
     field: FieldFunction
@@ -88,6 +91,7 @@ class MissionSpec:
     glowworm: GlowwormConfig = field(default_factory=GlowwormConfig)
     levy: LevyConfig = field(default_factory=LevyConfig)
     exhaustive: ExhaustiveConfig = field(default_factory=ExhaustiveConfig)
+    faults: FaultConfig = field(default_factory=FaultConfig)
 
     def __post_init__(self) -> None:
         if self.noise_std < 0.0 or self.relative_noise < 0.0:
@@ -195,7 +199,14 @@ def run_mission(
     if n_robots < 1:
         msg = f'n_robots must be >= 1, got {n_robots}'
         raise ConfigError(msg)
+    unsupported = spec.faults.configured(BODY_SENSOR_FAULTS)
+    if unsupported:
+        msg = f'faults {", ".join(unsupported)} are not simulated by this runner (no such sensor)'
+        raise ConfigError(msg)
     if algorithm == 'glowworm':
+        if spec.faults.active:
+            msg = 'faults are not simulated by this runner for glowworm (a synchronous swarm)'
+            raise ConfigError(msg)
         seeds = np.random.SeedSequence(seed).spawn(n_robots + 1)
         world = _world(spec, n_robots, np.random.default_rng(seeds[0]))
         return _run_glowworm(spec, world, n_robots, seeds)
@@ -286,15 +297,19 @@ def _deliver(
     sender: int,
     update: PeerUpdate,
     time_s: float,
+    links: tuple[float | None, float, np.ndarray | None] | None = None,
 ) -> None:
+    """Deliver ``sender``'s update; ``links``: range [m] (None: unlimited), loss and the
+    dropped robots that receive nothing, when faults change them."""
+    comm_range_m, loss, dropped = links or (spec.comm_range_m, spec.loss_probability, None)
     for j, robot in enumerate(robots):
-        if j == sender:
+        if j == sender or (dropped is not None and dropped[j]):
             continue
-        if spec.comm_range_m is not None:
+        if comm_range_m is not None:
             gap = world.positions[j] - world.positions[sender]
-            if np.hypot(*gap) > spec.comm_range_m:
+            if np.hypot(*gap) > comm_range_m:
                 continue
-        if spec.loss_probability > 0.0 and world.rng.uniform() < spec.loss_probability:
+        if loss > 0.0 and world.rng.uniform() < loss:
             continue
         robot.peer(update, time_s)
 
@@ -320,13 +335,36 @@ def run_events(
     yaws = np.zeros(n)
     tick = 0
     t = 0.0
+    plan = FaultPlan(spec.faults, n_robots, seed) if spec.faults.active else None
+    # Faults: the dropout instant is an event; dropped robots stop, sample, decide and talk
+    # no more; faulty sensors read what the plan says.
+    dropout_s = math.inf if plan is None else plan.config.dropout_time_s
+    dropped = np.zeros(n, dtype=bool)
+    held: dict[int, float] = {}
+
+    def links() -> tuple[float | None, float, np.ndarray | None] | None:
+        if plan is None:
+            return None
+        comm_range_m = plan.combined_range_m(spec.comm_range_m)
+        return comm_range_m, plan.combined_loss(spec.loss_probability), dropped
 
     def sample_all() -> None:
         values = world.sample(world.positions)
         stamp = ros_time_s(t)
         for i, robot in enumerate(robots):
+            if dropped[i]:
+                continue
+            value = float(values[i])
+            if plan is not None:
+                value = plan.signal(i, value, t, held)
             robot.pose(world.positions[i].copy(), float(yaws[i]), stamp)
-            robot.signal(float(values[i]), stamp)
+            robot.signal(value, stamp)
+
+    def drop_out() -> None:
+        nonlocal dropped
+        assert plan is not None
+        dropped = plan.dropped(t).copy()
+        waypoints[dropped] = world.positions[dropped]
 
     def tick_robot(i: int) -> None:
         stamp = ros_time_s(t)
@@ -341,12 +379,15 @@ def run_events(
             yaws[i] = math.atan2(leg[1], leg[0])
         world.trajectories[i].append(world.positions[i].copy())
         if out.broadcast is not None:
-            _deliver(spec, world, robots, i, out.broadcast, stamp)
+            _deliver(spec, world, robots, i, out.broadcast, stamp, links())
 
+    if dropout_s <= 0.0:
+        drop_out()
     sample_all()
     if not world.move(waypoints, 0.0, 0.0, speed):
         for i in range(n):
-            tick_robot(i)
+            if not dropped[i]:
+                tick_robot(i)
     while world.finder < 0 and t < t_max - _TIME_EPS:
         remaining = np.hypot(*(waypoints - world.positions).T)
         arrivals = t + remaining / speed
@@ -354,16 +395,21 @@ def run_events(
         moving = remaining > 1e-12
         t_next = min(next_tick, float(np.min(arrivals[moving])) if np.any(moving) else math.inf)
         t_next = min(t_next, t_max)
+        if t < dropout_s - _TIME_EPS:
+            t_next = min(t_next, dropout_s)
         if world.move(waypoints, t, t_next, speed):
             t = world.found_time_s
             break
         t = t_next
+        if plan is not None and abs(t - dropout_s) <= _TIME_EPS:
+            drop_out()
         if abs(t - next_tick) <= _TIME_EPS:
             tick += 1
             sample_all()
         arrived = np.flatnonzero(np.hypot(*(waypoints - world.positions).T) <= 1e-9)
         for i in arrived:
-            tick_robot(int(i))
+            if not dropped[i]:
+                tick_robot(int(i))
     for i in range(n):
         world.trajectories[i].append(world.positions[i].copy())
     return MissionResult(

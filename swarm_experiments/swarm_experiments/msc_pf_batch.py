@@ -34,6 +34,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
 import numpy as np
+from msc_pf.errors import ConfigError
 from msc_pf.loop import RobotLoop, Steering
 from msc_pf.peers import PeerInfo
 from msc_pf.robot import RobotController, StepOutput
@@ -43,6 +44,7 @@ from swarm_common.angles import yaw_from_unit_quaternion, yaw_to_quaternion
 from swarm_common.stamps import ns_to_sec_nanosec, seconds_to_ns
 from swarm_runtime.builtin._messages import cdr_roundtrip_enabled
 from swarm_sim.engine import SimEngine, SiteGeometry
+from swarm_sim.faults import BODY_SENSOR_FAULTS, FaultConfig, FaultPlan
 from swarm_sim.peer_relay import RelayConfig, RelayModel
 from swarm_sim.rssi_targets import RssiTargetConfig, RssiTargetField, place_robots
 
@@ -69,6 +71,9 @@ class BatchScenario:
         physics_rate_hz: the bridge's physics (and odometry) rate [Hz].
         drive_rate_hz: the node's drive_rate_hz [Hz].
         max_linear_speed_m_s: the simulated base's speed limit [m/s].
+        faults: faults injected on purpose (:mod:`swarm_sim.faults`): robot dropouts (a
+            dropped robot stands still, hears, works and talks no more) and a shorter or
+            lossier peer link.
     """
 
     scheme: Scheme = Scheme.PROPOSED
@@ -84,6 +89,7 @@ class BatchScenario:
     physics_rate_hz: float = 10.0
     drive_rate_hz: float = 10.0
     max_linear_speed_m_s: float = 1.05
+    faults: FaultConfig = field(default_factory=FaultConfig)
 
 
 @dataclass
@@ -181,6 +187,12 @@ def run_batch(
             does; None follows the built-in runtime's CDR round-trip setting, so the run
             equals the ROS path's in the same process.
     """
+    unsupported = scenario.faults.configured(
+        (*BODY_SENSOR_FAULTS, 'stuck_gas_robots', 'drifting_gas_robots', 'gas_drift_per_s')
+    )
+    if unsupported:
+        msg = f'faults {", ".join(unsupported)} are not simulated by this runner (no such sensor)'
+        raise ConfigError(msg)
     start_wall = time.perf_counter()
     config = replace(scenario.controller, scheme=Scheme(scenario.scheme))
     if float32_fields is None:
@@ -208,11 +220,20 @@ def run_batch(
         ),
     )
     noise_rng = np.random.default_rng([scenario.seed, 1])
+    plan = (
+        FaultPlan(scenario.faults, scenario.n_robots, scenario.seed)
+        if scenario.faults.active
+        else None
+    )
+    comm_range_m, comm_loss = config.swarm.comm_range_m, scenario.comm_loss
+    if plan is not None:
+        comm_range_m = min(comm_range_m, plan.comm_range_m)
+        comm_loss = plan.combined_loss(comm_loss)
     relay = RelayModel(
         RelayConfig(
             msg_type='swarm_interfaces/msg/MscPeer',
-            comm_range_m=config.swarm.comm_range_m,
-            loss_probability=scenario.comm_loss,
+            comm_range_m=comm_range_m,
+            loss_probability=comm_loss,
         ),
         np.random.default_rng(np.random.SeedSequence([scenario.seed, 7])),
     )
@@ -238,14 +259,23 @@ def run_batch(
         step = engine.step_index
         now_ns = seconds_to_ns(out.time_s)
         now = now_ns * 1e-9  # the nodes' clock: the /clock stamp
+        # Faults: a dropped robot's node is dead (no pose, samples, ticks or messages), its
+        # base stands still and it works on no target.
+        dropped = plan.dropped(out.time_s) if plan is not None else None
+        if dropped is not None and not dropped.any():
+            dropped = None
         if out.odometry is not None:
-            for loop, pose in zip(loops, out.odometry[0].tolist(), strict=True):
+            for i, (loop, pose) in enumerate(zip(loops, out.odometry[0].tolist(), strict=True)):
+                if dropped is not None and dropped[i]:
+                    continue
                 _, _, qz, qw = yaw_to_quaternion(pose[2])
                 loop.receive_pose(
                     (pose[0], pose[1], yaw_from_unit_quaternion(0.0, 0.0, qz, qw)), now
                 )
         positions = out.poses[:, :2]
         speeds = np.abs(engine.world.velocities[:, 0])
+        if dropped is not None:
+            speeds[dropped] = np.inf  # a dropped robot works on no target
         for capture in targets.work(positions, speeds, engine.config.physics_period_s, out.time_s):
             for robot in capture.robot_indices:
                 loops[robot].receive_captured([capture.target_id])
@@ -253,8 +283,12 @@ def run_batch(
             samples = targets.sample_rssi(positions, noise_rng)
             if float32_fields:
                 samples = samples.astype(np.float32).astype(np.float64)
+            if dropped is not None:
+                samples[dropped] = np.nan  # a dropped robot hears nothing
             stamp = _message_seconds(out.time_s)
-            for loop, row in zip(loops, samples.tolist(), strict=True):
+            for i, (loop, row) in enumerate(zip(loops, samples.tolist(), strict=True)):
+                if dropped is not None and dropped[i]:
+                    continue
                 loop.receive_rssi(stamp, {t: v for t, v in enumerate(row) if v == v})
             heard_now = ~np.isnan(samples).all(axis=0)
             first_time = heard_now & np.isnan(first_heard)
@@ -270,13 +304,17 @@ def run_batch(
         if not drive_due:
             continue
         for i, loop in enumerate(loops):
+            if dropped is not None and dropped[i]:
+                engine.set_velocity_command(i, 0.0, 0.0)
+                continue
             if control_due:
                 result = loop.control(now, with_estimates=False)
                 if result.output is not None:
                     last[i] = result.output
                     message = _as_received(result.output.broadcast)
                     for receiver in relay.receivers(i, engine.world.poses).tolist():
-                        loops[receiver].receive_peer(message)
+                        if dropped is None or not dropped[receiver]:
+                            loops[receiver].receive_peer(message)
             engine.set_velocity_command(i, *loop.command(now))
         if control_due:
             outputs = [o for o in last if o is not None]

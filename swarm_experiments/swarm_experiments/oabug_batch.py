@@ -278,8 +278,9 @@ def _deliver(engine: SimEngine, out: Any, robots: list[BatchRobot], own_tags: np
     if out.scans is not None:
         # The message's float32 values, widened once for every robot's feature extractor.
         ranges_m = out.scans.astype(np.float32).astype(float)
-        for robot, ranges in zip(robots, ranges_m, strict=True):
-            robot.receive_scan(ranges, now_s)
+        for i, (robot, ranges) in enumerate(zip(robots, ranges_m, strict=True)):
+            if out.published('scan', i):
+                robot.receive_scan(ranges, now_s)
     if out.gas_raw is not None:
         for robot, raw in zip(robots, out.gas_raw.tolist(), strict=True):
             robot.receive_gas(raw, now_s)

@@ -47,10 +47,13 @@ from swarm_sim.sites import PRESETS, Site, require_rooms
 
 from swarm_experiments.cli_args import (
     SPAWNER_EXIT_CODES,
+    add_fault_arguments,
     add_physics_option,
     add_render_option,
     add_run_options,
+    add_sensor_arguments,
     check_run_outputs,
+    engine_options,
     render_config,
 )
 from swarm_experiments.errors import ExperimentError
@@ -439,6 +442,8 @@ def _parser() -> argparse.ArgumentParser:
     add_physics_option(parser)
     add_render_option(parser)
     add_runtime_arguments(parser)
+    add_sensor_arguments(parser)
+    add_fault_arguments(parser)
     return parser
 
 
@@ -464,7 +469,9 @@ def _main(argv: list[str]) -> int:
         record_scans=args.record_scans,
         out_dir=None if args.no_plots else args.out,
         time_scale=args.time_scale,
-        engine=EngineConfig(physics=args.physics, render=render_config(args.render)),
+        engine=engine_options(
+            args, EngineConfig(physics=args.physics, render=render_config(args.render))
+        ),
     )
     require_backend(args.physics)
     check_runtime(args.runtime)
@@ -478,6 +485,8 @@ def _main(argv: list[str]) -> int:
         f'= {config.budget_s:.0f} s at {config.speed_mps} m/s',
         flush=True,
     )
+    if args.sensors != 'ideal' or config.engine.faults.active:
+        print(f'sensors {args.sensors}; faults: {config.engine.faults.describe()}', flush=True)
     if config.robot_parameters:
         settings = ', '.join(f'{k}={v}' for k, v in sorted(config.robot_parameters.items()))
         print(f'OA-Bug parameters other than the defaults: {settings}', flush=True)

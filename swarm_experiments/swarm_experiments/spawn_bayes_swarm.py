@@ -23,6 +23,7 @@ outcome so far is printed and the bag closed).
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import math
 import sys
 from collections.abc import Sequence
@@ -42,6 +43,7 @@ from swarm_common.cli import (
     run_tool,
 )
 from swarm_sim.engine import EngineConfig, SiteGeometry
+from swarm_sim.faults import FaultConfig
 from swarm_sim.physics import require_backend
 from swarm_sim.signal_fields import CASE_NAMES, SignalCase, UnknownCaseError, get_case
 from swarm_sim.signal_mission import SignalMissionModel
@@ -50,10 +52,12 @@ from swarm_experiments.bayes_batch import MissionSpec as BatchMissionSpec
 from swarm_experiments.bayes_batch import depot_fan
 from swarm_experiments.cli_args import (
     SPAWNER_EXIT_CODES,
+    add_fault_arguments,
     add_physics_option,
     add_run_options,
     check_finite,
     check_run_outputs,
+    fault_config,
     points_argument,
 )
 from swarm_experiments.errors import ExperimentError
@@ -127,6 +131,8 @@ class SpawnSettings:
             'paper', the as-published solvers, or 'grid', the project's).
         record: bag directory to write, or None.
         out_dir: where the PNGs go (None: no plots).
+        faults: faults injected on purpose (robot dropouts and link faults act through
+            the bridge: a dropped robot stops and its peer messages are lost).
         extra_parameters: further node parameters (name -> value).
         physics: the engine's physics backend ('numpy' or 'pybullet').
         time_scale: on real rclpy, sim seconds per wall second (MissionSpec.time_scale).
@@ -148,6 +154,7 @@ class SpawnSettings:
     extra_parameters: dict[str, Any] = field(default_factory=dict)
     physics: str = 'numpy'
     time_scale: float = 1.0
+    faults: FaultConfig = field(default_factory=FaultConfig)
 
 
 @dataclass
@@ -390,7 +397,9 @@ def run(settings: SpawnSettings, progress: Any = None) -> BayesSwarmRun:
         initial_poses=poses,
         robots=[RobotNodeSpec(factory, node_parameters(case, settings, n, i)) for i in range(n)],
         max_sim_time_s=case.max_mission_time_s + 2.0,
-        engine_config=_engine_config(case, settings.seed, settings.physics),
+        engine_config=dataclasses.replace(
+            _engine_config(case, settings.seed, settings.physics), faults=settings.faults
+        ),
         bridge_parameters=bridge_parameters,
         time_scale=settings.time_scale,
         extensions=[SignalExtension(model)],
@@ -518,6 +527,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     add_physics_option(parser)
     add_runtime_arguments(parser)
+    add_fault_arguments(parser)
     return parser
 
 
@@ -530,8 +540,10 @@ def _main(argv: list[str]) -> int:
     args = build_parser().parse_args(argv)
     require_backend(args.physics)
     check_runtime(args.runtime)
+    faults = fault_config(args.fault)
     extra = node_parameter_overrides(args.param)
     settings = SpawnSettings(
+        faults=faults,
         extra_parameters=extra,
         algorithm=args.algorithm,
         case=args.case,

@@ -25,6 +25,7 @@ written. Exit codes: 0 every target captured, 1 not all by T_max, 2 bad options 
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import math
 import sys
 from collections.abc import Sequence
@@ -43,15 +44,18 @@ from swarm_common.cli import (
     run_tool,
 )
 from swarm_sim.engine import EngineConfig, SiteGeometry
+from swarm_sim.faults import FaultConfig
 from swarm_sim.physics import require_backend
 from swarm_sim.rssi_targets import RssiTargetField
 
 from swarm_experiments.cli_args import (
     SPAWNER_EXIT_CODES,
+    add_fault_arguments,
     add_physics_option,
     add_run_options,
     check_finite,
     check_run_outputs,
+    fault_config,
     points_argument,
 )
 from swarm_experiments.errors import ExperimentError
@@ -111,6 +115,8 @@ class SpawnSettings:
         target_positions_m: (targets, 2) fixed target positions, or None.
         record: bag directory to write, or None.
         out_dir: where the PNGs go (None: no plots).
+        faults: faults injected on purpose (robot dropouts and link faults act through
+            the bridge: a dropped robot stops and its peer messages are lost).
         extra_parameters: further msc_pf node parameters (name -> value).
         physics: the engine's physics backend ('numpy' or 'pybullet').
         time_scale: on real rclpy, sim seconds per wall second (MissionSpec.time_scale).
@@ -132,6 +138,7 @@ class SpawnSettings:
     extra_parameters: dict[str, Any] = field(default_factory=dict)
     physics: str = 'numpy'
     time_scale: float = 1.0
+    faults: FaultConfig = field(default_factory=FaultConfig)
 
 
 @dataclass
@@ -293,7 +300,7 @@ def run(settings: SpawnSettings, progress: Any = None) -> MscPfRun:
         initial_poses=poses,
         robots=[RobotNodeSpec(factory, node_parameters(settings, i)) for i in range(len(poses))],
         max_sim_time_s=settings.max_time_s,
-        engine_config=_engine_config(settings),
+        engine_config=dataclasses.replace(_engine_config(settings), faults=settings.faults),
         bridge_parameters={
             'peer_msg_type': PEER_TYPE,
             'comm_range_m': float(settings.comm_range_m),
@@ -427,6 +434,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     add_physics_option(parser)
     add_runtime_arguments(parser)
+    add_fault_arguments(parser)
     return parser
 
 
@@ -440,8 +448,10 @@ def _main(argv: list[str]) -> int:
     targets = args.targets if args.target_positions is None else len(args.target_positions)
     require_backend(args.physics)
     check_runtime(args.runtime)
+    faults = fault_config(args.fault)
     extra = controller_parameter_overrides(args.param)
     settings = SpawnSettings(
+        faults=faults,
         extra_parameters=extra,
         scheme=args.scheme,
         robots=args.robots,

@@ -100,12 +100,18 @@ def assert_same_run(ros, batch):
 
 
 @pytest.mark.slow
+@pytest.mark.builtin_only(
+    reason='exact agreement needs the deterministic executor order of the built-in runtime'
+)
 def test_ros_path_and_batch_runner_agree_exactly(ros_run):
     # The same RobotLoop per robot, the same engine and target field, the executor's order.
     assert_same_run(ros_run, batch_of(ros_run.settings))
 
 
 @pytest.mark.slow
+@pytest.mark.builtin_only(
+    reason='exact agreement needs the deterministic executor order of the built-in runtime'
+)
 @pytest.mark.parametrize('scheme', ['msc', 'msc_pf', 'proposed'])
 def test_ros_path_and_batch_runner_agree_exactly_with_swarms_and_lossy_relay(scheme):
     run_settings = settings(

@@ -23,6 +23,7 @@ from swarm_common.angles import wrap_angle
 from swarm_common.params import parameter, section
 
 from swarm_sim.errors import ConfigurationError, WorldGeometryError
+from swarm_sim.faults import FaultConfig, FaultInjector, FaultPlan
 from swarm_sim.ground_truth import CoverageTracker, RoomEntry
 from swarm_sim.physics import (
     PHYSICS_BACKENDS,
@@ -32,6 +33,7 @@ from swarm_sim.physics import (
     RenderConfig,
     make_physics,
 )
+from swarm_sim.sensor_profiles import AoaRealism, AoaRealismConfig
 from swarm_sim.sensors.bearings import BearingConfig, BearingCycle, BearingModel, PeerBearings
 from swarm_sim.sensors.gas_sensor import GasSensorConfig, Mp503Model
 from swarm_sim.sensors.imu import GyroYawModel, ImuConfig
@@ -86,6 +88,9 @@ class EngineConfig:
             rays; fast) or 'pybullet' (rigid bodies with pybullet's contacts and ray tests).
         pybullet: settings of the pybullet backend (ignored by 'numpy').
         render: showing the run (pybullet only: a window or camera frames).
+        aoa: non-line-of-sight effects on the AoA bearings (off: the ideal profile; see
+            :mod:`swarm_sim.sensor_profiles`).
+        faults: faults injected on purpose (none by default; see :mod:`swarm_sim.faults`).
     """
 
     physics_rate_hz: float = parameter(
@@ -120,6 +125,8 @@ class EngineConfig:
     odometry: OdometryConfig = section(OdometryConfig, prefix='odom_')
     pybullet: PybulletConfig = field(default_factory=PybulletConfig)
     render: RenderConfig = field(default_factory=RenderConfig)
+    aoa: AoaRealismConfig = section(AoaRealismConfig, prefix='aoa_')
+    faults: FaultConfig = section(FaultConfig, prefix='fault_')
 
     def __post_init__(self) -> None:
         for name in ('physics_rate_hz', 'cmd_vel_timeout_s', 'pump_timeout_s'):
@@ -169,6 +176,8 @@ class StepOutput:
         odometry: (N, 3) odometry poses and (N, 2) speed [m/s] / yaw rate [rad/s].
         ground_truth_due: True when the true poses should be published.
         new_room_entries: rooms first entered during this step.
+        withheld: per sensor name, (N,) bool of the robots whose reading of this step is
+            not published (a faulty device; see :mod:`swarm_sim.faults`).
     """
 
     time_s: float
@@ -181,6 +190,12 @@ class StepOutput:
     odometry: tuple[np.ndarray, np.ndarray] | None = None
     ground_truth_due: bool = False
     new_room_entries: list[RoomEntry] = field(default_factory=list)
+    withheld: dict[str, np.ndarray] = field(default_factory=dict)
+
+    def published(self, sensor: str, robot: int) -> bool:
+        """False when robot ``robot``'s reading of ``sensor`` this step is withheld."""
+        mask = self.withheld.get(sensor)
+        return mask is None or not mask[robot]
 
 
 def _headings(poses: np.ndarray) -> np.ndarray:
@@ -274,6 +289,16 @@ class SimEngine:
             self.imu = GyroYawModel(poses[:, 2], cfg.imu, rngs[3])
         if 'odometry' in self.sensors:
             self.odometry = WheelOdometry(poses, cfg.odometry, rngs[4])
+        # Step hooks: sensor realism, then faults; none in the ideal profile without faults.
+        self.fault_plan: FaultPlan | None = None
+        self._hooks: list[AoaRealism | FaultInjector] = []
+        if cfg.aoa.active and self.bearing_model is not None:
+            self._hooks.append(
+                AoaRealism(cfg.aoa, n, self.world.walls, cfg.bearings.rate_hz, cfg.seed)
+            )
+        if cfg.faults.active:
+            self.fault_plan = FaultPlan(cfg.faults, n, cfg.seed)
+            self._hooks.append(FaultInjector(self.fault_plan, cfg.seed))
         self.coverage = CoverageTracker(
             site.room_rects, cfg.body.robot_radius_m, site.room_index_at
         )
@@ -396,6 +421,8 @@ class SimEngine:
         dt = cfg.physics_period_s
         commands = self.active_commands()
         pumping = self.pumps_running()
+        for hook in self._hooks:
+            commands, pumping = hook.actuators(self.time_s, commands, pumping)
         before = self.world.poses
         self.world.step(commands, dt)
         self._step_index += 1
@@ -433,4 +460,6 @@ class SimEngine:
         if due and self.odometry is not None:
             out.odometry = self.odometry.update(poses, elapsed)
         out.ground_truth_due = sched['ground_truth'].due(self.time_s)[0]
+        for hook in self._hooks:
+            hook.readings(out)
         return out

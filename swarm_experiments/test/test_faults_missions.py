@@ -1,0 +1,222 @@
+"""Injected faults in whole missions: the same spec on both paths, survivors keep working."""
+
+import dataclasses
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+from msc_pf.schemes import Scheme
+from swarm_experiments.bayes_batch import run_mission as run_bayes
+from swarm_experiments.cli_args import fault_config
+from swarm_experiments.mission import run_mission
+from swarm_experiments.msc_pf_batch import BatchScenario, run_batch
+from swarm_experiments.node_overrides import OverrideError
+from swarm_experiments.oabug_batch import BatchRobot, _deliver, run_oabug_batch
+from swarm_experiments.reliability import parse_fault, still_time_s
+from swarm_experiments.spawn import SpawnSettings, build_mission
+from swarm_experiments.spawn import main as spawn_main
+from swarm_experiments.spawn_msc_pf import main as msc_main
+from swarm_sim.engine import EngineConfig, SimEngine
+from swarm_sim.faults import FaultConfig, FaultPlan
+from swarm_sim.sensor_profiles import apply_sensor_profile
+from swarm_sim.site_geometry import geometry_from_site
+
+FIVE_ROOMS = Path(__file__).parent / 'data' / 'five_rooms.lay'
+
+
+def test_the_same_faults_give_the_same_mission_on_the_batch_and_ros_paths():
+    faults = FaultConfig(
+        dropout_robots=1,
+        dropout_time_s=8.0,
+        stale_lidar_robots=1,
+        stuck_gas_robots=1,
+        sensor_time_s=5.0,
+        bearing_dropout_probability=0.3,
+    )
+    engine = apply_sensor_profile(EngineConfig(faults=faults), 'realistic')
+    config = SpawnSettings(
+        site=str(FIVE_ROOMS),
+        robots=4,
+        variant='gas_sound',
+        departure='edge',
+        actions=150,
+        engine=engine,
+    )
+    spec, _ = build_mission(config)
+    ros = run_mission(spec)
+    batch = run_oabug_batch(spec)
+    np.testing.assert_array_equal(batch.trajectories, ros.trajectories)
+    assert batch.room_entries == ros.room_entries
+    plan = FaultPlan(faults, 4, config.seed)
+    (dropped,) = plan.robots['dropout']
+    late = ros.trajectory_times_s >= 8.5
+    assert np.ptp(ros.trajectories[late, dropped, :2], axis=0).max() == 0.0
+
+
+def _robots_and_engine(settings):
+    spec, _ = build_mission(settings)
+    engine = SimEngine(
+        geometry_from_site(spec.site),
+        np.asarray(spec.initial_poses, dtype=float),
+        dataclasses.replace(spec.engine_config, sensors=spec.engine_config.sensors - {'odometry'}),
+        bearing_cycles=True,
+    )
+    robots = [BatchRobot(r.parameters, engine.config.lidar) for r in spec.robots]
+    tags = tuple(f'R{i}' for i in range(len(robots)))
+    own = np.array([robot.own_tag_index(tags) for robot in robots], dtype=np.int64)
+    return engine, robots, own
+
+
+@pytest.mark.slow
+def test_survivors_never_push_into_a_wall_and_lidarless_robots_stop_with_the_pump_off():
+    onset = 20.0
+    faults = FaultConfig(
+        dropout_robots=2,
+        dropout_time_s=onset,
+        stale_lidar_robots=2,
+        stuck_gas_robots=1,
+        drifting_gas_robots=1,
+        imu_drift_robots=1,
+        sensor_time_s=onset,
+        bearing_dropout_probability=0.5,
+    )
+    settings = SpawnSettings(
+        site='small', robots=10, variant='gas_sound', seed=4, engine=EngineConfig(faults=faults)
+    )
+    engine, robots, own = _robots_and_engine(settings)
+    plan = engine.fault_plan
+    stale = plan.mask('stale_lidar')
+    working = ~(plan.mask('dropout') | stale)
+    anchor = engine.world.poses[:, :2].copy()
+    pushing_since = np.full(10, np.nan)  # when a robot began driving forward without moving
+    longest_push = np.zeros(10)
+    pumped_before = np.zeros(10, dtype=bool)
+    while engine.time_s < 150.0:
+        out = engine.step()
+        _deliver(engine, out, robots, own)
+        now = engine.time_s
+        forward = engine.active_commands()[:, 0] > 0.01
+        moved = np.hypot(*(out.poses[:, :2] - anchor).T) > 0.02
+        anchor[moved] = out.poses[moved, :2]
+        restart = moved | ~forward
+        pushing_since[restart] = np.nan
+        start = ~restart & np.isnan(pushing_since)
+        pushing_since[start] = now
+        longest_push = np.fmax(longest_push, now - pushing_since)
+        if now < onset:
+            pumped_before |= engine.pumps_running()
+        elif now > onset + 1.0:
+            # Stale scan: zero command and the pump off, within the stale timeout.
+            assert not engine.pumps_running()[stale].any()
+            assert not engine.active_commands()[stale].any()
+    assert pumped_before.any()  # the pumps did run: "off" above is a change
+    # No robot drove forward against an obstacle for more than 5 s.
+    assert longest_push[working].max() < 5.0
+    assert engine.distance_travelled_m[working].min() > 10.0
+
+
+def test_a_bayes_swarm_without_some_robots_still_finds_the_source(case1_spec):
+    full = run_bayes(case1_spec, 'bayes_swarm_p', 5, seed=3)
+    faults = FaultConfig(dropout_robots=2, dropout_time_s=5.0)
+    spec = dataclasses.replace(case1_spec, faults=faults)
+    fewer = run_bayes(spec, 'bayes_swarm_p', 5, seed=3)
+    plan = FaultPlan(faults, 5, 3)
+    assert full.found
+    assert fewer.found
+    assert fewer.finder not in plan.robots['dropout']
+    for robot in plan.robots['dropout']:
+        assert all(d.compute_time_s >= 0 for d in fewer.decisions[robot])
+        path = fewer.trajectories[robot]
+        # After the dropout the robot is where it was at 5 s: at most V * 5 s from its start.
+        assert np.hypot(*(path[-1] - path[0])) <= case1_spec.planner.velocity_mps * 5.0 + 1e-9
+    everyone = dataclasses.replace(case1_spec, faults=FaultConfig(dropout_robots=5))
+    assert not run_bayes(everyone, 'bayes_swarm_p', 5, seed=3).found
+    deaf = dataclasses.replace(case1_spec, faults=FaultConfig(comm_loss_probability=1.0))
+    alone = run_bayes(deaf, 'bayes_swarm_p', 5, seed=3)
+    assert alone.found_time_s != full.found_time_s
+
+
+@pytest.mark.slow
+def test_dropped_msc_robots_stand_still_and_capture_nothing():
+    targets = np.array([[1150.0, 1080.0], [820.0, 900.0]])
+    faults = FaultConfig(dropout_robots=2, dropout_time_s=50.0)
+    scenario = BatchScenario(
+        scheme=Scheme.PROPOSED,
+        n_robots=6,
+        n_targets=2,
+        seed=7,
+        max_time_s=3000.0,
+        target_positions_m=targets,
+        faults=faults,
+    )
+    result = run_batch(scenario, record=True)
+    dropped = FaultPlan(faults, 6, 7).robots['dropout']
+    paths = result.paths_m
+    assert np.ptp(paths[51:, dropped], axis=0).max() == 0.0
+    assert np.ptp(paths[:50, dropped], axis=0).max() > 10.0
+    assert np.isfinite(result.cct_s)
+
+
+def test_msc_link_faults_act_in_the_relay_and_dropped_robots_go_silent():
+    base = BatchScenario(scheme=Scheme.PROPOSED, n_robots=4, n_targets=2, seed=5, max_time_s=150.0)
+    deaf = run_batch(
+        dataclasses.replace(base, faults=FaultConfig(comm_loss_probability=1.0)), record=True
+    )
+    lossy = run_batch(dataclasses.replace(base, comm_loss=1.0), record=True)
+    talking = run_batch(base, record=True)
+    # The fault's loss combines with the scenario's in the relay: all lost either way.
+    assert np.array_equal(deaf.paths_m, lossy.paths_m)
+    assert not np.array_equal(deaf.paths_m, talking.paths_m)
+    # Robots dropped at 0 s never move, and nobody hears from them.
+    faults = FaultConfig(dropout_robots=3, dropout_time_s=0.0)
+    alone = run_batch(dataclasses.replace(base, faults=faults), record=True)
+    dropped = FaultPlan(faults, 4, 5).robots['dropout']
+    assert np.ptp(alone.paths_m[:, dropped], axis=0).max() == 0.0
+    survivor = [i for i in range(4) if i not in dropped]
+    solo = run_batch(dataclasses.replace(base, comm_loss=1.0), record=True)
+    assert np.ptp(alone.paths_m[:, survivor], axis=0).max() > 1.0
+    assert np.array_equal(alone.paths_m[:, survivor], solo.paths_m[:, survivor])
+
+
+def test_faults_of_sensors_the_point_robot_runners_lack_are_refused(case1_spec):
+    from bayes_swarm.errors import ConfigError as BayesConfigError
+    from msc_pf.errors import ConfigError as MscConfigError
+
+    lidar = dataclasses.replace(case1_spec, faults=FaultConfig(stale_lidar_robots=1))
+    with pytest.raises(BayesConfigError, match='stale_lidar_robots are not simulated'):
+        run_bayes(lidar, 'bayes_swarm_p', 3, seed=1)
+    glow = dataclasses.replace(case1_spec, faults=FaultConfig(dropout_robots=1))
+    with pytest.raises(BayesConfigError, match='not simulated by this runner'):
+        run_bayes(glow, 'glowworm', 3, seed=1)
+    gas = BatchScenario(n_robots=3, n_targets=1, faults=FaultConfig(stuck_gas_robots=1))
+    with pytest.raises(MscConfigError, match='stuck_gas_robots are not simulated'):
+        run_batch(gas)
+
+
+def test_still_time_measures_the_longest_stop():
+    times = np.arange(6.0)
+    positions = np.array([[0, 0], [1, 0], [1, 0], [1, 0.01], [2, 0], [3, 0]], dtype=float)
+    assert still_time_s(times, positions) == 2.0
+    driving = np.column_stack([0.1 * times, np.zeros(6)])
+    assert still_time_s(times, driving) == 0.0
+
+
+def test_fault_scenarios_and_options_parse_and_bad_ones_fail_in_one_line(capsys):
+    config = parse_fault('dropout_robots=2,comm_loss_probability=0.5', 30.0)
+    assert (config.dropout_robots, config.dropout_time_s) == (2, 30.0)
+    assert config.comm_loss_probability == 0.5
+    assert parse_fault('none', 0.0) == FaultConfig()
+    with pytest.raises(OverrideError, match='dropout_robot'):
+        fault_config(['dropout_robot=2'])
+    with pytest.raises(OverrideError, match='comm_loss_probability'):
+        fault_config(['comm_loss_probability=2'])
+    assert spawn_main(['--fault', 'stale_lidars=1', '--no-plots']) == 2
+    assert msc_main(['--fault', 'comm_range_m=-3', '--no-plots']) == 2
+    assert spawn_main(['--sensors', 'realistic', '--sensor-param', 'lidar=1']) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 3
+    assert 'stale_lidars' in err[0]
+    assert 'comm_range_m' in err[1]
+    assert 'lidar' in err[2]
+    assert math.isinf(FaultConfig().comm_range_m)
