@@ -358,7 +358,7 @@ def studies() -> list[Study]:
             },
             params=_params(),
             runs=40,
-            description='Issue 22.6: the MSC baseline as a bracket, gradient leader rule and '
+            description='Beyond the paper: the MSC baseline as a bracket, gradient leader rule and '
             'a PSO-style pbest rule that finishes, beside the proposed scheme.',
             smoke=_SMOKE,
             report=report_fig4,
@@ -380,7 +380,7 @@ def studies() -> list[Study]:
             },
             params=_params(),
             runs=40,
-            description='Beyond the paper (issue 22.6): robots search alone and gather on a '
+            description='Beyond the paper: robots search alone and gather on a '
             'heard target, against the best MSC configuration (MSC given the same searches); '
             'the paper-faithful proposed scheme first.',
             smoke=_SMOKE,

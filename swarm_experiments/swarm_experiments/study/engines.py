@@ -18,6 +18,7 @@ must be importable module-level callables on the workers (the same code installe
 
 from __future__ import annotations
 
+import abc
 import concurrent.futures
 import contextlib
 import multiprocessing
@@ -37,19 +38,20 @@ __all__ = ['ENGINES', 'DaskEngine', 'Engine', 'PoolEngine', 'SerialEngine', 'mak
 RunFunction = Callable[[RunSpec], Mapping[str, Any]]
 
 
-class Engine:
+class Engine(abc.ABC):
     """Runs specs and yields their rows as they complete (in any order)."""
 
     name = 'engine'
     #: Worker slots the engine runs on (for progress and projections).
     slots = 1
 
+    @abc.abstractmethod
     def rows(
         self, run: RunFunction, specs: Sequence[RunSpec], code_version: str
     ) -> Iterator[dict[str, Any]]:
-        raise NotImplementedError
+        """Run every spec with ``run``; yield one row per spec as it completes."""
 
-    def close(self) -> None:
+    def close(self) -> None:  # noqa: B027 (optional: an engine without processes has none)
         """Release the engine's processes (idempotent)."""
 
     def __enter__(self) -> Engine:
