@@ -21,6 +21,7 @@ Ctrl-C (the summary so far is printed and the bag closed).
 from __future__ import annotations
 
 import argparse
+import contextlib
 import dataclasses
 import math
 import sys
@@ -68,6 +69,7 @@ from swarm_experiments.mission import (
     run_mission,
 )
 from swarm_experiments.node_overrides import parse_overrides
+from swarm_experiments.processes import DryRunDone, process_runner
 from swarm_experiments.progress import MissionProgressBar, progress_wanted
 from swarm_experiments.runtime_option import add_runtime_arguments, check_runtime
 
@@ -85,6 +87,8 @@ __all__ = [
     'run',
 ]
 
+#: (package, executable) of the OA-Bug node, for ``--processes``.
+OABUG_EXECUTABLE = ('oabug_robot', 'oabug')
 VARIANTS = ('random', 'minimum', 'sound', 'gas', 'gas_sound')
 ACTION_LENGTH_M = 0.1
 DEFAULT_ACTIONS = 1000
@@ -290,7 +294,7 @@ def build_mission(
         }
         params.update(PROFILES[config.profile])
         params.update(config.robot_parameters)
-        robots.append(RobotNodeSpec(factory, params))
+        robots.append(RobotNodeSpec(factory, params, executable=OABUG_EXECUTABLE))
     recording = None
     if config.record is not None:
         topics = list(DEFAULT_RECORD_TOPICS)
@@ -475,6 +479,12 @@ def _main(argv: list[str]) -> int:
     )
     require_backend(args.physics)
     check_runtime(args.runtime)
+    runner = process_runner(args) or run_mission
+    if args.dry_run:
+        spec, _ = build_mission(config, max_robots=MAX_ROBOTS)
+        with contextlib.suppress(DryRunDone):
+            runner(spec)
+        return EXIT_SUCCESS
     check_run_outputs(config.record, config.out_dir)
     spec, bias = build_mission(config, max_robots=MAX_ROBOTS)
     for warning in spec.site.warnings:
@@ -497,7 +507,7 @@ def _main(argv: list[str]) -> int:
         lines=not args.quiet,
     )
     with bar:
-        mission = run_mission(spec, progress=bar)
+        mission = runner(spec, progress=bar)
     result = OABugRun(settings=config, mission=mission, heading_bias_rad=bias)
     print(format_summary(result), flush=True)
     if mission.bag_path is not None:
