@@ -546,7 +546,7 @@ def _progress(monitor: _Monitor, wall_start: float) -> MissionProgress:
 def _raise_crash(child: _Child, status: int) -> None:
     how = f'was killed by signal {-status}' if status < 0 else f'exited with status {status}'
     last = child.last_line()
-    detail = f': {last}' if last else ''
+    detail = f'; its last log line: {last}' if last else ''
     msg = (
         f'{child.command.name} ({child.command.executable}) {how} before the mission ended'
         f'{detail} (log: {child.log_path})'
