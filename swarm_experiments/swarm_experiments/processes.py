@@ -67,6 +67,7 @@ __all__ = [
     'mission_commands',
     'parse_command',
     'run_mission_processes',
+    'spawner_commands',
 ]
 
 #: (package, executable) of the sim bridge.
@@ -595,3 +596,34 @@ def process_runner(args: Any, out: IO[str] | None = None) -> Callable[..., Missi
         return run_mission_processes(spec, options=options, **kwargs)
 
     return runner
+
+
+#: The spawners' console scripts and their modules.
+SPAWNERS = {
+    'spawn': 'swarm_experiments.spawn',
+    'spawn_bayes_swarm': 'swarm_experiments.spawn_bayes_swarm',
+    'spawn_msc_pf': 'swarm_experiments.spawn_msc_pf',
+}
+
+
+def spawner_commands(spawner: str, argv: Sequence[str], run_dir: Path) -> list[NodeCommand]:
+    """The node commands ``<spawner> --processes --dry-run --run-dir RUN_DIR ARGV`` prints
+    (the mission file is written into ``run_dir``).
+
+    Raises:
+        ExperimentError: an unknown spawner, or options it rejects.
+    """
+    import importlib
+    import io
+
+    if spawner not in SPAWNERS:
+        msg = f'unknown spawner {spawner!r}; choose one of {", ".join(SPAWNERS)}'
+        raise ExperimentError(msg)
+    main = importlib.import_module(SPAWNERS[spawner]).main
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        status = main(['--processes', '--dry-run', '--run-dir', str(run_dir), *argv])
+    if status != 0:
+        lines = err.getvalue().strip().splitlines()
+        raise ExperimentError(lines[0] if lines else f'{spawner} exited with status {status}')
+    return [parse_command(line) for line in out.getvalue().splitlines()]

@@ -181,7 +181,7 @@ class BayesSwarmRun:
     def finder_decision_times_s(self) -> np.ndarray:
         """Decision times of the finder (all robots if none found) [s]."""
         if self.finder:
-            return np.array(self.decision_times_s[self.finder])
+            return np.array(self.decision_times_s.get(self.finder, []))
         return np.array([t for ts in self.decision_times_s.values() for t in ts])
 
 
