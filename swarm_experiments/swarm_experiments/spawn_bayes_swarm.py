@@ -513,7 +513,8 @@ def write_plots(result: BayesSwarmRun, out_dir: Path) -> list[Path]:
     paths.append(path)
 
     index = int(result.finder[1:]) if result.finder else 0
-    node = result.robot_nodes[index]
+    # With one process per node the nodes are not here: no GP plot.
+    node = result.robot_nodes[index] if index < len(result.robot_nodes) else None
     planner = getattr(node, 'planner', None)
     if planner is not None and planner.gp.n_samples:
         mean, _ = planner.gp.predict(grid)

@@ -24,6 +24,7 @@ import pytest
 from sim_bridge.bridge_parameters import BRIDGE_PARAMETERS
 from sim_bridge.mission_file import load_mission
 from swarm_experiments.processes import NodeCommand, format_command, parse_command
+from swarm_runtime.bag import read_messages
 from swarm_runtime.ros import using_real_rclpy
 
 from swarm_experiments import spawn, spawn_bayes_swarm, spawn_msc_pf
@@ -173,14 +174,19 @@ def _outcome(run_dir: Path) -> dict:
 
 
 @real_rclpy
-def test_oabug_runs_in_processes(tmp_path: Path) -> None:
-    done = _run('spawn', ['--robots', '2', '--actions', '24', '--time-scale', '2'], tmp_path)
+def test_oabug_runs_in_processes_and_records_the_bag(tmp_path: Path) -> None:
+    bag = tmp_path / 'bag'
+    argv = ['--robots', '2', '--actions', '24', '--time-scale', '3', '--record', str(bag)]
+    done = _run('spawn', argv, tmp_path / 'run')
     assert done.returncode in (0, 1), done.stderr
     assert 'stopped by budget after 8.0 s sim' in done.stdout
     assert 'Coverage:' in done.stdout
-    outcome = _outcome(tmp_path)
+    outcome = _outcome(tmp_path / 'run')
     assert outcome['stop_reason'] == 'budget'
     assert min(outcome['distance_travelled_m']) > 0.3  # both robots drove on their scans
+    topics = {m.topic for m in read_messages(bag, raw=True)}
+    for topic in ('/clock', '/sim/site', '/sim/coverage', '/r1/cmd_vel', '/r0/state'):
+        assert topic in topics  # the supervisor's recorder took the children's topics
 
 
 @real_rclpy
