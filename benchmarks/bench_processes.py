@@ -22,13 +22,13 @@ noise (two standard errors of the difference of the means).
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import math
 import os
 import re
 import shlex
 import subprocess
 import sys
-import tempfile
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -191,17 +191,25 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument('--sweep-seeds', type=int, default=5, help='seeds per time scale')
     parser.add_argument('--scales', type=float, nargs='+', default=[2.0, 4.0, 8.0, 16.0])
     parser.add_argument('--no-sweep', action='store_true', help='skip the time-scale sweep')
+    parser.add_argument(
+        '--time-scale',
+        type=float,
+        default=None,
+        help="every mission's time scale (default: each its own)",
+    )
     args = parser.parse_args(argv)
     print(
         f'# {shlex.join([Path(sys.argv[0]).name, *(argv if argv is not None else sys.argv[1:])])}'
     )
     env = _env()
-    with tempfile.TemporaryDirectory():
-        start = time.perf_counter()
-        compare([MISSIONS[name] for name in args.algorithms], args.seeds, env)
-        if not args.no_sweep:
-            sweep(args.scales, args.sweep_seeds, env)
-        print(f'\ntotal wall time {time.perf_counter() - start:.0f} s')
+    start = time.perf_counter()
+    missions = [MISSIONS[name] for name in args.algorithms]
+    if args.time_scale is not None:
+        missions = [dataclasses.replace(m, time_scale=args.time_scale) for m in missions]
+    compare(missions, args.seeds, env)
+    if not args.no_sweep:
+        sweep(args.scales, args.sweep_seeds, env)
+    print(f'\ntotal wall time {time.perf_counter() - start:.0f} s')
     return 0
 
 

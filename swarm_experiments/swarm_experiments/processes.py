@@ -28,6 +28,7 @@ import contextlib
 import ctypes
 import math
 import os
+import re
 import shlex
 import shutil
 import signal
@@ -49,6 +50,7 @@ from swarm_common.params import render_value
 from swarm_sim.errors import ConfigurationError
 from swarm_sim.ground_truth import RoomEntry
 
+from swarm_experiments.cli_args import NODE_CRASH_PREFIX
 from swarm_experiments.errors import ExperimentError, MissionError
 from swarm_experiments.mission import (
     MissionProgress,
@@ -61,6 +63,7 @@ from swarm_experiments.mission import (
 __all__ = [
     'BRIDGE_EXECUTABLE',
     'NodeCommand',
+    'NodeCrash',
     'ProcessOptions',
     'format_command',
     'launch_entries',
@@ -68,6 +71,7 @@ __all__ = [
     'parse_command',
     'run_mission_processes',
     'spawner_commands',
+    'split_crash_faults',
 ]
 
 #: (package, executable) of the sim bridge.
@@ -169,6 +173,54 @@ def parse_command(line: str) -> NodeCommand:
 
 
 @dataclass(frozen=True)
+class NodeCrash:
+    """A node-crash fault: robot ``robot`` is killed (SIGKILL) when ``/clock`` reaches
+    ``time_s`` and, unless ``restart_after_s`` is None, started again with the same command
+    line that much sim time later."""
+
+    robot: int
+    time_s: float
+    restart_after_s: float | None = None
+
+    @property
+    def name(self) -> str:
+        """The robot's name (r<i>)."""
+        return f'r{self.robot}'
+
+
+_CRASH = re.compile(r'crash:r(\d+)@([0-9.]+)(?:\+([0-9.]+))?')
+
+
+def split_crash_faults(items: Sequence[str]) -> tuple[list[str], tuple[NodeCrash, ...]]:
+    """Split ``--fault`` items into the world's ``NAME=VALUE`` faults and node crashes
+    ``crash:r<i>@<time_s>[+<restart_after_s>]``.
+
+    Raises:
+        ExperimentError: a malformed crash item.
+    """
+    rest: list[str] = []
+    crashes: list[NodeCrash] = []
+    for item in items:
+        if not item.startswith(NODE_CRASH_PREFIX):
+            rest.append(item)
+            continue
+        match = _CRASH.fullmatch(item.strip())
+        if match is None:
+            msg = (
+                f'--fault {item}: a node crash is crash:r<i>@<time_s>[+<restart_after_s>], '
+                'e.g. crash:r1@60 or crash:r1@60+10'
+            )
+            raise ExperimentError(msg)
+        try:
+            time_s = float(match.group(2))
+            restart = None if match.group(3) is None else float(match.group(3))
+        except ValueError as err:
+            raise ExperimentError(f'--fault {item}: {err}') from err
+        crashes.append(NodeCrash(int(match.group(1)), time_s, restart))
+    return rest, tuple(crashes)
+
+
+@dataclass(frozen=True)
 class ProcessOptions:
     """How to run a mission in processes.
 
@@ -178,11 +230,13 @@ class ProcessOptions:
         stop_timeout_s: seconds a child gets after SIGINT before it is killed.
         startup_timeout_s: wall seconds the bridge may wait for the nodes before the first
             step; exceeded, the run fails.
+        crashes: node-crash faults to inject.
     """
 
     run_dir: Path | None = None
     stop_timeout_s: float = STOP_TIMEOUT_S
     startup_timeout_s: float = 120.0
+    crashes: tuple[NodeCrash, ...] = ()
 
 
 def _bridge_parameters(spec: MissionSpec, run_dir: Path) -> dict[str, Any]:
@@ -277,6 +331,7 @@ class _Child:
     process: subprocess.Popen[bytes]
     log_path: Path
     log: IO[bytes]
+    crashed: bool = False  # its crash fault has been injected
 
     def last_line(self) -> str:
         with contextlib.suppress(OSError):
@@ -394,9 +449,9 @@ def _result_from_outcome(
     )
 
 
-def _start(command: NodeCommand, run_dir: Path) -> _Child:
+def _start(command: NodeCommand, run_dir: Path, *, restart: bool = False) -> _Child:
     log_path = run_dir / f'{command.name}.log'
-    log = log_path.open('wb')
+    log = log_path.open('ab' if restart else 'wb')
     env = dict(os.environ, SWARM_RUNTIME='rclpy', PYTHONUNBUFFERED='1')
     try:
         process = subprocess.Popen(
@@ -439,6 +494,10 @@ def run_mission_processes(
     run_dir = Path(tempfile.mkdtemp(prefix='swarm-processes-')) if temporary else options.run_dir
     assert run_dir is not None
     commands = mission_commands(spec, run_dir)
+    for crash in options.crashes:
+        if not 0 <= crash.robot < len(spec.robots):
+            msg = f'--fault crash:{crash.name}: the mission has robots r0..r{len(spec.robots) - 1}'
+            raise ExperimentError(msg)
     outcome_path = Path(commands[0].parameters['outcome_file'])
     from rclpy.signals import SignalHandlerOptions
 
@@ -461,6 +520,7 @@ def run_mission_processes(
             for command in commands:
                 children.append(_start(command, run_dir))
             bridge = children[0]
+            pending: dict[str, NodeCrash] = {}  # killed on purpose, maybe to be restarted
             next_report_s = 0.0
             started_wall = time.monotonic()
             stopping = False
@@ -474,9 +534,10 @@ def run_mission_processes(
                     if status != 0:
                         _raise_crash(bridge, status)
                     break
+                _inject_crashes(options.crashes, monitor.sim_time_s, children, run_dir, pending)
                 for child in children[1:]:
                     status = child.process.poll()
-                    if status is not None:
+                    if status is not None and child.command.name not in pending:
                         _raise_crash(child, status)
                 if monitor.clocks == 0:
                     if time.monotonic() - started_wall > options.startup_timeout_s:
@@ -527,6 +588,34 @@ def run_mission_processes(
             rclpy.try_shutdown()
         if temporary and not failed:
             shutil.rmtree(run_dir, ignore_errors=True)
+
+
+def _inject_crashes(
+    crashes: Sequence[NodeCrash],
+    sim_time_s: float,
+    children: list[_Child],
+    run_dir: Path,
+    pending: dict[str, NodeCrash],
+) -> None:
+    """Kill the robots whose crash time has come; restart those whose time has come.
+    ``pending`` holds the robots killed on purpose and not (yet) restarted."""
+    for crash in crashes:
+        index = crash.robot + 1  # children[0] is the bridge
+        child = children[index]
+        due = sim_time_s + 1e-9 >= crash.time_s
+        if not child.crashed and due and child.process.poll() is None:
+            _signal_group(child, signal.SIGKILL)
+            child.process.wait()
+            child.log.close()
+            child.crashed = True
+            pending[crash.name] = crash
+            continue
+        restart_s = None if crash.restart_after_s is None else crash.time_s + crash.restart_after_s
+        if crash.name in pending and restart_s is not None and sim_time_s + 1e-9 >= restart_s:
+            restarted = _start(child.command, run_dir, restart=True)
+            restarted.crashed = True
+            children[index] = restarted
+            del pending[crash.name]
 
 
 def _replace_reason(result: MissionResult, reason: str) -> MissionResult:
@@ -584,13 +673,16 @@ def process_runner(args: Any, out: IO[str] | None = None) -> Callable[..., Missi
     if not args.processes:
         if args.dry_run or args.run_dir is not None:
             raise ExperimentError('--dry-run and --run-dir need --processes')
+        if split_crash_faults(args.fault)[1]:
+            raise ExperimentError('--fault crash:... kills a node process: it needs --processes')
         return None
     if args.runtime == 'builtin':
         msg = '--processes runs every node on real rclpy; leave out --runtime builtin'
         raise ExperimentError(msg)
+    _, crashes = split_crash_faults(args.fault)
     if args.dry_run:
         return _dry_run(args.run_dir, out or sys.stdout)
-    options = ProcessOptions(run_dir=args.run_dir)
+    options = ProcessOptions(run_dir=args.run_dir, crashes=crashes)
 
     def runner(spec: MissionSpec, **kwargs: Any) -> MissionResult:
         return run_mission_processes(spec, options=options, **kwargs)

@@ -116,7 +116,13 @@ def test_dry_run_lines_are_the_msc_pf_nodes(tmp_path: Path) -> None:
 
 @pytest.mark.parametrize(
     'argv',
-    [['--dry-run'], ['--run-dir', 'x'], ['--processes', '--runtime', 'builtin']],
+    [
+        ['--dry-run'],
+        ['--run-dir', 'x'],
+        ['--processes', '--runtime', 'builtin'],
+        ['--fault', 'crash:r1@5'],  # a node crash needs node processes
+        ['--processes', '--dry-run', '--fault', 'crash:1@5'],
+    ],
 )
 def test_process_options_that_do_not_fit_are_usage_errors(argv: list[str]) -> None:
     err = io.StringIO()
@@ -258,3 +264,14 @@ def test_ctrl_c_stops_every_child_with_the_summary_so_far(tmp_path: Path) -> Non
     assert 'stopped by interrupted' in out
     assert 'Coverage:' in out
     assert not [pid for pid in children if _alive(pid)]
+
+
+@real_rclpy
+def test_a_crash_fault_kills_and_restarts_one_robot(tmp_path: Path) -> None:
+    argv = ['--robots', '2', '--actions', '45', '--time-scale', '2', '--fault', 'crash:r1@3+2']
+    done = _run('spawn', argv, tmp_path)
+    assert done.returncode in (0, 1), done.stderr  # the mission goes on without r1
+    assert 'stopped by budget after 15.0 s sim' in done.stdout
+    starts = 'OA-Bug gas_sound: robot {} of 2'
+    assert (tmp_path / 'r0.log').read_text().count(starts.format(0)) == 1
+    assert (tmp_path / 'r1.log').read_text().count(starts.format(1)) == 2  # started again
