@@ -13,6 +13,7 @@ def share_files(subdir: str) -> list[tuple[str, list[str]]]:
     files = sorted(str(f.relative_to(HERE)) for f in (HERE / subdir).glob('*') if f.is_file())
     return [(f'share/{PACKAGE_NAME}/{subdir}', files)] if files else []
 
+
 setup(
     name=PACKAGE_NAME,
     version='0.1.0',
