@@ -490,14 +490,14 @@ def run_mission_processes(
     if not using_real_rclpy():
         raise ExperimentError('--processes needs real rclpy (ROS 2 Jazzy or its PyPI wheels)')
     options = options or ProcessOptions()
-    temporary = options.run_dir is None
-    run_dir = Path(tempfile.mkdtemp(prefix='swarm-processes-')) if temporary else options.run_dir
-    assert run_dir is not None
-    commands = mission_commands(spec, run_dir)
     for crash in options.crashes:
         if not 0 <= crash.robot < len(spec.robots):
             msg = f'--fault crash:{crash.name}: the mission has robots r0..r{len(spec.robots) - 1}'
             raise ExperimentError(msg)
+    temporary = options.run_dir is None
+    run_dir = Path(tempfile.mkdtemp(prefix='swarm-processes-')) if temporary else options.run_dir
+    assert run_dir is not None
+    commands = mission_commands(spec, run_dir)
     outcome_path = Path(commands[0].parameters['outcome_file'])
     from rclpy.signals import SignalHandlerOptions
 
