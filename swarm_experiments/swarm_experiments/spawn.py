@@ -1,12 +1,13 @@
 """OA-Bug spawner: N robots search a site until every room is covered or the budget ends.
 
-Plain script, no launch file (``ros2 run swarm_experiments spawn`` or ``python -m
+Plain script (``ros2 run swarm_experiments spawn`` or ``python -m
 swarm_experiments.spawn``). It builds the site, starts the sim bridge and one OA-Bug node
 per robot on sim time, shows a progress bar (on a terminal), prints the summary (coverage,
 rooms covered/total, time, rooms first visited per robot) and writes two PNGs: the paper's
 Fig. 6 view (paths per robot, rooms coloured by first visitor) and coverage over time. With
 ``--record`` it also writes a rosbag2 (MCAP) bag from which ``swarm_report`` reproduces the
-same summary and figures.
+same summary and figures. With ``--processes`` the bridge and every robot node run in
+processes of their own on real DDS (:mod:`swarm_experiments.processes`).
 
 The budget follows the paper: max actions per robot (Table II: Small 1000, Medium 2000, Big
 4000), one action being a 0.1 m step, so mission time = actions x 0.1 m / robot speed.

@@ -1,6 +1,6 @@
 """Bayes-Swarm spawner: N robots seek the strongest source of a signal field.
 
-Plain script, no launch file (``ros2 run swarm_experiments spawn_bayes_swarm`` or
+Plain script (``ros2 run swarm_experiments spawn_bayes_swarm`` or
 ``python -m swarm_experiments.spawn_bayes_swarm``). It builds an obstacle-free arena for the chosen
 case (the paper's Cases 1-3 or the avalanche field), starts the sim bridge with the signal
 extension and one ``bayes_swarm`` node per robot on sim time, relays peer messages within

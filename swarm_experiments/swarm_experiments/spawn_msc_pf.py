@@ -1,6 +1,6 @@
 """MSC + PF spawner: N robots search for and capture RSSI-emitting targets.
 
-Plain script, no launch file (``ros2 run swarm_experiments spawn_msc_pf`` or
+Plain script (``ros2 run swarm_experiments spawn_msc_pf`` or
 ``python -m swarm_experiments.spawn_msc_pf``). It builds the paper's scenario (Sec. IV-A): an
 obstacle-free 2000 m x 2000 m field, targets placed uniformly, robots starting uniformly in a
 30 m disc at the centre; starts the sim bridge with the RSSI-target extension and one
