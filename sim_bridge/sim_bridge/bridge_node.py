@@ -15,8 +15,12 @@ physics period divided by ``real_time_factor``; in the built-in runtime that tim
 virtual clock, so a headless simulation goes as fast as the machine allows.
 
 Standalone: ``ros2 run sim_bridge sim_bridge --ros-args -p site_file:=site.yaml
--p robot_count:=6 -p departure:=center``; the mission runner (:mod:`swarm_experiments.mission`)
-builds it in-process with a site object and start poses instead.
+-p robot_count:=6 -p departure:=center``, or with ``-p mission_file:=mission.json`` (site,
+start poses, sensors and extensions: :mod:`sim_bridge.mission_file`), as the spawners'
+``--processes`` mode starts it; the mission runner (:mod:`swarm_experiments.mission`)
+builds it in-process with a site object and start poses instead. With ``max_sim_time_s``,
+``stop_when_all_rooms_covered`` or ``outcome_file`` set, the bridge ends the mission itself:
+it stops stepping, writes the outcome file and exits 0.
 """
 
 from __future__ import annotations
