@@ -24,6 +24,7 @@ setup(
         (f'share/{PACKAGE_NAME}', ['package.xml']),
         *share_files('config'),
         *share_files('bringup'),
+        *share_files('launch'),
     ],
     install_requires=[
         'numpy',

@@ -1,8 +1,18 @@
 """ament_python packaging for swarm_experiments; also what the development install uses."""
 
+from pathlib import Path
+
 from setuptools import find_packages, setup
 
 PACKAGE_NAME = 'swarm_experiments'
+HERE = Path(__file__).resolve().parent
+
+
+def share_files(subdir: str) -> list[tuple[str, list[str]]]:
+    """Install every file under ``subdir`` into share/<package>/<subdir>."""
+    files = sorted(str(f.relative_to(HERE)) for f in (HERE / subdir).glob('*') if f.is_file())
+    return [(f'share/{PACKAGE_NAME}/{subdir}', files)] if files else []
+
 
 setup(
     name=PACKAGE_NAME,
@@ -12,6 +22,7 @@ setup(
     data_files=[
         ('share/ament_index/resource_index/packages', [f'resource/{PACKAGE_NAME}']),
         (f'share/{PACKAGE_NAME}', ['package.xml']),
+        *share_files('launch'),
     ],
     install_requires=[
         'numpy',
@@ -37,8 +48,8 @@ setup(
     maintainer='Swarm search maintainers',
     maintainer_email='maintainers@swarm-search.org',
     description=(
-        'Experiment harness: the launch-free spawners, the mission loop, the batch runners of '
-        'the benchmarks, the node parameter overrides and the studies (swarm_study).'
+        'Experiment harness: the spawners and their launch file, the mission loop, the batch '
+        'runners of the benchmarks, the node parameter overrides and the studies (swarm_study).'
     ),
     license='Apache-2.0',
     entry_points={

@@ -12,6 +12,6 @@ Per device three layers (docs/hardware.md explains wiring, permissions and bring
   ``pump_node``, translating through ``conversions`` with ``node_common`` helpers.
 
 ``errors`` holds the exception hierarchy (recoverable vs fatal), ``fakes`` the byte/register
-level fakes used by tests and by ``fake_device:=true``, ``robot_bringup`` the launch-free
-bringup of one robot.
+level fakes used by tests and by ``fake_device:=true``, ``robot_bringup`` the supervised
+bringup of one robot (``launch/robot.launch.py`` starts the same nodes).
 """

@@ -15,12 +15,17 @@ physics period divided by ``real_time_factor``; in the built-in runtime that tim
 virtual clock, so a headless simulation goes as fast as the machine allows.
 
 Standalone: ``ros2 run sim_bridge sim_bridge --ros-args -p site_file:=site.yaml
--p robot_count:=6 -p departure:=center``; the mission runner (:mod:`swarm_experiments.mission`)
-builds it in-process with a site object and start poses instead.
+-p robot_count:=6 -p departure:=center``, or with ``-p mission_file:=mission.json`` (site,
+start poses, sensors and extensions: :mod:`sim_bridge.mission_file`), as the spawners'
+``--processes`` mode starts it; the mission runner (:mod:`swarm_experiments.mission`)
+builds it in-process with a site object and start poses instead. With ``max_sim_time_s``,
+``stop_when_all_rooms_covered`` or ``outcome_file`` set, the bridge ends the mission itself:
+it stops stepping, writes the outcome file and exits 0.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Callable, Sequence
 from typing import Any
@@ -44,6 +49,7 @@ from swarm_sim.site_geometry import geometry_from_site
 from sim_bridge import conversions
 from sim_bridge.bridge_parameters import BRIDGE_PARAMETERS, NODE_NAME, BridgeNodeConfig
 from sim_bridge.extensions import RobotStates, SimExtension
+from sim_bridge.mission_file import extension_outcome, load_mission, write_outcome
 from sim_bridge.visualization import BridgeVisualization
 
 __all__ = ['SimBridgeNode', 'main']
@@ -86,6 +92,15 @@ class SimBridgeNode(Node):
         self._declared = declare_config(self, BRIDGE_PARAMETERS, base=base, on_change=self._retime)
         self.settings: BridgeNodeConfig = self._declared.config
         self.config = self.settings.engine
+        if site is None and self.settings.mission_file:
+            mission = load_mission(self.settings.mission_file, site_seed=self.config.seed)
+            site = mission.site
+            if initial_poses is None:
+                initial_poses = mission.initial_poses
+            if not extensions:
+                extensions = mission.extensions
+            if mission.sensors is not None:
+                self.config = dataclasses.replace(self.config, sensors=mission.sensors)
         self._site_model = site if site is not None and not isinstance(site, SiteGeometry) else None
         geometry = self._resolve_site(site)
         poses = self._resolve_poses(initial_poses)
@@ -134,8 +149,23 @@ class SimBridgeNode(Node):
 
         coverage_rate = self.settings.coverage_rate_hz
         self._coverage_every = max(1, round(self.config.physics_rate_hz / coverage_rate))
-        rtf = self.settings.real_time_factor
-        self._timer = self.create_timer(self.config.physics_period_s / rtf, self._on_tick)
+        self._stop_reason = ''
+        # The bridge ends a mission itself only when asked to (the in-process runner ends it).
+        self._ends_mission = bool(
+            self.settings.outcome_file
+            or self.settings.stop_when_all_rooms_covered
+            or math.isfinite(self.settings.max_sim_time_s)
+        )
+        self._outcome_written = False
+        self._trajectory_times: list[float] = [0.0]
+        self._trajectory_poses: list[np.ndarray] = [self.engine.world.poses]
+        self._next_sample_s = self.settings.trajectory_period_s
+        self._timer: Any = None
+        self._grace_until_ns: int | None = None
+        if self.settings.start_after_clock_subscribers > 0:
+            self._wait_timer: Any = self.create_timer(0.05, self._wait_for_subscribers)
+        else:
+            self._start_physics()
         self._publish_coverage()
         self.get_logger().info(
             f'simulating {n} robots in {geometry.name!r} '
@@ -147,8 +177,29 @@ class SimBridgeNode(Node):
     def _retime(self, settings: BridgeNodeConfig) -> None:
         """Apply an accepted parameter change (only ``real_time_factor`` may change)."""
         self.settings = settings
-        period_s = self.config.physics_period_s / settings.real_time_factor
-        self._timer.timer_period_ns = round(period_s * 1e9)
+        if self._timer is not None:
+            period_s = self.config.physics_period_s / settings.real_time_factor
+            self._timer.timer_period_ns = round(period_s * 1e9)
+
+    def _start_physics(self) -> None:
+        rtf = self.settings.real_time_factor
+        self._timer = self.create_timer(self.config.physics_period_s / rtf, self._on_tick)
+
+    def _wait_for_subscribers(self) -> None:
+        """Before the first step: wait for ``start_after_clock_subscribers`` subscribers of
+        /clock, then one more wall second for their other topics to match."""
+        now_ns = self.get_clock().now().nanoseconds
+        if self._grace_until_ns is None:
+            wanted = self.settings.start_after_clock_subscribers
+            if self._clock_pub.get_subscription_count() < wanted:
+                return
+            self._grace_until_ns = now_ns + 1_000_000_000
+            return
+        if now_ns < self._grace_until_ns:
+            return
+        self._wait_timer.cancel()
+        self.get_logger().info('every expected node is up: the simulation starts')
+        self._start_physics()
 
     # Set-up helpers -------------------------------------------------------------------
 
@@ -324,6 +375,58 @@ class SimBridgeNode(Node):
                 ext.on_step(t, states)
         for listener in self.step_listeners:
             listener(out)
+        if self.settings.outcome_file and t + 1e-9 >= self._next_sample_s:
+            self._trajectory_times.append(t)
+            self._trajectory_poses.append(out.poses)
+            self._next_sample_s += self.settings.trajectory_period_s
+        reason = self._mission_end_reason() if self._ends_mission else ''
+        if reason:
+            self._end_mission(reason)
+
+    def _mission_end_reason(self) -> str:
+        """The stop reason once the mission's end condition holds ('' before)."""
+        if self.settings.stop_when_all_rooms_covered and self.engine.coverage.complete:
+            return 'all_rooms_covered'
+        if self.extensions and self.extensions_done():
+            return 'extension_done'
+        if self.engine.time_s + 1e-9 >= self.settings.max_sim_time_s:
+            return 'budget'
+        return ''
+
+    def _end_mission(self, reason: str) -> None:
+        """Stop stepping, write the outcome file and shut the context down (exit 0)."""
+        self.pause()
+        self._stop_reason = reason
+        self.write_outcome()
+        self.get_logger().info(f'mission ended ({reason}) at sim time {self.engine.time_s:.2f} s')
+        self.context.try_shutdown()
+
+    def outcome(self) -> dict[str, Any]:
+        """The mission's outcome so far as JSON values (see :mod:`sim_bridge.mission_file`)."""
+        times = list(self._trajectory_times)
+        poses = list(self._trajectory_poses)
+        if times[-1] < self.engine.time_s:
+            times.append(self.engine.time_s)
+            poses.append(self.engine.world.poses)
+        cov = self.engine.coverage
+        return {
+            'stop_reason': self._stop_reason or 'interrupted',
+            'sim_time_s': float(self.engine.time_s),
+            'robot_names': list(self.robot_names),
+            'rooms_total': int(cov.rooms_total),
+            'room_entries': [[e.room_index, e.robot_index, e.time_s] for e in cov.entries],
+            'trajectory_times_s': [float(v) for v in times],
+            'trajectories': np.stack(poses).tolist(),
+            'distance_travelled_m': self.engine.distance_travelled_m.tolist(),
+            'extensions': [extension_outcome(ext) for ext in self.extensions],
+        }
+
+    def write_outcome(self) -> None:
+        """Write the outcome to ``outcome_file`` (once; nothing without one)."""
+        if not self.settings.outcome_file or self._outcome_written:
+            return
+        self._outcome_written = True
+        write_outcome(self.settings.outcome_file, self.outcome())
 
     def _publish_coverage(self) -> None:
         cov = self.engine.coverage
@@ -337,13 +440,16 @@ class SimBridgeNode(Node):
         """Release the engine's physics backend, then destroy the node."""
         engine = getattr(self, 'engine', None)
         if engine is not None:
+            if hasattr(self, '_outcome_written'):
+                self.write_outcome()  # a stop before the end: the outcome so far
             engine.close()
         super().destroy_node()
 
     def pause(self) -> None:
         """Stop stepping the world (the physics timer is cancelled); messages already
         published are still delivered."""
-        self._timer.cancel()
+        if self._timer is not None:
+            self._timer.cancel()
 
     @property
     def sim_time_s(self) -> float:

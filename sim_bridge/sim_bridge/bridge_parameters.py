@@ -65,6 +65,34 @@ class BridgeNodeConfig:
     path_rate_hz: float = parameter(
         0.5, 'rate of the robot paths on /sim/markers/paths', unit='Hz', gt=0.0
     )
+    mission_file: str = parameter(
+        '',
+        'JSON mission file: site, start poses, sensors and extensions (sim_bridge.mission_file); '
+        'overrides site_file, robot_count and departure',
+    )
+    max_sim_time_s: float = parameter(
+        math.inf,
+        'end the mission at this sim time: write outcome_file and exit 0; .inf = never',
+        unit='s',
+        gt=0.0,
+        finite=False,
+    )
+    stop_when_all_rooms_covered: bool = parameter(
+        False, 'also end the mission once every room is covered'
+    )
+    outcome_file: str = parameter(
+        '',
+        "JSON file the mission's outcome is written to at its end or stop ('' = none); with "
+        "it, an extension's end also ends the mission",
+    )
+    trajectory_period_s: float = parameter(
+        0.5, 'sim-time interval of the true poses kept for outcome_file', unit='s', gt=0.0
+    )
+    start_after_clock_subscribers: int = parameter(
+        0,
+        'wait until /clock has this many subscribers (robots, recorder) before the first step',
+        ge=0,
+    )
 
 
 BRIDGE_PARAMETERS = ParameterSpec(BridgeNodeConfig, error=BridgeParameterError)

@@ -36,6 +36,9 @@ __all__ = [
     'render_config',
 ]
 
+#: How a ``--fault`` item naming a node crash starts (``crash:r1@60``; --processes only).
+NODE_CRASH_PREFIX = 'crash:'
+
 SPAWNER_EXIT_CODES = (
     'exit codes: 0 the mission finished (every room covered, source found, every target '
     'captured); 1 it did not finish within its budget; 2 bad options or input (one line on '
@@ -164,7 +167,9 @@ def add_fault_arguments(parser: argparse.ArgumentParser) -> None:
         default=[],
         metavar='NAME=VALUE',
         help='inject a fault (repeatable), e.g. dropout_robots=2 dropout_time_s=60 '
-        'stale_lidar_robots=1 comm_loss_probability=0.3; names: docs/simulation.md',
+        'stale_lidar_robots=1 comm_loss_probability=0.3; names: docs/simulation.md; with '
+        '--processes also crash:r<i>@<time_s>[+<restart_after_s>] (kill robot i at that sim '
+        'time, restart it that much later)',
     )
 
 
@@ -188,14 +193,16 @@ def add_sensor_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def fault_config(items: Sequence[str]) -> FaultConfig:
-    """The :class:`FaultConfig` of ``--fault`` items.
+    """The :class:`FaultConfig` of ``--fault`` items (node crashes, ``crash:...``, are
+    left to the ``--processes`` runner: :func:`swarm_experiments.processes.split_crash_faults`).
 
     Raises:
         swarm_experiments.node_overrides.OverrideError: a malformed item, an unknown name or
             a bad value (one line naming it).
     """
     spec = ParameterSpec(FaultConfig)
-    return spec.build(parse_overrides(items, spec))
+    world = [item for item in items if not item.startswith(NODE_CRASH_PREFIX)]
+    return spec.build(parse_overrides(world, spec))
 
 
 def realistic_sensors(items: Sequence[str]) -> RealisticSensors:

@@ -89,10 +89,13 @@ class RobotNodeSpec:
         factory: called as ``factory(namespace='/r0', parameter_overrides=[...])``; a Node
             subclass whose constructor forwards keyword arguments to rclpy's Node works.
         parameters: parameter overrides (name -> value); ``use_sim_time`` is set to True.
+        executable: (package, executable) of the node's ``ros2 run`` command, for a run with
+            one process per node (:mod:`swarm_experiments.processes`).
     """
 
     factory: NodeFactory
     parameters: Mapping[str, Any] = field(default_factory=dict)
+    executable: tuple[str, str] | None = None
 
 
 @dataclass(frozen=True)
@@ -137,6 +140,8 @@ class MissionSpec:
             ``real_time_factor``, unless ``bridge_parameters`` sets that). On real rclpy the
             mission runs this much faster than real time, as far as the nodes keep up; the
             built-in runtime runs as fast as it can whatever it is.
+        extension_entries: the ``extensions`` as mission-file entries
+            (:mod:`sim_bridge.mission_file`), for a bridge in a process of its own.
     """
 
     site: Any
@@ -151,6 +156,7 @@ class MissionSpec:
     progress_period_s: float = 10.0
     trajectory_period_s: float = 0.5
     time_scale: float = 1.0
+    extension_entries: Sequence[Mapping[str, Any]] = ()
 
     def __post_init__(self) -> None:
         poses = np.asarray(self.initial_poses, dtype=float)
@@ -219,6 +225,9 @@ class MissionResult:
         trajectories: (T, N, 3) true poses at those times.
         distance_travelled_m: (N,) path length of each robot [m].
         bag_path: the recorded bag directory, if any.
+        extension_outcomes: with one process per node, each extension's outcome as the
+            bridge reported it (:func:`sim_bridge.mission_file.extension_outcome`); empty
+            in process, where the caller holds the extensions themselves.
     """
 
     robot_names: tuple[str, ...]
@@ -232,6 +241,7 @@ class MissionResult:
     trajectories: np.ndarray
     distance_travelled_m: np.ndarray
     bag_path: Path | None = None
+    extension_outcomes: tuple[Mapping[str, Any], ...] = ()
 
     @property
     def rooms_covered(self) -> int:

@@ -15,10 +15,13 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import importlib.util
 import os
 import sys
 from collections.abc import Callable, Sequence
+from pathlib import Path
 
+from swarm_common.cli import EXIT_USAGE, fail
 from swarm_common.errors import SwarmError
 
 __all__ = [
@@ -59,6 +62,24 @@ def add_runtime_arguments(parser: argparse.ArgumentParser) -> None:
         metavar='X',
         help="on real rclpy, the bridge's clock runs X times faster than wall time, as far as "
         'the nodes keep up (the built-in runtime ignores it)',
+    )
+    parser.add_argument(
+        '--processes',
+        action='store_true',
+        help='one OS process per node (the sim bridge and each robot, started as ros2 run '
+        'would) on real rclpy and DDS; this process supervises them (docs/runtime.md)',
+    )
+    parser.add_argument(
+        '--dry-run',
+        action='store_true',
+        help='with --processes: print the command line of every node, one per line, and exit',
+    )
+    parser.add_argument(
+        '--run-dir',
+        type=Path,
+        default=None,
+        help='with --processes: directory for the mission file, the outcome and the logs of '
+        'the nodes (default: a temporary one, removed after a normal end)',
     )
 
 
@@ -104,6 +125,13 @@ def _entry(module: str) -> Callable[[], int]:
     def main() -> int:
         argv = sys.argv[1:]
         runtime = chosen_runtime(argv)
+        processes = '--processes' in argv and '--dry-run' not in argv
+        if processes and _option_value(argv) is None:
+            runtime = 'rclpy'  # --processes implies real rclpy
+        if runtime == 'rclpy' and importlib.util.find_spec('rclpy') is None:
+            what = '--processes' if processes else '--runtime rclpy'
+            text = f'{what} needs real rclpy (ROS 2 Jazzy or its PyPI wheels), not installed here'
+            return fail(module.rsplit('.', 1)[-1], text, EXIT_USAGE)
         if runtime in RUNTIMES:
             os.environ[_ENV_VAR] = runtime
         return int(importlib.import_module(module).main(argv))

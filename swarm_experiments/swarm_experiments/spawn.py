@@ -1,12 +1,13 @@
 """OA-Bug spawner: N robots search a site until every room is covered or the budget ends.
 
-Plain script, no launch file (``ros2 run swarm_experiments spawn`` or ``python -m
+Plain script (``ros2 run swarm_experiments spawn`` or ``python -m
 swarm_experiments.spawn``). It builds the site, starts the sim bridge and one OA-Bug node
 per robot on sim time, shows a progress bar (on a terminal), prints the summary (coverage,
 rooms covered/total, time, rooms first visited per robot) and writes two PNGs: the paper's
 Fig. 6 view (paths per robot, rooms coloured by first visitor) and coverage over time. With
 ``--record`` it also writes a rosbag2 (MCAP) bag from which ``swarm_report`` reproduces the
-same summary and figures.
+same summary and figures. With ``--processes`` the bridge and every robot node run in
+processes of their own on real DDS (:mod:`swarm_experiments.processes`).
 
 The budget follows the paper: max actions per robot (Table II: Small 1000, Medium 2000, Big
 4000), one action being a 0.1 m step, so mission time = actions x 0.1 m / robot speed.
@@ -21,6 +22,7 @@ Ctrl-C (the summary so far is printed and the bag closed).
 from __future__ import annotations
 
 import argparse
+import contextlib
 import dataclasses
 import math
 import sys
@@ -68,6 +70,7 @@ from swarm_experiments.mission import (
     run_mission,
 )
 from swarm_experiments.node_overrides import parse_overrides
+from swarm_experiments.processes import DryRunDone, process_runner
 from swarm_experiments.progress import MissionProgressBar, progress_wanted
 from swarm_experiments.runtime_option import add_runtime_arguments, check_runtime
 
@@ -85,6 +88,8 @@ __all__ = [
     'run',
 ]
 
+#: (package, executable) of the OA-Bug node, for ``--processes``.
+OABUG_EXECUTABLE = ('oabug_robot', 'oabug')
 VARIANTS = ('random', 'minimum', 'sound', 'gas', 'gas_sound')
 ACTION_LENGTH_M = 0.1
 DEFAULT_ACTIONS = 1000
@@ -290,7 +295,7 @@ def build_mission(
         }
         params.update(PROFILES[config.profile])
         params.update(config.robot_parameters)
-        robots.append(RobotNodeSpec(factory, params))
+        robots.append(RobotNodeSpec(factory, params, executable=OABUG_EXECUTABLE))
     recording = None
     if config.record is not None:
         topics = list(DEFAULT_RECORD_TOPICS)
@@ -475,6 +480,12 @@ def _main(argv: list[str]) -> int:
     )
     require_backend(args.physics)
     check_runtime(args.runtime)
+    runner = process_runner(args) or run_mission
+    if args.dry_run:
+        spec, _ = build_mission(config, max_robots=MAX_ROBOTS)
+        with contextlib.suppress(DryRunDone):
+            runner(spec)
+        return EXIT_SUCCESS
     check_run_outputs(config.record, config.out_dir)
     spec, bias = build_mission(config, max_robots=MAX_ROBOTS)
     for warning in spec.site.warnings:
@@ -497,7 +508,7 @@ def _main(argv: list[str]) -> int:
         lines=not args.quiet,
     )
     with bar:
-        mission = run_mission(spec, progress=bar)
+        mission = runner(spec, progress=bar)
     result = OABugRun(settings=config, mission=mission, heading_bias_rad=bias)
     print(format_summary(result), flush=True)
     if mission.bag_path is not None:

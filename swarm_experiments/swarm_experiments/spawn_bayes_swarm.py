@@ -1,6 +1,6 @@
 """Bayes-Swarm spawner: N robots seek the strongest source of a signal field.
 
-Plain script, no launch file (``ros2 run swarm_experiments spawn_bayes_swarm`` or
+Plain script (``ros2 run swarm_experiments spawn_bayes_swarm`` or
 ``python -m swarm_experiments.spawn_bayes_swarm``). It builds an obstacle-free arena for the chosen
 case (the paper's Cases 1-3 or the avalanche field), starts the sim bridge with the signal
 extension and one ``bayes_swarm`` node per robot on sim time, relays peer messages within
@@ -23,16 +23,18 @@ outcome so far is printed and the bag closed).
 from __future__ import annotations
 
 import argparse
+import contextlib
 import dataclasses
 import math
 import sys
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 from bayes_swarm.profiles import PROFILES, profile_options
+from sim_bridge.mission_file import signal_entry
 from sim_bridge.signal_extension import SignalExtension
 from swarm_common.cli import (
     EXIT_INTERRUPTED,
@@ -63,6 +65,7 @@ from swarm_experiments.cli_args import (
 from swarm_experiments.errors import ExperimentError
 from swarm_experiments.mission import (
     VIEWER_TOPICS,
+    MissionResult,
     MissionSpec,
     RecordingSpec,
     RobotNodeSpec,
@@ -71,6 +74,7 @@ from swarm_experiments.mission import (
 )
 from swarm_experiments.node_overrides import parse_overrides
 from swarm_experiments.open_field import point_robot_engine_config
+from swarm_experiments.processes import DryRunDone, process_runner
 from swarm_experiments.progress import MissionProgressBar, progress_wanted
 from swarm_experiments.runtime_option import (
     add_runtime_arguments,
@@ -110,6 +114,8 @@ GLOWWORM_RATE_HZ = 100.0
 #: Largest swarm the spawner runs: every robot is a node in this one process. The papers'
 #: largest swarm is 100 (Case 3); bayes_batch runs larger ones without nodes.
 MAX_ROBOTS = 100
+#: (package, executable) of the Bayes-Swarm node, for ``--processes``.
+BAYES_SWARM_EXECUTABLE = ('bayes_swarm', 'bayes_swarm_node')
 
 
 @dataclass(frozen=True)
@@ -175,7 +181,7 @@ class BayesSwarmRun:
     def finder_decision_times_s(self) -> np.ndarray:
         """Decision times of the finder (all robots if none found) [s]."""
         if self.finder:
-            return np.array(self.decision_times_s[self.finder])
+            return np.array(self.decision_times_s.get(self.finder, []))
         return np.array([t for ts in self.decision_times_s.values() for t in ts])
 
 
@@ -354,8 +360,18 @@ def check_settings(settings: SpawnSettings) -> SignalCase:
     return _check(settings)
 
 
-def run(settings: SpawnSettings, progress: Any = None) -> BayesSwarmRun:
-    """Run one mission; raises a SwarmError on bad settings or a failed run."""
+def run(
+    settings: SpawnSettings,
+    progress: Any = None,
+    *,
+    runner: Callable[..., MissionResult] = run_mission,
+) -> BayesSwarmRun:
+    """Run one mission; raises a SwarmError on bad settings or a failed run.
+
+    ``runner`` runs the mission spec: :func:`~swarm_experiments.mission.run_mission` (in
+    process) or a :mod:`swarm_experiments.processes` runner (one process per node; the
+    decision times, which need the nodes, are then empty).
+    """
     from bayes_swarm.node import BayesSwarmNode
 
     case = _check(settings)
@@ -395,7 +411,12 @@ def run(settings: SpawnSettings, progress: Any = None) -> BayesSwarmRun:
     spec = MissionSpec(
         site=_arena_site(case),
         initial_poses=poses,
-        robots=[RobotNodeSpec(factory, node_parameters(case, settings, n, i)) for i in range(n)],
+        robots=[
+            RobotNodeSpec(
+                factory, node_parameters(case, settings, n, i), executable=BAYES_SWARM_EXECUTABLE
+            )
+            for i in range(n)
+        ],
         max_sim_time_s=case.max_mission_time_s + 2.0,
         engine_config=dataclasses.replace(
             _engine_config(case, settings.seed, settings.physics), faults=settings.faults
@@ -403,23 +424,37 @@ def run(settings: SpawnSettings, progress: Any = None) -> BayesSwarmRun:
         bridge_parameters=bridge_parameters,
         time_scale=settings.time_scale,
         extensions=[SignalExtension(model)],
+        extension_entries=[
+            signal_entry(
+                case,
+                noise_std=settings.noise_std,
+                relative_noise=settings.relative_noise,
+                seed=settings.seed,
+            )
+        ],
         stop_when_all_rooms_covered=False,
         recording=recording,
         progress_period_s=max(1.0, case.max_mission_time_s / 20.0),
     )
-    mission = run_mission(spec, progress=progress)
+    mission = runner(spec, progress=progress)
     names = tuple(f'r{i}' for i in range(n))
     times = {
         name: [d.compute_time_s for d in node.decisions]
-        for name, node in zip(names, nodes, strict=True)
+        for name, node in zip(names, nodes, strict=False)
     }
+    found, found_time_s, finder, tau = model.found, model.found_time_s, model.finder, model.tau()
+    for outcome in mission.extension_outcomes:  # the bridge ran in a process of its own
+        if outcome.get('kind') == 'signal':
+            found, finder = bool(outcome['found']), int(outcome['finder'])
+            found_time_s = _float(outcome['found_time_s'])
+            tau = _float(outcome['tau'])
     result = BayesSwarmRun(
         case=case,
         settings=settings,
-        found=model.found,
-        found_time_s=model.found_time_s,
-        finder=names[model.finder] if model.found else '',
-        tau=model.tau(),
+        found=found,
+        found_time_s=found_time_s,
+        finder=names[finder] if found else '',
+        tau=tau,
         decision_times_s=times,
         robot_nodes=nodes,
         mission=mission,
@@ -428,6 +463,10 @@ def run(settings: SpawnSettings, progress: Any = None) -> BayesSwarmRun:
     if settings.out_dir is not None:
         result.plots = write_plots(result, Path(settings.out_dir))
     return result
+
+
+def _float(value: float | None) -> float:
+    return math.nan if value is None else float(value)
 
 
 def _save(fig: Any, path: Path) -> None:
@@ -474,7 +513,8 @@ def write_plots(result: BayesSwarmRun, out_dir: Path) -> list[Path]:
     paths.append(path)
 
     index = int(result.finder[1:]) if result.finder else 0
-    node = result.robot_nodes[index]
+    # With one process per node the nodes are not here: no GP plot.
+    node = result.robot_nodes[index] if index < len(result.robot_nodes) else None
     planner = getattr(node, 'planner', None)
     if planner is not None and planner.gp.n_samples:
         mean, _ = planner.gp.predict(grid)
@@ -561,6 +601,11 @@ def _main(argv: list[str]) -> int:
         time_scale=args.time_scale,
     )
     case = check_settings(settings)
+    runner = process_runner(args) or run_mission
+    if args.dry_run:
+        with contextlib.suppress(DryRunDone):
+            run(settings, runner=runner)
+        return EXIT_SUCCESS
     out_dir = None if args.no_plots else args.out
     check_run_outputs(settings.record, out_dir)
     bar = MissionProgressBar(
@@ -571,7 +616,7 @@ def _main(argv: list[str]) -> int:
         detail=lambda report: '',
     )
     with bar:
-        result = run(settings, progress=bar)
+        result = run(settings, progress=bar, runner=runner)
     mission = result.mission
     times = result.finder_decision_times_s()
     print(f'case {result.case.name}, {result.settings.algorithm}, seed {settings.seed}')

@@ -1,6 +1,6 @@
 """MSC + PF spawner: N robots search for and capture RSSI-emitting targets.
 
-Plain script, no launch file (``ros2 run swarm_experiments spawn_msc_pf`` or
+Plain script (``ros2 run swarm_experiments spawn_msc_pf`` or
 ``python -m swarm_experiments.spawn_msc_pf``). It builds the paper's scenario (Sec. IV-A): an
 obstacle-free 2000 m x 2000 m field, targets placed uniformly, robots starting uniformly in a
 30 m disc at the centre; starts the sim bridge with the RSSI-target extension and one
@@ -25,15 +25,17 @@ written. Exit codes: 0 every target captured, 1 not all by T_max, 2 bad options 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import dataclasses
 import math
 import sys
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+from sim_bridge.mission_file import rssi_entry
 from sim_bridge.rssi_extension import RssiExtension
 from swarm_common.cli import (
     EXIT_INTERRUPTED,
@@ -62,6 +64,7 @@ from swarm_experiments.errors import ExperimentError
 from swarm_experiments.mission import (
     VIEWER_TOPICS,
     MissionProgress,
+    MissionResult,
     MissionSpec,
     RecordingSpec,
     RobotNodeSpec,
@@ -71,6 +74,7 @@ from swarm_experiments.mission import (
 from swarm_experiments.msc_pf_batch import scenario_start
 from swarm_experiments.node_overrides import parse_overrides
 from swarm_experiments.open_field import point_robot_engine_config
+from swarm_experiments.processes import DryRunDone, process_runner
 from swarm_experiments.progress import MissionProgressBar, progress_wanted
 from swarm_experiments.runtime_option import (
     add_runtime_arguments,
@@ -84,6 +88,8 @@ SPAWNER_PARAMETERS = ('scheme', 'seed', 'robot_id', 'field_size_m', 'swarm.comm_
 
 SCHEMES = ('proposed', 'msc_pf', 'msc')
 PEER_TYPE = 'swarm_interfaces/msg/MscPeer'
+#: (package, executable) of the MSC + PF node, for ``--processes``.
+MSC_PF_EXECUTABLE = ('msc_pf', 'msc_pf_node')
 DEFAULT_RECORD_TOPICS = (
     '/clock',
     '/sim/poses',
@@ -261,8 +267,18 @@ def scenario(settings: SpawnSettings) -> tuple[RssiTargetField, np.ndarray]:
     )
 
 
-def run(settings: SpawnSettings, progress: Any = None) -> MscPfRun:
-    """Run one mission; raises a SwarmError on bad settings or a failed run."""
+def run(
+    settings: SpawnSettings,
+    progress: Any = None,
+    *,
+    runner: Callable[..., MissionResult] = run_mission,
+) -> MscPfRun:
+    """Run one mission; raises a SwarmError on bad settings or a failed run.
+
+    ``runner`` runs the mission spec: :func:`~swarm_experiments.mission.run_mission` (in
+    process) or a :mod:`swarm_experiments.processes` runner (one process per node; the
+    estimate log, which needs the nodes, is then empty).
+    """
     from msc_pf.node import MscPfNode
 
     check_settings(settings)
@@ -298,7 +314,10 @@ def run(settings: SpawnSettings, progress: Any = None) -> MscPfRun:
     spec = MissionSpec(
         site=site,
         initial_poses=poses,
-        robots=[RobotNodeSpec(factory, node_parameters(settings, i)) for i in range(len(poses))],
+        robots=[
+            RobotNodeSpec(factory, node_parameters(settings, i), executable=MSC_PF_EXECUTABLE)
+            for i in range(len(poses))
+        ],
         max_sim_time_s=settings.max_time_s,
         engine_config=dataclasses.replace(_engine_config(settings), faults=settings.faults),
         bridge_parameters={
@@ -308,15 +327,21 @@ def run(settings: SpawnSettings, progress: Any = None) -> MscPfRun:
         },
         time_scale=settings.time_scale,
         extensions=[extension],
+        extension_entries=[rssi_entry(targets, seed=settings.seed)],
         stop_when_all_rooms_covered=False,
         recording=recording,
         progress_period_s=10.0,
     )
-    mission = run_mission(spec, progress=on_progress)
+    mission = runner(spec, progress=on_progress)
     times = targets.capture_time_s.copy()
+    for outcome in mission.extension_outcomes:  # the bridge ran in a process of its own
+        if outcome.get('kind') == 'rssi':
+            times = np.array(
+                [math.nan if t is None else float(t) for t in outcome['capture_times_s']]
+            )
     result = MscPfRun(
         settings=settings,
-        cct_s=float(np.max(times)) if targets.all_captured else math.nan,
+        cct_s=float(np.max(times)) if np.all(np.isfinite(times)) else math.nan,
         capture_times_s=times,
         target_positions_m=targets.positions_m.copy(),
         estimate_log=np.array(log, dtype=float).reshape(-1, 7),
@@ -466,6 +491,11 @@ def _main(argv: list[str]) -> int:
         time_scale=args.time_scale,
     )
     check_settings(settings)
+    runner = process_runner(args) or run_mission
+    if args.dry_run:
+        with contextlib.suppress(DryRunDone):
+            run(settings, runner=runner)
+        return EXIT_SUCCESS
     out_dir = None if args.no_plots else args.out
     check_run_outputs(settings.record, out_dir)
     bar = MissionProgressBar(
@@ -476,7 +506,7 @@ def _main(argv: list[str]) -> int:
         detail=lambda report: '',
     )
     with bar:
-        result = run(settings, progress=bar)
+        result = run(settings, progress=bar, runner=runner)
     mission = result.mission
     interrupted = mission.stop_reason == StopReason.INTERRUPTED
     print(

@@ -64,9 +64,11 @@ __all__ = [
     'Supervisor',
     'build_plan',
     'driver_parameters',
+    'launch_nodes',
     'load_params_file',
     'main',
     'node_parameters',
+    'plan_parameters',
     'preflight',
     'run',
 ]
@@ -204,23 +206,17 @@ def _command(
     return (*head, *args)
 
 
-def build_plan(options: BringupOptions) -> list[ChildSpec]:
-    """The processes to start, in order."""
+def plan_parameters(options: BringupOptions) -> list[tuple[str, dict[str, Any]]]:
+    """(executable, ``-p`` parameters) of each node the bringup starts, in start order: the
+    pump first (its line is held off), then the static frames, the sensors and the OA-Bug
+    node. :func:`build_plan` and the launch file ``robot.launch.py`` are built from it."""
     params = driver_parameters(options.robot, own_tag_id=options.own_tag_id, fake=options.fake)
     if options.gas_backend:
         params['gas_adc_node']['backend'] = options.gas_backend
     for name, extra in options.extra.items():
         params.setdefault(name, {}).update(extra)
-    # The pump first (its line is held off), then the static frames, then the sensors.
     order = (DRIVERS[0], 'static_frames_node', *DRIVERS[1:])
-    plan = [
-        ChildSpec(name, _command(name, options.robot, params[name], options), settle_s=0.5)
-        for name in order
-    ]
-    if options.locator_command:
-        # The authors' locator exits whenever its TCP connection ends: respawn it alone.
-        command = tuple(shlex.split(options.locator_command))
-        plan.append(ChildSpec('aoa_locator', command, settle_s=0.5, respawn=True))
+    plan = [(name, params[name]) for name in order]
     if options.with_oabug:
         oabug_params = {
             'variant': options.variant,
@@ -229,7 +225,41 @@ def build_plan(options: BringupOptions) -> list[ChildSpec]:
             'own_tag_id': options.own_tag_id,
             **params.get('oabug', {}),
         }
-        plan.append(ChildSpec('oabug', _command('oabug', options.robot, oabug_params, options)))
+        plan.append(('oabug', oabug_params))
+    return plan
+
+
+def launch_nodes(options: BringupOptions) -> list[dict[str, Any]]:
+    """The nodes of :func:`plan_parameters` as launch ``Node`` arguments (package,
+    executable, namespace, parameters: the parameter file first, then the values)."""
+    files: list[Any] = [options.params_file] if options.params_file else []
+    return [
+        {
+            'package': EXECUTABLES[name][0],
+            'executable': name,
+            'namespace': options.robot,
+            'parameters': [*files, dict(params)],
+        }
+        for name, params in plan_parameters(options)
+    ]
+
+
+def build_plan(options: BringupOptions) -> list[ChildSpec]:
+    """The processes to start, in order."""
+    plan: list[ChildSpec] = []
+    for name, params in plan_parameters(options):
+        command = _command(name, options.robot, params, options)
+        if name == 'oabug':
+            if options.locator_command:
+                # The authors' locator exits whenever its TCP connection ends: respawn it alone.
+                locator = tuple(shlex.split(options.locator_command))
+                plan.append(ChildSpec('aoa_locator', locator, settle_s=0.5, respawn=True))
+            plan.append(ChildSpec(name, command))
+        else:
+            plan.append(ChildSpec(name, command, settle_s=0.5))
+    if options.locator_command and not options.with_oabug:
+        locator = tuple(shlex.split(options.locator_command))
+        plan.append(ChildSpec('aoa_locator', locator, settle_s=0.5, respawn=True))
     return plan
 
 
