@@ -29,9 +29,10 @@ test-builtin: bootstrap
 	SWARM_RUNTIME=builtin $(PY) -m pytest -n 2 -q $(PYTEST_ARGS)
 
 # Test folders that never touch ROS (the layer test keeps them ROS-free): the real-rclpy leg
-# leaves them out, since they would only repeat the built-in leg.
+# leaves them out, since they would only repeat the built-in leg. --ignore-glob, because
+# pytest's --ignore does not drop a folder that is itself one of the testpaths.
 ROS_FREE_TESTS := swarm_common/test swarm_sim/test swarm_experiments/test/study
-RCLPY_IGNORE := $(foreach d,$(ROS_FREE_TESTS),--ignore=$(d))
+RCLPY_IGNORE := $(foreach d,$(ROS_FREE_TESTS),--ignore-glob='$(d)/*')
 
 test-rclpy: bootstrap
 	@if $(PY) -c 'import rclpy' 2>/dev/null; then \

@@ -18,6 +18,7 @@ from swarm_sim.physics import PHYSICS_BACKENDS, RenderConfig
 from swarm_sim.sensor_profiles import SENSOR_PROFILES, RealisticSensors, apply_sensor_profile
 
 from swarm_experiments.errors import ExperimentError
+from swarm_experiments.mission import RECORD_TOPIC_SETS
 from swarm_experiments.node_overrides import parse_overrides
 
 __all__ = [
@@ -111,13 +112,22 @@ def render_config(values: Sequence[str] | None) -> RenderConfig:
 
 
 def add_run_options(parser: argparse.ArgumentParser, *, out_default: Path, plots: str) -> None:
-    """``--record``, ``--out``, ``--no-plots`` and ``--quiet``, the same in every spawner."""
+    """``--record``, ``--record-topics``, ``--out``, ``--no-plots`` and ``--quiet``, the same
+    in every spawner."""
     parser.add_argument(
         '--record',
         type=Path,
         default=None,
         help='write a rosbag2 (MCAP) bag to this new directory; it appears under this name '
         'when the recording is complete',
+    )
+    parser.add_argument(
+        '--record-topics',
+        choices=RECORD_TOPIC_SETS,
+        default='sensors',
+        help="what --record writes: 'sensors' the mission's topics and every topic the robots' "
+        "nodes read (a bag BagPlayer can replay into a node), 'mission' the mission's topics "
+        "only (smaller, for big studies), 'all' every topic of the graph (docs/bags.md)",
     )
     parser.add_argument('--out', type=Path, default=out_default, help=f'directory for {plots}')
     parser.add_argument('--no-plots', action='store_true', help='do not write plots')

@@ -51,6 +51,7 @@ from swarm_sim.ground_truth import RoomEntry
 from swarm_experiments.errors import MissionError
 
 __all__ = [
+    'RECORD_TOPIC_SETS',
     'VIEWER_TOPICS',
     'MissionProgress',
     'MissionResult',
@@ -58,6 +59,7 @@ __all__ = [
     'RecordingSpec',
     'RobotNodeSpec',
     'StopReason',
+    'recorded_topics',
     'run_mission',
 ]
 
@@ -66,6 +68,33 @@ NodeFactory = Callable[..., Any]
 #: What Foxglove and RViz need to show a recorded run: the transform tree and the site's
 #: markers (sim_bridge.visualization). Every spawner records them by default.
 VIEWER_TOPICS = ('/tf', '/tf_static', '/sim/markers/*')
+
+#: What a spawner's ``--record`` writes (``--record-topics``): 'sensors' (the default) the
+#: mission's topics plus every topic the robots' nodes subscribe to, so ``BagPlayer`` can feed
+#: the recording back into a node; 'mission' only the mission's topics (ground truth, the
+#: robots' states and commands, the viewer topics), for big studies; 'all' every topic the
+#: graph shows (``/rosout`` and ``/parameter_events`` excepted, see docs/bags.md).
+RECORD_TOPIC_SETS = ('sensors', 'mission', 'all')
+
+
+def recorded_topics(
+    which: str, *, mission: Sequence[str], sensors: Sequence[str]
+) -> tuple[str, ...] | None:
+    """The topics (names or patterns) of the record set ``which`` (one of
+    :data:`RECORD_TOPIC_SETS`); None for 'all' (the recorder then takes every topic).
+
+    Raises:
+        ConfigurationError: ``which`` is not a record set.
+    """
+    if which == 'mission':
+        return tuple(mission)
+    if which == 'sensors':
+        return (*mission, *(t for t in sensors if t not in mission))
+    if which == 'all':
+        return None
+    msg = f'unknown record topic set {which!r}; choose one of {", ".join(RECORD_TOPIC_SETS)}'
+    raise ConfigurationError(msg)
+
 
 # Callbacks run per node after the stop, to deliver the messages of the last step.
 _DRAIN_CALLBACKS_PER_NODE = 20

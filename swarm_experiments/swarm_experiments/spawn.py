@@ -67,6 +67,7 @@ from swarm_experiments.mission import (
     RecordingSpec,
     RobotNodeSpec,
     StopReason,
+    recorded_topics,
     run_mission,
 )
 from swarm_experiments.node_overrides import parse_overrides
@@ -78,6 +79,7 @@ __all__ = [
     'ACTION_LENGTH_M',
     'DEFAULT_RECORD_TOPICS',
     'MAX_ROBOTS',
+    'SENSOR_TOPICS',
     'VARIANTS',
     'OABugRun',
     'SpawnSettings',
@@ -97,6 +99,9 @@ DEFAULT_ACTIONS = 1000
 #: reports 2 to 10 robots; oabug_batch runs larger swarms without nodes).
 MAX_ROBOTS = 100
 DEFAULT_RECORD_TOPICS = ('/clock', '/sim/poses', '/sim/coverage', '/sim/site', *VIEWER_TOPICS)
+#: The topics an OA-Bug node subscribes to (oabug_robot.node), per robot: what
+#: ``--record-topics sensors`` adds so that a bag replays into a node.
+SENSOR_TOPICS = ('scan', 'imu', 'gas', 'bearings')
 # OA-Bug node parameters the spawner sets from its own options (see build_mission).
 SPAWNER_PARAMETERS = (
     'variant',
@@ -128,8 +133,9 @@ class SpawnSettings:
         speed_mps: the robots' cruise speed [m/s].
         record: bag directory to write, or None.
         record_robot_topics: also record each robot's state, cmd_vel and pump topics.
-        record_scans: also record each robot's lidar scans (``/r<i>/scan``, about 8 kB/s
-            per robot; off by default, the viewers' scan displays show them when present).
+        record_topics: what the bag holds (:data:`~swarm_experiments.mission.RECORD_TOPIC_SETS`):
+            'sensors' adds every robot's :data:`SENSOR_TOPICS` (the lidar scans are about
+            8 kB/s per robot), 'mission' leaves them out, 'all' records every topic.
         out_dir: directory for the PNGs, or None for no plots.
         profile: the OA-Bug parameter profile (``oabug_robot.profiles``): 'tuned' (the
             node's defaults) or 'paper' (Table I read literally).
@@ -148,7 +154,7 @@ class SpawnSettings:
     speed_mps: float = 0.3
     record: Path | None = None
     record_robot_topics: bool = True
-    record_scans: bool = False
+    record_topics: str = 'sensors'
     out_dir: Path | None = None
     profile: str = 'tuned'
     robot_parameters: dict[str, object] = field(default_factory=dict)
@@ -302,9 +308,11 @@ def build_mission(
         if config.record_robot_topics:
             for i in range(config.robots):
                 topics += [f'/r{i}/state', f'/r{i}/cmd_vel', f'/r{i}/pump']
-        if config.record_scans:
-            topics += [f'/r{i}/scan' for i in range(config.robots)]
-        recording = RecordingSpec(Path(config.record), tuple(topics))
+        sensors = [f'/r{i}/{name}' for i in range(config.robots) for name in SENSOR_TOPICS]
+        recording = RecordingSpec(
+            Path(config.record),
+            recorded_topics(config.record_topics, mission=topics, sensors=sensors),
+        )
     engine = dataclasses.replace(config.engine, seed=int(config.seed))
     spec = MissionSpec(
         site=site,
@@ -434,9 +442,6 @@ def _parser() -> argparse.ArgumentParser:
     parser.add_argument('--speed', type=float, default=0.3, help='robot cruise speed [m/s]')
     add_run_options(parser, out_default=Path('oabug_results'), plots='the PNGs')
     parser.add_argument(
-        '--record-scans', action='store_true', help="also record the robots' lidar scans"
-    )
-    parser.add_argument(
         '--param',
         action='append',
         default=[],
@@ -471,7 +476,7 @@ def _main(argv: list[str]) -> int:
         actions=args.actions,
         speed_mps=args.speed,
         record=args.record,
-        record_scans=args.record_scans,
+        record_topics=args.record_topics,
         out_dir=None if args.no_plots else args.out,
         time_scale=args.time_scale,
         engine=engine_options(

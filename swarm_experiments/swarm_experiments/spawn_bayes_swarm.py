@@ -70,6 +70,7 @@ from swarm_experiments.mission import (
     RecordingSpec,
     RobotNodeSpec,
     StopReason,
+    recorded_topics,
     run_mission,
 )
 from swarm_experiments.node_overrides import parse_overrides
@@ -107,9 +108,13 @@ DEFAULT_RECORD_TOPICS = (
     '/sim/poses',
     '/sim/source_search',
     '/r*/state',
+    '/r*/cmd_vel',
     '/r*/peers/out',
     *VIEWER_TOPICS,
 )
+#: The topics the robots' nodes subscribe to (bayes_swarm.node): what ``--record-topics sensors``
+#: adds so that a bag replays into a node.
+SENSOR_TOPICS = ('/r*/odom', '/r*/signal', '/r*/peers/in')
 GLOWWORM_RATE_HZ = 100.0
 #: Largest swarm the spawner runs: every robot is a node in this one process. The papers'
 #: largest swarm is 100 (Case 3); bayes_batch runs larger ones without nodes.
@@ -136,6 +141,9 @@ class SpawnSettings:
         profile: Bayes-Swarm settings profile (:data:`bayes_swarm.profiles.PROFILES`:
             'paper', the as-published solvers, or 'grid', the project's).
         record: bag directory to write, or None.
+        record_topics: what the bag holds
+            (:data:`~swarm_experiments.mission.RECORD_TOPIC_SETS`): 'sensors' adds the
+            :data:`SENSOR_TOPICS`, 'mission' leaves them out, 'all' records every topic.
         out_dir: where the PNGs go (None: no plots).
         faults: faults injected on purpose (robot dropouts and link faults act through
             the bridge: a dropped robot stops and its peer messages are lost).
@@ -156,6 +164,7 @@ class SpawnSettings:
     max_mission_time_s: float | None = None
     profile: str = 'paper'
     record: Path | None = None
+    record_topics: str = 'sensors'
     out_dir: Path | None = None
     extra_parameters: dict[str, Any] = field(default_factory=dict)
     physics: str = 'numpy'
@@ -407,7 +416,12 @@ def run(
         bridge_parameters['peer_loss_probability'] = float(settings.loss_probability)
     recording = None
     if settings.record is not None:
-        recording = RecordingSpec(Path(settings.record), DEFAULT_RECORD_TOPICS)
+        recording = RecordingSpec(
+            Path(settings.record),
+            recorded_topics(
+                settings.record_topics, mission=DEFAULT_RECORD_TOPICS, sensors=SENSOR_TOPICS
+            ),
+        )
     spec = MissionSpec(
         site=_arena_site(case),
         initial_poses=poses,
@@ -597,6 +611,7 @@ def _main(argv: list[str]) -> int:
         max_mission_time_s=args.t_max,
         profile=args.profile,
         record=args.record,
+        record_topics=args.record_topics,
         physics=args.physics,
         time_scale=args.time_scale,
     )

@@ -69,6 +69,7 @@ from swarm_experiments.mission import (
     RecordingSpec,
     RobotNodeSpec,
     StopReason,
+    recorded_topics,
     run_mission,
 )
 from swarm_experiments.msc_pf_batch import scenario_start
@@ -95,9 +96,13 @@ DEFAULT_RECORD_TOPICS = (
     '/sim/poses',
     '/sim/targets',
     '/r*/state',
+    '/r*/cmd_vel',
     '/r*/peers/out',
     *VIEWER_TOPICS,
 )
+#: The topics the robots' nodes subscribe to (msc_pf.node): what ``--record-topics sensors``
+#: adds so that a bag replays into a node.
+SENSOR_TOPICS = ('/r*/odom', '/r*/rssi', '/r*/captured', '/r*/peers/in')
 #: Largest swarm the spawner runs: every robot is a node in this one process (the paper's
 #: sweep goes to 30; msc_pf_batch runs larger swarms without nodes).
 MAX_ROBOTS = 100
@@ -120,6 +125,9 @@ class SpawnSettings:
         physics_rate_hz: simulation step rate [Hz].
         target_positions_m: (targets, 2) fixed target positions, or None.
         record: bag directory to write, or None.
+        record_topics: what the bag holds
+            (:data:`~swarm_experiments.mission.RECORD_TOPIC_SETS`): 'sensors' adds the
+            :data:`SENSOR_TOPICS`, 'mission' leaves them out, 'all' records every topic.
         out_dir: where the PNGs go (None: no plots).
         faults: faults injected on purpose (robot dropouts and link faults act through
             the bridge: a dropped robot stops and its peer messages are lost).
@@ -140,6 +148,7 @@ class SpawnSettings:
     physics_rate_hz: float = 10.0
     target_positions_m: np.ndarray | None = None
     record: Path | None = None
+    record_topics: str = 'sensors'
     out_dir: Path | None = None
     extra_parameters: dict[str, Any] = field(default_factory=dict)
     physics: str = 'numpy'
@@ -305,7 +314,12 @@ def run(
 
     recording = None
     if settings.record is not None:
-        recording = RecordingSpec(Path(settings.record), DEFAULT_RECORD_TOPICS)
+        recording = RecordingSpec(
+            Path(settings.record),
+            recorded_topics(
+                settings.record_topics, mission=DEFAULT_RECORD_TOPICS, sensors=SENSOR_TOPICS
+            ),
+        )
     site = SiteGeometry(
         walls=np.zeros((0, 2, 2)),
         room_rects=(np.array([[0.0, 0.0, settings.field_size_m, settings.field_size_m]]),),
@@ -487,6 +501,7 @@ def _main(argv: list[str]) -> int:
         max_time_s=args.t_max,
         target_positions_m=args.target_positions,
         record=args.record,
+        record_topics=args.record_topics,
         physics=args.physics,
         time_scale=args.time_scale,
     )

@@ -5,6 +5,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from swarm_common.errors import UsageError
 from swarm_experiments.cli_args import (
     add_physics_option,
     add_render_option,
@@ -42,3 +43,39 @@ def test_physics_and_render_options_build_the_engine_settings() -> None:
 def test_malformed_render_options_are_rejected(values: list[str]) -> None:
     with pytest.raises(ConfigurationError, match="--render takes 'gui' or 'frames DIR'"):
         render_config(values)
+
+
+@pytest.mark.parametrize(
+    ('module', 'settings'),
+    [
+        ('swarm_experiments.spawn', {'site': 'small', 'robots': 2}),
+        ('swarm_experiments.spawn_bayes_swarm', {}),
+        ('swarm_experiments.spawn_msc_pf', {}),
+    ],
+)
+def test_every_spawner_takes_record_topics_and_defaults_to_sensors(module, settings) -> None:
+    import importlib
+
+    spawner = importlib.import_module(module)
+    parser = spawner._parser() if hasattr(spawner, '_parser') else spawner.build_parser()
+    assert parser.parse_args([]).record_topics == 'sensors'
+    assert parser.parse_args(['--record-topics', 'mission']).record_topics == 'mission'
+    with pytest.raises(UsageError, match="--record-topics: invalid choice: 'scans'"):
+        parser.parse_args(['--record-topics', 'scans'])
+    assert spawner.SpawnSettings(**settings).record_topics == 'sensors'
+
+
+def test_record_sets_add_the_sensor_topics_or_leave_them_out() -> None:
+    from swarm_experiments.mission import RECORD_TOPIC_SETS, recorded_topics
+
+    mission, sensors = ('/clock', '/r*/state'), ('/r*/odom', '/clock')
+    assert recorded_topics('mission', mission=mission, sensors=sensors) == mission
+    assert recorded_topics('sensors', mission=mission, sensors=sensors) == (
+        '/clock',
+        '/r*/state',
+        '/r*/odom',
+    )
+    assert recorded_topics('all', mission=mission, sensors=sensors) is None
+    assert set(RECORD_TOPIC_SETS) == {'sensors', 'mission', 'all'}
+    with pytest.raises(ConfigurationError, match='unknown record topic set'):
+        recorded_topics('scans', mission=mission, sensors=sensors)

@@ -54,9 +54,16 @@ def test_case_2_decisions_follow_the_samples_and_never_the_true_source():
         assert np.hypot(*(shifted[1].expected_source_m - expected)) > 0.1
 
 
+@pytest.fixture(scope='module')
+def case1_run(tmp_path_factory):
+    """One recorded Case 1 mission with plots (seed 2), shared by the tests below."""
+    root = tmp_path_factory.mktemp('case1')
+    return run(SpawnSettings(case='case1', seed=2, out_dir=root / 'plots', record=root / 'bag'))
+
+
 @pytest.mark.slow
-def test_case_1_spawn_finds_the_source(tmp_path):
-    result = run(SpawnSettings(case='case1', seed=2, out_dir=tmp_path))
+def test_case_1_spawn_finds_the_source(case1_run):
+    result = case1_run
     assert result.found
     assert result.found_time_s < result.case.max_mission_time_s
     assert result.tau < 1.0
@@ -68,19 +75,18 @@ def test_case_1_spawn_finds_the_source(tmp_path):
 
 @pytest.mark.slow
 @pytest.mark.skipif(not _recorder_available(), reason='swarm_runtime.bag has no recorder node yet')
-def test_a_recorded_case_1_bag_gives_the_same_tau(tmp_path):
-    result = run(SpawnSettings(case='case1', seed=2, record=tmp_path / 'bag'))
+def test_a_recorded_case_1_bag_gives_the_same_tau(case1_run):
+    result = case1_run
+    bag = result.settings.record
     assert result.found
-    from_bag = tau_from_bag(tmp_path / 'bag')
+    from_bag = tau_from_bag(bag)
     assert from_bag.found
     assert from_bag.reported_tau == pytest.approx(result.tau)
     # /sim/poses is sampled at 2 Hz: the recomputed detection may lag by one sample.
     assert from_bag.found_time_s == pytest.approx(result.found_time_s, abs=0.5)
     assert from_bag.tau == pytest.approx(result.tau, abs=0.5 * 0.1 / math.sqrt(5.0))
     # The viewer topics: the source turns green when found; /tf at 10 Hz of 20 Hz odometry.
-    targets = [
-        item.message for item in read_messages(tmp_path / 'bag', topics=['/sim/markers/targets'])
-    ]
+    targets = [item.message for item in read_messages(bag, topics=['/sim/markers/targets'])]
     assert len(targets) == 2
     first, last = (next(m for m in a.markers if m.ns == 'targets') for a in targets)
     source = get_case('case1').source_m
@@ -89,7 +95,7 @@ def test_a_recorded_case_1_bag_gives_the_same_tau(tmp_path):
     assert last.color.g > last.color.r
     stamps = [
         stamp_to_seconds(item.message.transforms[0].header.stamp)
-        for item in read_messages(tmp_path / 'bag', topics=['/tf'])
+        for item in read_messages(bag, topics=['/tf'])
     ]
     assert np.diff(stamps) == pytest.approx(0.1, abs=1e-6)
 

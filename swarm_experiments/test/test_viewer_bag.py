@@ -45,7 +45,11 @@ MAX_GROWTH = 2.0
 
 
 def _settings(bag: Path, **extra) -> SpawnSettings:
-    return SpawnSettings(site='small', robots=ROBOTS, actions=200, seed=4, record=bag, **extra)
+    # The mission's topics only: the growth below is the viewer topics' against those.
+    return SpawnSettings(
+        site='small', robots=ROBOTS, actions=200, seed=4, record=bag, record_topics='mission',
+        **extra,
+    )  # fmt: skip
 
 
 @pytest.fixture(scope='module')
@@ -184,7 +188,7 @@ def test_the_foxglove_layout_shows_what_the_spawner_records_in_the_map_frame() -
     assert panel['followTf'] == 'map'
     topics = panel['topics']
     assert set(MARKER_TOPICS) <= {t for t, s in topics.items() if s['visible']}
-    recorded = _spawner_topics(record_scans=True)
+    recorded = _spawner_topics()
     assert [t for t in topics if not _recorded(t, recorded)] == []
 
 
@@ -201,12 +205,13 @@ def test_the_rviz_config_shows_what_the_spawner_records_in_the_map_frame() -> No
     by_topic = {d['Topic']['Value']: d for d in displays if 'Topic' in d}
     assert set(MARKER_TOPICS) <= set(by_topic)
     assert {f'/r{i}/scan' for i in range(10)} <= set(by_topic)
-    with_scans = _spawner_topics(record_scans=True)
     default = _spawner_topics()
-    assert [t for t in by_topic if not _recorded(t, with_scans)] == []
-    # What is on when the config opens is recorded by default; scans are one tick away.
+    mission_only = _spawner_topics(record_topics='mission')
+    assert [t for t in by_topic if not _recorded(t, default)] == []
+    # What is on when the config opens is in every bag, also a mission-only one; the scans
+    # (recorded by default, not with --record-topics mission) are one tick away.
     enabled = [t for t, d in by_topic.items() if d['Enabled']]
-    assert [t for t in enabled if not _recorded(t, default)] == []
+    assert [t for t in enabled if not _recorded(t, mission_only)] == []
     assert all(not by_topic[f'/r{i}/scan']['Enabled'] for i in range(10))
 
 
@@ -229,6 +234,8 @@ def test_the_viewers_fixed_frame_and_latched_topics_match_the_bag(bags) -> None:
         assert all(q.durability.name == 'TRANSIENT_LOCAL' for q in offered), topic
 
 
-def test_scans_are_recorded_on_request_only() -> None:
-    assert not any(fnmatch.fnmatchcase('/r0/scan', t) for t in _spawner_topics())
-    assert {f'/r{i}/scan' for i in range(10)} <= set(_spawner_topics(record_scans=True))
+def test_scans_are_recorded_by_default_and_left_out_of_mission_only_bags() -> None:
+    assert {f'/r{i}/scan' for i in range(10)} <= set(_spawner_topics())
+    mission_only = _spawner_topics(record_topics='mission')
+    assert not any(fnmatch.fnmatchcase('/r0/scan', t) for t in mission_only)
+    assert set(VIEWER_TOPICS) <= set(mission_only)

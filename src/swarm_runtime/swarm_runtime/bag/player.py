@@ -11,6 +11,13 @@ at ``start + (log_time - bag_start) / rate``. On real ROS that is real time; the
 runtime's executor jumps its virtual wall clock from one instant to the next, so a replay runs
 as fast as the callbacks allow and always the same way. :meth:`BagPlayer.step` publishes the
 next instant at once, for callers that drive the replay themselves.
+
+Within an instant, a recording shows which messages its node received only after it had acted:
+those recorded after the node's own output of that instant (a peer's message relayed after
+the node's decision). With ``outputs`` naming the node's output topics, the player holds those
+messages back and publishes them just before the next instant's ``/clock``, after the node's
+callbacks of the instant, so a deterministic node on the built-in runtime receives its inputs
+in the recorded order and acts exactly as it did.
 """
 
 from __future__ import annotations
@@ -82,6 +89,10 @@ class BagPlayer(Node):
         publish_clock: Publish ``/clock`` (rosgraph_msgs/Clock) with the bag's time.
         start_paused: Do not schedule playback; call :meth:`play` or :meth:`step`.
         allow_truncated: Replay a damaged bag as far as it can be read.
+        outputs: Topic names or patterns the nodes under test publish (recorded, never
+            replayed). At an instant where the bag holds one of them, the replayed messages
+            recorded after it are held back and published just before the next instant's
+            ``/clock`` (module docstring). None: every message goes out at its instant.
         node_name: Name of the player node.
         **node_kwargs: Passed to ``Node`` (namespace, context ...).
 
@@ -99,6 +110,7 @@ class BagPlayer(Node):
         publish_clock: bool = True,
         start_paused: bool = False,
         allow_truncated: bool = False,
+        outputs: Iterable[str] | None = None,
         node_name: str = 'bag_player',
         **node_kwargs: Any,
     ) -> None:
@@ -122,9 +134,12 @@ class BagPlayer(Node):
             if publisher is not None:
                 self._publishers_by_topic[topic] = publisher
         replayed = set(self._publishers_by_topic)
+        is_output = _selector(outputs) if outputs is not None else (lambda _topic: False)
+        self._anchors = {t for t in info.topics if t not in replayed and is_output(t)}
         self._messages: Iterator[BagMessage] = read_messages(
-            bag, sorted(replayed), allow_truncated=allow_truncated, raw=True
+            bag, sorted(replayed | self._anchors), allow_truncated=allow_truncated, raw=True
         )
+        self._held: list[BagMessage] = []
         self._clock_publisher = (
             self.create_publisher(
                 message_module('rosgraph_msgs').Clock, CLOCK_TOPIC, QoSProfile(depth=1)
@@ -144,7 +159,7 @@ class BagPlayer(Node):
     @property
     def finished(self) -> bool:
         """True once every message has been published."""
-        return self._pending is None
+        return self._pending is None and not self._held
 
     @property
     def published_count(self) -> int:
@@ -158,7 +173,11 @@ class BagPlayer(Node):
 
     def play(self) -> None:
         """Schedule playback on the player's clock from the next pending instant."""
-        if self._pending is None or self._timer is not None:
+        if self.finished or self._timer is not None:
+            return
+        if self._pending is None:
+            self._wall_start_ns = self.get_clock().now().nanoseconds
+            self._schedule()
             return
         now = self.get_clock().now().nanoseconds
         self._wall_start_ns = now - int(
@@ -173,10 +192,19 @@ class BagPlayer(Node):
             self._timer = None
 
     def step(self) -> int | None:
-        """Publish the next instant now; return its log time [ns], or None when finished."""
+        """Publish the next instant now; return its log time [ns], or None when finished.
+
+        Messages held back from the previous instant (``outputs``) go out first; after the
+        last instant, one more step publishes those of the last and returns its time.
+        """
+        for held in self._held:
+            self._publisher_for(held).publish(held.message)
+            self._published += 1
+        flushed = bool(self._held)
+        self._held = []
         pending = self._pending
         if pending is None:
-            return None
+            return self._last_clock_ns if flushed else None
         log_time = pending.log_time_ns
         if self._clock_publisher is not None and log_time > self._last_clock_ns:
             stamp = message_module('builtin_interfaces').Time(
@@ -184,9 +212,15 @@ class BagPlayer(Node):
             )
             self._clock_publisher.publish(message_module('rosgraph_msgs').Clock(clock=stamp))
         self._last_clock_ns = max(self._last_clock_ns, log_time)
+        after_output = False
         while pending is not None and pending.log_time_ns == log_time:
-            self._publisher_for(pending).publish(pending.message)
-            self._published += 1
+            if pending.topic in self._anchors:
+                after_output = True
+            elif after_output:
+                self._held.append(pending)
+            else:
+                self._publisher_for(pending).publish(pending.message)
+                self._published += 1
             pending = next(self._messages, None)
         self._pending = pending
         return log_time
@@ -222,11 +256,14 @@ class BagPlayer(Node):
         if self._timer is not None:
             self.destroy_timer(self._timer)
             self._timer = None
-        if self._pending is None or self._wall_start_ns is None:
+        if self.finished or self._wall_start_ns is None:
             return
-        due = self._wall_start_ns + int(
-            (self._pending.log_time_ns - self._bag_start_ns) / self._rate
-        )
+        if self._pending is None:  # only held-back messages of the last instant are left
+            due = self.get_clock().now().nanoseconds
+        else:
+            due = self._wall_start_ns + int(
+                (self._pending.log_time_ns - self._bag_start_ns) / self._rate
+            )
         delay_ns = max(due - self.get_clock().now().nanoseconds, 1)
         self._timer = self.create_timer(delay_ns / 1e9, self._on_timer)
 
