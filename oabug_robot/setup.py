@@ -34,6 +34,9 @@ setup(
     ),
     license='Apache-2.0',
     entry_points={
-        'console_scripts': ['oabug = oabug_robot.node:main'],
+        'console_scripts': [
+            'oabug = oabug_robot.node:main',
+            'sgba = oabug_robot.sgba.node:main',
+        ],
     },
 )
