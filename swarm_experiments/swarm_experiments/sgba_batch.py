@@ -124,6 +124,7 @@ def build_sgba_mission(settings: SgbaSettings) -> tuple[MissionSpec, float]:
     starts = place_starts(
         site, settings.departure, settings.robots, seed=settings.seed, body=settings.engine.body
     )
+    factory = _sgba_factory()
     robots = []
     for i in range(settings.robots):
         params: dict[str, object] = {
@@ -135,7 +136,7 @@ def build_sgba_mission(settings: SgbaSettings) -> tuple[MissionSpec, float]:
             'own_tag_id': f'R{i}',
         }
         params.update(settings.robot_parameters)
-        robots.append(RobotNodeSpec(_sgba_factory, params))
+        robots.append(RobotNodeSpec(factory, params))
     spec = MissionSpec(
         site=site,
         initial_poses=starts.poses,
