@@ -3,7 +3,8 @@
 Study ``sgba-vs-oabug``: the OA-Bug paper's Fig. 4 setting (Small sites at the Table II
 budget, 10 robots, centre and edge departure, coverage every 100 actions), with the method
 as an axis: OA-Bug's Gas+Sound and Gas in the as-published profile (``profile=paper``, the
-rows that lead), then SGBA (:mod:`oabug_robot.sgba`) with the authors' parameters. The seed
+rows that lead), then SGBA (:mod:`oabug_robot.sgba`) with the authors' parameters
+(``sgba``) and with its distances halved for the sites' doors (``sgba_scaled``). The seed
 is the site index, so every method runs on the same sites and starts and results pair by
 site. Fixed parameters: ``actions`` (None: the Table II budget), ``speed`` [m/s],
 ``profile`` (OA-Bug's), and ``sgba.<name>`` for every SGBA node parameter (None: its default).
@@ -27,7 +28,10 @@ __all__ = ['SGBA_VS_OABUG', 'run_comparison', 'studies']
 
 SGBA_VS_OABUG = 'sgba-vs-oabug'
 #: The methods in table order: OA-Bug as published first, then SGBA.
-METHODS = ('gas_sound', 'gas', 'sgba')
+METHODS = ('gas_sound', 'gas', 'sgba', 'sgba_scaled')
+#: SGBA parameters of each SGBA method (``sgba.<name>`` settings win): ``sgba`` keeps the
+#: authors' distances; ``sgba_scaled`` halves them for the sites' 0.53 m doors.
+SGBA_METHODS: dict[str, dict[str, Any]] = {'sgba': {}, 'sgba_scaled': {'geometry_scale': 0.5}}
 
 
 def _sgba_parameter_names() -> tuple[str, ...]:
@@ -40,7 +44,8 @@ def _sgba_parameter_names() -> tuple[str, ...]:
 
 def _sgba_overrides(config: Mapping[str, Any]) -> dict[str, Any]:
     given = config.get('sgba') or {}
-    return {name: value for name, value in given.items() if value is not None}
+    chosen = {name: value for name, value in given.items() if value is not None}
+    return {**SGBA_METHODS.get(str(config['method']), {}), **chosen}
 
 
 def _sgba_settings(config: Mapping[str, Any], seed: int) -> Any:
@@ -73,7 +78,7 @@ def check_config(config: Mapping[str, Any]) -> None:
     method = config['method']
     if method not in METHODS:
         raise UsageError(f'unknown method {method!r}; choose one of {", ".join(METHODS)}')
-    if method != 'sgba':
+    if method not in SGBA_METHODS:
         check_oabug({**config, 'variant': method})
         return
     unknown = sorted(set(config.get('sgba') or {}) - set(_sgba_parameter_names()))
@@ -96,7 +101,7 @@ def run_comparison(spec: RunSpec) -> dict[str, Any]:
     from swarm_experiments.spawn import ACTION_LENGTH_M
 
     config = spec.config
-    if config['method'] != 'sgba':
+    if config['method'] not in SGBA_METHODS:
         oabug = {k: v for k, v in config.items() if k not in ('method', 'sgba')}
         return run_fig4(
             RunSpec(spec.study, {**oabug, 'variant': config['method']}, spec.seed, spec.run_id)
@@ -180,7 +185,7 @@ def report_comparison(page: ReportPage) -> None:
     page.add_table(pd.DataFrame(records), title='Coverage % (mean ± std over sites)')
     frames = []
     for baseline in ('gas_sound', 'gas'):
-        subset = rows[rows['config.method'].isin((baseline, 'sgba'))]
+        subset = rows[rows['config.method'].isin((baseline, *SGBA_METHODS))]
         if subset['config.method'].nunique() < 2:
             continue
         table = paired_differences(
@@ -190,7 +195,7 @@ def report_comparison(page: ReportPage) -> None:
             baseline=baseline,
             group_by=('config.site', 'config.robots', 'config.departure'),
         )
-        table.insert(0, 'comparison', f'sgba - {baseline}')
+        table.insert(0, 'comparison', table['config.method'] + f' - {baseline}')
         frames.append(table.drop(columns=['config.method']))
     if frames:
         page.add_table(

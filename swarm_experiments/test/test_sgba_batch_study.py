@@ -6,7 +6,12 @@ import numpy as np
 import pytest
 from swarm_experiments.mission import run_mission
 from swarm_experiments.sgba_batch import SgbaSettings, build_sgba_mission, run_sgba_batch
-from swarm_experiments.sgba_study import SGBA_VS_OABUG, run_comparison, studies
+from swarm_experiments.sgba_study import (
+    SGBA_VS_OABUG,
+    _sgba_overrides,
+    run_comparison,
+    studies,
+)
 from swarm_experiments.study import make_specs
 from swarm_experiments.study.definition import load_registry
 from swarm_experiments.study.engines import make_engine
@@ -55,9 +60,14 @@ def test_the_study_is_registered_with_oabug_rows_first():
     study = load_registry().get(SGBA_VS_OABUG)
     plan = make_specs(study)
     assert study.axes['method'][0] == 'gas_sound'
-    assert study.axes['method'][-1] == 'sgba'
+    assert study.axes['method'][-2:] == ('sgba', 'sgba_scaled')
     assert plan.params['profile'] == 'paper'
-    assert len(plan.specs) == 2 * 3 * 1 * 2 * 20
+    assert len(plan.specs) == 2 * 4 * 1 * 2 * 20
+    scaled = next(s for s in plan.specs if s.config['method'] == 'sgba_scaled')
+    assert _sgba_overrides(scaled.config) == {'geometry_scale': 0.5}
+    chosen = make_specs(study, overrides={'sgba.geometry_scale': '0.7'}, smoke=True)
+    scaled = next(s for s in chosen.specs if s.config['method'] == 'sgba_scaled')
+    assert _sgba_overrides(scaled.config) == {'geometry_scale': 0.7}, 'a setting wins'
 
 
 @pytest.mark.parametrize(
@@ -81,14 +91,14 @@ def test_smoke_runs_both_methods_and_reports_the_paired_comparison(tmp_path):
     (study,) = studies()
     registry = load_registry(use_entry_points=False)
     registry.add(study)
-    plan = make_specs(study, overrides={'method': '[gas_sound, sgba]'}, smoke=True)
+    plan = make_specs(study, overrides={'method': '[gas_sound, sgba_scaled]'}, smoke=True)
     with make_engine('serial') as engine:
         summary = run_study(plan, tmp_path, engine)
     assert summary.complete
     (page,) = write_reports(tmp_path, registry)
     text = page.read_text()
     assert '## SGBA beside OA-Bug' in text
-    assert 'sgba - gas_sound' in text
+    assert 'sgba_scaled - gas_sound' in text
 
 
 def test_an_sgba_run_records_the_coverage_curve():

@@ -30,6 +30,7 @@ from oabug_robot.heading import preferred_direction
 from oabug_robot.sgba.settings import AUTHORS_HEADINGS_RAD, HeadingScheme, SgbaConfig
 
 __all__ = [
+    'Geometry',
     'Peer',
     'Ranges',
     'SgbaCommand',
@@ -159,9 +160,9 @@ def initial_heading(config: SgbaConfig) -> float:
 
 
 def rssi_from_distance(distance_m: float, config: SgbaConfig) -> float:
-    """Inter-robot RSSI [dBm] of the log-distance path-loss model at ``distance_m``
-    (distances below 0.1 m count as 0.1 m): P1m - 10 n log10(d)."""
-    d = max(float(distance_m), 0.1)
+    """Inter-robot RSSI [dBm] of the log-distance path-loss model at ``distance_m`` divided
+    by the geometry scale (distances below 0.1 m count as 0.1 m): P1m - 10 n log10(d)."""
+    d = max(float(distance_m) / config.geometry_scale, 0.1)
     return config.rssi_at_1m_dbm - 10.0 * config.path_loss_exponent * math.log10(d)
 
 
@@ -198,11 +199,44 @@ def ranges_from_scan(
     )
 
 
+@dataclass(frozen=True)
+class Geometry:
+    """SGBA's distances [m] at the configured geometry scale: the wall distance and the
+    authors' margins on it (hit at +0.2 m, side lost at +0.3 m, clear ahead to leave at
+    +0.4 m), the side check, the avoidance distance, the loop check's start."""
+
+    wall_m: float
+    hit_m: float
+    side_lost_m: float
+    leave_clear_m: float
+    side_check_m: float
+    avoid_m: float
+    loop_min_m: float
+    distance_gain: float
+
+    @classmethod
+    def of(cls, config: SgbaConfig) -> Geometry:
+        """The distances of ``config`` (each times ``geometry_scale``)."""
+        k = config.geometry_scale
+        wall = config.wall_distance_m * k
+        return cls(
+            wall_m=wall,
+            hit_m=wall + 0.2 * k,
+            side_lost_m=wall + 0.3 * k,
+            leave_clear_m=wall + 0.4 * k,
+            side_check_m=config.side_check_m * k,
+            avoid_m=config.avoid_distance_m * k,
+            loop_min_m=config.loop_min_distance_m * k,
+            distance_gain=config.wall_distance_gain / k,
+        )
+
+
 class SgbaController:
     """One robot's SGBA: :meth:`step` maps a step's readings to a velocity command."""
 
     def __init__(self, config: SgbaConfig) -> None:
         self.config = config
+        self.geometry = Geometry.of(config)
         self.memory = SgbaMemory(preferred_heading_rad=initial_heading(config))
         self._started = False
 
@@ -228,14 +262,14 @@ class SgbaController:
 
     def _on_hit(self, inputs: SgbaInputs) -> None:
         """A wall in front while going forward: pick the side, remember the hit."""
-        cfg, m, r = self.config, self.memory, inputs.ranges
+        g, m, r = self.geometry, self.memory, inputs.ranges
         if m.reverse_next_hit:
             m.direction = -m.direction
             m.reverse_next_hit = False
-        elif r.left_m < r.right_m and r.left_m < cfg.side_check_m:
+        elif r.left_m < r.right_m and r.left_m < g.side_check_m:
             m.direction = -1
-        elif (r.left_m > r.right_m and r.right_m < cfg.side_check_m) or (
-            r.left_m > cfg.side_check_m and r.right_m > cfg.side_check_m
+        elif (r.left_m > r.right_m and r.right_m < g.side_check_m) or (
+            r.left_m > g.side_check_m and r.right_m > g.side_check_m
         ):
             m.direction = 1
         m.hit_position_m = inputs.position_m
@@ -264,7 +298,7 @@ class SgbaController:
         m = self.memory
         dx = inputs.position_m[0] - m.hit_position_m[0]
         dy = inputs.position_m[1] - m.hit_position_m[1]
-        if math.hypot(dx, dy) < self.config.loop_min_distance_m:
+        if math.hypot(dx, dy) < self.geometry.loop_min_m:
             return False
         seen = math.atan2(dy, dx)
         return abs(wrap_angle(m.hit_preferred_heading_rad + math.pi - seen)) < (
@@ -273,7 +307,8 @@ class SgbaController:
 
     def _transitions(self, inputs: SgbaInputs) -> None:
         cfg, m, r = self.config, self.memory, inputs.ranges
-        hit = r.front_m < cfg.wall_distance_m + 0.2
+        g = self.geometry
+        hit = r.front_m < g.hit_m
         if m.state is SgbaState.FORWARD:
             if hit:
                 self._on_hit(inputs)
@@ -299,7 +334,7 @@ class SgbaController:
             if (
                 m.wall_state is WallState.AROUND_CORNER
                 and goal_free
-                and r.front_m > cfg.wall_distance_m + 0.4
+                and r.front_m > g.leave_clear_m
                 and not m.cannot_go_to_goal
             ):
                 m.events.append('leave_wall')
@@ -318,24 +353,25 @@ class SgbaController:
     def _wall_follow(self, inputs: SgbaInputs) -> SgbaCommand:
         cfg, m, r = self.config, self.memory, inputs.ranges
         s = m.direction
-        ref = cfg.wall_distance_m
+        g = self.geometry
+        ref = g.wall_m
         side, diagonal = r.side(s), r.diagonal(s)
         if m.last_yaw_rad == m.last_yaw_rad:  # not NaN
             m.corner_turned_rad += abs(wrap_angle(inputs.yaw_rad - m.last_yaw_rad))
         # Transitions of the wall follower.
         if m.wall_state is WallState.TURN_TO_FIND_WALL:
-            clear = r.front_m > ref + 0.3 and diagonal > ref
-            if clear and (side < ref + 0.3 or m.corner_turned_rad > math.pi):
+            clear = r.front_m > g.side_lost_m and diagonal > ref
+            if clear and (side < g.side_lost_m or m.corner_turned_rad > math.pi):
                 m.wall_state = WallState.ALONG_WALL
         elif m.wall_state is WallState.ALONG_WALL:
-            if r.front_m < ref + 0.2:
+            if r.front_m < g.hit_m:
                 self._enter(WallState.TURN_TO_FIND_WALL, inputs)
-            elif side > ref + 0.3:
+            elif side > g.side_lost_m:
                 self._enter(WallState.AROUND_CORNER, inputs)
         elif m.wall_state is WallState.AROUND_CORNER:
-            if r.front_m < ref + 0.2:
+            if r.front_m < g.hit_m:
                 self._enter(WallState.TURN_TO_FIND_WALL, inputs)
-            elif side < ref + 0.2 or m.corner_turned_rad > 2 * math.pi:
+            elif side < g.hit_m or m.corner_turned_rad > 2 * math.pi:
                 m.wall_state = WallState.ALONG_WALL
         # Actions.
         if m.wall_state is WallState.TURN_TO_FIND_WALL:
@@ -347,7 +383,7 @@ class SgbaController:
         alpha = math.atan2(side - diagonal * c, diagonal * c)
         alpha = max(-0.6, min(0.6, alpha))
         distance = side * math.cos(alpha)
-        rate = s * (cfg.wall_angle_gain * alpha + cfg.wall_distance_gain * (ref - distance))
+        rate = s * (cfg.wall_angle_gain * alpha + g.distance_gain * (ref - distance))
         limit = cfg.max_yaw_rate_radps
         return SgbaCommand(cfg.forward_speed_mps, max(-limit, min(limit, rate)))
 
@@ -361,9 +397,9 @@ class SgbaController:
         cfg, m, r = self.config, self.memory, inputs.ranges
         if m.state is SgbaState.FORWARD:
             rate = 0.0
-            if r.left_m < cfg.wall_distance_m:
+            if r.left_m < self.geometry.wall_m:
                 rate -= cfg.side_correction_radps
-            if r.right_m < cfg.wall_distance_m:
+            if r.right_m < self.geometry.wall_m:
                 rate += cfg.side_correction_radps
             return SgbaCommand(cfg.forward_speed_mps, rate)
         if m.state is SgbaState.ROTATE_TO_GOAL:
@@ -372,9 +408,9 @@ class SgbaController:
             return self._wall_follow(inputs)
         # Move out of the way: back off obstacles that are too close, otherwise hold still.
         linear = 0.0
-        if r.front_m < cfg.avoid_distance_m:
+        if r.front_m < self.geometry.avoid_m:
             linear -= cfg.forward_speed_mps
-        if r.back_m < cfg.avoid_distance_m:
+        if r.back_m < self.geometry.avoid_m:
             linear += cfg.forward_speed_mps
         return SgbaCommand(linear, 0.0)
 

@@ -76,8 +76,13 @@ class SgbaConfig:
         wall_angle_gain: wall following: yaw rate per rad of wall angle.
         wall_distance_gain: wall following: yaw rate per m of distance error [rad/s/m].
         max_yaw_rate_radps: limit of the wall-following yaw rate.
+        geometry_scale: multiplies every distance above (and the authors' margins: hit at
+            the wall distance + 0.2 m, side lost at + 0.3 m, clear ahead at + 0.4 m) and
+            divides the peer distance the RSSI model reads, so that the thresholds mean
+            distances scaled alike; 1 keeps the authors' Crazyflie-scale values.
         ranger_half_width_rad: each range direction reads the nearest return within this of
-            its axis (the Crazyflie's four single-beam rangers, taken from the lidar).
+            its axis: the Crazyflie's four rangers (the Multiranger deck's VL53L1x time-of-
+            flight sensors, 27 deg field of view), taken from the lidar.
     """
 
     robot_index: int = parameter(0, 'this robot index in the swarm, 0..robot_count-1', ge=0)
@@ -141,9 +146,18 @@ class SgbaConfig:
     max_yaw_rate_radps: float = parameter(
         1.0, 'limit of the wall-following yaw rate', unit='rad/s', gt=0.0
     )
+    geometry_scale: float = parameter(
+        1.0,
+        (
+            'multiplies every SGBA distance (wall, margins, side check, avoidance, loop check) '
+            "and divides the peer distance of the RSSI model; 1: the authors' values"
+        ),
+        gt=0.0,
+    )
     ranger_half_width_rad: float = parameter(
-        math.radians(2.0),
-        'each range direction reads the nearest lidar return within this of its axis',
+        math.radians(13.5),
+        'each range direction reads the nearest lidar return within this of its axis '
+        "(the Multiranger's VL53L1x: 27 deg field of view)",
         unit='deg',
         degrees=True,
         ge=0.0,
