@@ -234,3 +234,19 @@ def test_the_loop_stops_while_an_input_is_stale() -> None:
     loop.hold_position(0.0, 0.0, 0.1)
     assert loop.control(0.2).stale == ()
     assert set(loop.control(1.5).stale) == {'scan', 'imu', 'odom'}
+
+
+def test_the_geometry_scale_scales_every_distance_and_the_rssi_distance() -> None:
+    half = SgbaConfig(geometry_scale=0.5)
+    c = SgbaController(half)
+    assert c.geometry.wall_m == pytest.approx(0.2)
+    assert c.geometry.hit_m == pytest.approx(0.3)
+    assert c.geometry.side_check_m == pytest.approx(1.0)
+    step(c, ranges())
+    step(c, ranges())
+    step(c, ranges(front=0.5))
+    assert c.memory.state is SgbaState.FORWARD, '0.5 m ahead is no wall at half scale'
+    step(c, ranges(front=0.25))
+    assert c.memory.state is SgbaState.WALL_FOLLOWING
+    # A peer at 0.5 m reads as one at 1 m of the authors' scale.
+    assert rssi_from_distance(0.5, half) == pytest.approx(rssi_from_distance(1.0, SgbaConfig()))

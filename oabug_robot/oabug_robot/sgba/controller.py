@@ -141,8 +141,8 @@ class SgbaMemory:
     hit_preferred_heading_rad: float = 0.0
     reverse_next_hit: bool = False
     cannot_go_to_goal: bool = False
-    #: Yaw when the current corner manoeuvre began (fail-safe of a full circle).
-    corner_start_yaw_rad: float = 0.0
+    #: Rotation [rad] since the current wall-follower manoeuvre began (the fail-safes: a
+    #: half turn without finding the wall, a full circle around a corner).
     corner_turned_rad: float = 0.0
     last_yaw_rad: float = math.nan
     heading_changes: int = 0
@@ -256,7 +256,6 @@ class SgbaController:
         m = self.memory
         m.state = SgbaState.WALL_FOLLOWING
         m.wall_state = WallState.TURN_TO_FIND_WALL
-        m.corner_start_yaw_rad = inputs.yaw_rad
         m.corner_turned_rad = 0.0
         m.events.append('hit_wall')
 
@@ -390,7 +389,6 @@ class SgbaController:
     def _enter(self, state: WallState, inputs: SgbaInputs) -> None:
         m = self.memory
         m.wall_state = state
-        m.corner_start_yaw_rad = inputs.yaw_rad
         m.corner_turned_rad = 0.0
 
     def _actions(self, inputs: SgbaInputs) -> SgbaCommand:
