@@ -30,10 +30,13 @@ setup(
     maintainer_email='maintainers@swarm-search.org',
     description=(
         'OA-Bug swarm exploration (scent trail + AoA bearings, no map) and its four '
-        'ablations, as a per-robot ROS 2 node.'
+        'ablations, and SGBA for comparison, as per-robot ROS 2 nodes.'
     ),
     license='Apache-2.0',
     entry_points={
-        'console_scripts': ['oabug = oabug_robot.node:main'],
+        'console_scripts': [
+            'oabug = oabug_robot.node:main',
+            'sgba = oabug_robot.sgba.node:main',
+        ],
     },
 )

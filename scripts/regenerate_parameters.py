@@ -50,6 +50,14 @@ NODES = (
         '-p robot_index:=0 -p robot_count:=4',
     ),
     NodeEntry(
+        'sgba',
+        'oabug_robot.sgba.settings:SGBA_PARAMETERS',
+        'oabug_robot/config/sgba.yaml',
+        'docs/sgba.md',
+        'ros2 run oabug_robot sgba --ros-args -r __ns:=/r0 --params-file sgba.yaml '
+        '-p robot_index:=0 -p robot_count:=4 -p own_tag_id:=R0',
+    ),
+    NodeEntry(
         'bayes_swarm',
         'bayes_swarm.node_settings:BAYES_SWARM_PARAMETERS',
         'bayes_swarm/config/bayes_swarm.yaml',

@@ -64,6 +64,7 @@ setup(
             'msc_pf = swarm_experiments.msc_pf_studies:studies',
             'bayes_swarm = swarm_experiments.bayes_studies:studies',
             'reliability = swarm_experiments.reliability:studies',
+            'sgba = swarm_experiments.sgba_study:studies',
         ],
     },
 )

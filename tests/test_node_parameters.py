@@ -20,6 +20,13 @@ def _oabug():
     return OABugNode(namespace='/r0'), OABUG_PARAMETERS
 
 
+def _sgba():
+    from oabug_robot.sgba.node import SgbaNode
+    from oabug_robot.sgba.settings import SGBA_PARAMETERS
+
+    return SgbaNode(namespace='/r0'), SGBA_PARAMETERS
+
+
 def _bayes():
     from bayes_swarm.node import BayesSwarmNode
     from bayes_swarm.node_settings import BAYES_SWARM_PARAMETERS
@@ -51,7 +58,14 @@ def _lidar():
     return RPLidarNode(namespace='/r0', parameter_overrides=overrides), RPLIDAR_PARAMETERS
 
 
-NODES = {'oabug': _oabug, 'bayes': _bayes, 'msc': _msc, 'bridge': _bridge, 'lidar': _lidar}
+NODES = {
+    'oabug': _oabug,
+    'sgba': _sgba,
+    'bayes': _bayes,
+    'msc': _msc,
+    'bridge': _bridge,
+    'lidar': _lidar,
+}
 
 
 @pytest.mark.parametrize('kind', sorted(NODES))

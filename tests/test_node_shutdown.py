@@ -3,7 +3,7 @@
 Each node runs as a child process on real rclpy, publishing fast (so that a timer callback
 is running when the signal arrives: the race in which rclpy's signal handler shuts the
 context down under a callback that then fails to publish). Once its first output has
-arrived over DDS, it gets SIGINT or SIGTERM after a random delay: 20 stops in all, four per
+arrived over DDS, it gets SIGINT or SIGTERM after a random delay: 24 stops in all, four per
 executable, half of each signal. The pump driver is commanded on first and must have
 switched its (fake) line off by the time it exits.
 """
@@ -77,6 +77,9 @@ def _script(name: str) -> tuple[str, ...]:
 EXECUTABLES = {
     'oabug': Executable(
         _script('oabug'), ('-p', 'control_rate_hz:=200.0'), 'cmd_vel', geometry.Twist, 2
+    ),
+    'sgba': Executable(
+        _script('sgba'), ('-p', 'control_rate_hz:=200.0'), 'cmd_vel', geometry.Twist, 2
     ),
     'bayes_swarm_node': Executable(
         _script('bayes_swarm_node'), ('-p', 'control_rate_hz:=200.0'), 'cmd_vel', geometry.Twist, 2

@@ -125,6 +125,8 @@ def test_the_bayes_swarm_case_files_are_valid_parameter_files(case: str) -> None
 
 
 def _mains():
+    from oabug_robot.sgba import node as sgba_node
+
     from bayes_swarm import node as bayes_node
     from hw_drivers import (
         aoa_receiver_node,
@@ -140,6 +142,7 @@ def _mains():
 
     return {
         'oabug': oabug_node.main,
+        'sgba': sgba_node.main,
         'bayes_swarm': bayes_node.main,
         'msc_pf': msc_node.main,
         'sim_bridge': bridge_node.main,
