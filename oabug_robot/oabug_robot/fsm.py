@@ -155,6 +155,10 @@ class OABugFsm:
             config.robot_index, config.robot_count, config.departure, config.heading_bias_rad
         )
         self._memory = FsmMemory(preferred_direction_rad=phi, target_yaw_rad=phi)
+        # What every step asks of the (frozen) configuration, looked up once.
+        self._uses_scent = config.variant.uses_scent
+        self._random = config.variant is Variant.RANDOM
+        self._gas_threshold = config.gas_threshold
 
     @property
     def config(self) -> OABugConfig:
@@ -180,20 +184,15 @@ class OABugFsm:
         dt = 0.0 if mem.last_step_s is None else snapshot.time_s - mem.last_step_s
         mem.last_step_s = snapshot.time_s
         gas = snapshot.gas_raw
-        if (
-            self._config.variant.uses_scent
-            and gas is not None
-            and gas >= self._config.gas_threshold
-        ):
+        uses_scent = self._uses_scent
+        if uses_scent and gas is not None and gas >= self._gas_threshold:
             mem.last_scent_s = snapshot.time_s
-        if self._config.variant is Variant.RANDOM:
+        if self._random:
             twist = self._step_random(snapshot, min(max(dt, 0.0), _MAX_STEP_S))
         else:
             twist = self._step_bug(snapshot, min(max(dt, 0.0), _MAX_STEP_S))
         mem.last_linear_mps = twist.linear_mps
-        pump = self._config.variant.uses_scent and self._pump.update(
-            snapshot.time_s, twist.linear_mps
-        )
+        pump = uses_scent and self._pump.update(snapshot.time_s, twist.linear_mps)
         return Command(float(twist.linear_mps), float(twist.angular_radps), bool(pump))
 
     def _step_bug(self, snap: SensorSnapshot, dt_s: float) -> Twist2D:

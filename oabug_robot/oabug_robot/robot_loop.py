@@ -254,6 +254,8 @@ class RobotLoop(Generic[_ScanT]):
         Raises:
             ScanError: the scan is malformed; it is dropped and the features held stay.
         """
+        if self._scan is None:  # nothing new (the common case: features already taken)
+            return
         pending = self.pending_scan()
         if pending is None:
             return
@@ -282,8 +284,9 @@ class RobotLoop(Generic[_ScanT]):
 
     def control(self, now_s: float) -> LoopOutput:
         """:meth:`update_features` (a malformed scan is dropped) then :meth:`step`."""
-        with contextlib.suppress(ScanError):
-            self.update_features(now_s)
+        if self._scan is not None:  # else there is nothing to update
+            with contextlib.suppress(ScanError):
+                self.update_features(now_s)
         return self.step(now_s)
 
 

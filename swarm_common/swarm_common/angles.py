@@ -27,7 +27,7 @@ def wrap_angle(angle_rad: np.ndarray | float) -> np.ndarray | float:
 
     Python floats take a ``math`` path (no array round trip); both paths give the same bits.
     """
-    if isinstance(angle_rad, float | int):
+    if type(angle_rad) is float or isinstance(angle_rad, float | int):
         wrapped = math.fmod(angle_rad + math.pi, TWO_PI)
         if wrapped < 0.0:
             wrapped += TWO_PI

@@ -278,12 +278,14 @@ def _deliver(engine: SimEngine, out: Any, robots: list[BatchRobot], own_tags: np
     if out.scans is not None:
         # The message's float32 values, widened once for every robot's feature extractor.
         ranges_m = out.scans.astype(np.float32).astype(float)
+        withheld = out.withheld.get('scan')
         for i, (robot, ranges) in enumerate(zip(robots, ranges_m, strict=True)):
-            if out.published('scan', i):
+            if withheld is None or not withheld[i]:
                 robot.receive_scan(ranges, now_s)
     if out.gas_raw is not None:
+        # The int64 readings as Python ints (what receive_gas makes of them), held directly.
         for robot, raw in zip(robots, out.gas_raw.tolist(), strict=True):
-            robot.receive_gas(raw, now_s)
+            robot.loop.hold_gas(raw, now_s)
     if out.bearing_cycle is not None:
         _deliver_bearings(robots, out.bearing_cycle, own_tags, now_s)
     if out.imu is not None:
@@ -303,10 +305,10 @@ def _deliver(engine: SimEngine, out: Any, robots: list[BatchRobot], own_tags: np
     velocities: list[tuple[float, float]] = []
     pumps: list[bool] = []
     for i in due:
-        robot = robots[i]
-        command = robot.control(now_s)
-        velocities.append((float(command.linear_mps), float(command.angular_radps)))
-        pumps.append(bool(command.pump_on))
+        # BatchRobot.control, without the extra call.
+        command = robots[i].loop.control(now_s).command
+        velocities.append((command.linear_mps, command.angular_radps))
+        pumps.append(command.pump_on)
     engine.set_commands(due, velocities, pumps)
 
 

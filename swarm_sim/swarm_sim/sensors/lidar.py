@@ -105,8 +105,9 @@ class LidarModel:
         """
         cfg = self.config
         exact = self._caster.scan(poses, cfg.range_max_m)
-        # The same draws as measure_reference, in the same order.
-        normal = self._rng.normal(0.0, 1.0, int(np.count_nonzero(np.isfinite(exact))))
+        # The same draws as measure_reference, in the same order (``standard_normal`` gives
+        # ``normal(0.0, 1.0)``'s values from the same stream, without its per-element scaling).
+        normal = self._rng.standard_normal(int(np.count_nonzero(np.isfinite(exact))))
         uniform = self._rng.random(exact.shape) if cfg.dropout_probability > 0.0 else exact
         return lidar_noise_kernel(
             exact,
