@@ -42,6 +42,13 @@ _SIM_BRIDGE_ADDED = {
     'fault_bearing_dropout_probability': 0.0,
     'fault_comm_range_m': 'inf',
     'fault_comm_loss_probability': 0.0,
+    # The multi-process mission (--processes): mission file, end condition, outcome.
+    'mission_file': '',
+    'max_sim_time_s': 'inf',
+    'stop_when_all_rooms_covered': False,
+    'outcome_file': '',
+    'trajectory_period_s': 0.5,
+    'start_after_clock_subscribers': 0,
 }
 ADDED = {
     'oabug': {'min_turn_rate_radps': 0.3},
