@@ -10,15 +10,15 @@ It is driven from outside, by the ROS node or by the batch simulator, with the s
 * :meth:`BayesSwarmPlanner.broadcast` after a decision (Algorithm 3, SENDINFORMATION).
 
 Solvers. The inner problem (Eq. 5, argmax of the GP mean) is solved from several starts (the
-best grid/data points, the previous solution and a random point) by a projected trust-region
-Newton ascent with the analytic gradient and Hessian, all starts at once ('newton'); the
-paper's multi-start L-BFGS-B is available as 'lbfgsb'. The outer problem (Eq. 1 s.t. Eq. 2)
-is by default 'grid': the acquisition is evaluated on a polar grid of the reachable disk,
-where paths along one heading share their samples so every candidate's path integral comes
-from one cumulative sum, and a local polar pattern search refines the best grid point.
-'cobyla' is the authors' choice (COBYLA from the current position; note that scipy 1.17
-ships a pure-Python COBYLA costing tens of milliseconds per call); 'pso' is a particle swarm
-over the reachable disk.
+best grid/data points, the previous solution and a random point) by the paper's L-BFGS-B
+('lbfgsb', the default) or by a projected trust-region Newton ascent with the analytic
+gradient and Hessian, all starts at once ('newton'). The outer problem (Eq. 1 s.t. Eq. 2) is
+by default the paper's 'cobyla', COBYLA from the current position (``cobyla_library``: the
+compiled nlopt version of Powell's code, or scipy's, which since scipy 1.16 is a pure-Python
+rewrite costing tens of milliseconds per call); 'grid' evaluates the acquisition on a polar
+grid of the reachable disk, where paths along one heading share their samples so every
+candidate's path integral comes from one cumulative sum, and a local polar pattern search
+refines the best grid point; 'pso' is a particle swarm over the reachable disk.
 """
 
 from __future__ import annotations
@@ -570,6 +570,16 @@ class _OuterProblem:
         )
 
     def _cobyla(self, x0: np.ndarray, rhobeg: float) -> np.ndarray:
+        """COBYLA from ``x0``: the leg constraint of Eq. 2 and the arena, final step 1e-4 m.
+
+        ``cobyla_library`` 'nlopt' is the compiled C version of Powell's COBYLA (the
+        algorithm of the Fortran code that the authors' scipy 1.10 wrapped), with the arena
+        as bounds, so no candidate outside it is evaluated; 'scipy' is scipy's COBYLA, which
+        since scipy 1.16 is PRIMA's rewrite in pure Python (its own iterations cost more
+        than the acquisition), the arena as four linear constraints as in the authors' code.
+        """
+        if self.cfg.cobyla_library == 'nlopt':
+            return self._cobyla_nlopt(x0, rhobeg)
         cfg = self.cfg
         arena = cfg.arena
         constraints = [
@@ -587,6 +597,36 @@ class _OuterProblem:
             options={'rhobeg': rhobeg, 'maxiter': cfg.cobyla_max_iterations, 'tol': 1e-4},
         )
         return np.asarray(result.x, dtype=float)
+
+    def _cobyla_nlopt(self, x0: np.ndarray, rhobeg: float) -> np.ndarray:
+        import nlopt
+
+        cfg = self.cfg
+        arena = cfg.arena
+        px, py = float(self.position[0]), float(self.position[1])
+        leg = cfg.max_leg_m
+        best: list[tuple[float, np.ndarray]] = []
+
+        def objective(x: np.ndarray, _grad: np.ndarray) -> float:
+            value = -float(self.values(x)[0])
+            improves = math.isfinite(value) and (not best or value < best[0][0])
+            if improves and math.hypot(x[0] - px, x[1] - py) <= leg:
+                best[:] = [(value, np.array(x, dtype=float))]
+            return value if math.isfinite(value) else math.inf
+
+        opt = nlopt.opt(nlopt.LN_COBYLA, 2)
+        opt.set_lower_bounds([arena.x_min_m, arena.y_min_m])
+        opt.set_upper_bounds([arena.x_max_m, arena.y_max_m])
+        opt.set_min_objective(objective)
+        opt.add_inequality_constraint(lambda x, _g: math.hypot(x[0] - px, x[1] - py) - leg, 0.0)
+        opt.set_initial_step(rhobeg)
+        opt.set_xtol_abs(1e-4)
+        opt.set_maxeval(cfg.cobyla_max_iterations)
+        try:
+            return np.asarray(opt.optimize(np.asarray(x0, dtype=float)), dtype=float)
+        except nlopt.RoundoffLimited:
+            # Stopped by rounding errors: the best feasible point evaluated so far.
+            return best[0][1] if best else np.asarray(x0, dtype=float)
 
     def _pso(self, rng: np.random.Generator) -> np.ndarray:
         cfg = self.cfg

@@ -225,14 +225,20 @@ def _with_data(cfg, peer_waypoint):
     return planner
 
 
-def test_a_penalty_ball_over_the_whole_arena_stalls_cobyla_and_the_estimate_frees_it():
+@pytest.mark.parametrize('library', ['nlopt', 'scipy'])
+def test_a_penalty_ball_over_the_whole_arena_stalls_cobyla_and_the_estimate_frees_it(library):
     """With M far above the field (47 on a field of 1) and L = 2, the exclusion ball around
-    the peer's waypoint is ~23 m wide: Gamma is 0 on the whole arena, the acquisition is flat
-    and COBYLA ends one rhobeg from the start. The belief-estimated M and L keep it local."""
-    fixed = BayesSwarmConfig(max_signal=47.0, lipschitz=2.0)
+    the peer's waypoint is ~23 m wide: Gamma is 0 on the whole arena and the acquisition is
+    flat. Powell's COBYLA (nlopt) then stays at its start and Algorithm 1 jumps at random;
+    scipy's (PRIMA's) ends one rhobeg from the start. The belief-estimated M and L keep the
+    ball local."""
+    fixed = BayesSwarmConfig(max_signal=47.0, lipschitz=2.0, cobyla_library=library)
     decision = _with_data(fixed, [1.2, 1.2]).decide([0.71, 0.71], 50.0)
-    assert np.hypot(*(decision.waypoint_m - [0.71, 0.71])) == pytest.approx(1.0, abs=1e-6)
-    assert decision.waypoint_m[1] == pytest.approx(0.71, abs=1e-6)  # the first COBYLA step
+    if library == 'nlopt':
+        assert decision.kind is DecisionKind.RANDOM_JUMP
+    else:
+        assert np.hypot(*(decision.waypoint_m - [0.71, 0.71])) == pytest.approx(1.0, abs=1e-6)
+        assert decision.waypoint_m[1] == pytest.approx(0.71, abs=1e-6)  # the first step
     estimating = _with_data(replace(fixed, penalty_estimate=True), [1.2, 1.2])
     free = estimating.decide([0.71, 0.71], 50.0)
     assert free.kind is DecisionKind.ACQUISITION
@@ -243,3 +249,23 @@ def test_a_penalty_ball_over_the_whole_arena_stalls_cobyla_and_the_estimate_free
     _, grad, _ = estimating.gp.mean_derivatives(estimating.gp.training_inputs)
     assert lipschitz >= float(np.max(np.hypot(grad[:, 0], grad[:, 1]))) - 1e-12
     assert lipschitz < 2.0
+
+
+def test_both_cobyla_libraries_reach_the_same_waypoint_on_the_leg_constraint():
+    """Powell's COBYLA (nlopt) and PRIMA's (scipy) solve the same Eq. 1 to COBYLA's 1e-4 m."""
+    waypoints = {}
+    for library in ('nlopt', 'scipy'):
+        planner = planner_with_data()
+        planner._cfg = replace(planner.config, cobyla_library=library)
+        decision = planner.decide([0.71, 0.71], 50.0)
+        assert decision.kind is DecisionKind.ACQUISITION
+        # The optimum lies on the leg constraint (Eq. 2), kept on the disc.
+        assert np.hypot(*(decision.waypoint_m - [0.71, 0.71])) <= 1.0 + 1e-9
+        assert np.hypot(*(decision.waypoint_m - [0.71, 0.71])) > 1.0 - 1e-4
+        waypoints[library] = decision.waypoint_m
+    assert np.hypot(*(waypoints['nlopt'] - waypoints['scipy'])) < 1e-4
+
+
+def test_an_unknown_cobyla_library_is_rejected():
+    with pytest.raises(ConfigError, match='cobyla_library'):
+        BayesSwarmConfig(cobyla_library='fortran')
