@@ -29,6 +29,7 @@ import time
 import numpy as np
 from scipy.linalg import LinAlgError
 from scipy.optimize import minimize
+from scipy.special import erfc
 
 from bayes_swarm.acquisition import acquisition, omega, planned_path_points, ray_integrals
 from bayes_swarm.alpha import AlphaBranch, AlphaDecision, exploitation_weight
@@ -489,6 +490,15 @@ class _OuterProblem:
         self.ray_step_m = cfg.max_leg_m / self.n_steps
         # Path parameter u in [0, 1] (n_steps + 1,) of the paths sampled by values().
         self.path_u = np.linspace(0.0, 1.0, self.n_steps + 1)
+        # Trapezoid weights on path_u: the path integral of one candidate is one dot product.
+        self.path_weights = np.full(self.n_steps + 1, 1.0 / self.n_steps)
+        self.path_weights[[0, -1]] *= 0.5
+        self.path_base = np.zeros(2) if cfg.authors_origin_paths else position
+        # The penalty's per-peer constants of value(): z = (L d - M + mu) / (sqrt(2) sigma).
+        self.peer_shift = np.asarray(peer_mean, dtype=float) - max_signal
+        self.peer_scale = 1.0 / (
+            math.sqrt(2.0) * np.maximum(np.asarray(peer_std, dtype=float), cfg.penalty_std_floor)
+        )
         # The paper's units: Omega with distances in metres, Sigma in signal * m. Dimensionless:
         # Omega with distances in leg lengths V T, Sigma divided by its largest value (the prior
         # std along the longest leg); both then lie in [0, 1] whatever the field's scale.
@@ -509,6 +519,26 @@ class _OuterProblem:
             lipschitz=self.lipschitz,
             std_floor=self.cfg.penalty_std_floor,
         )
+
+    def value(self, x: np.ndarray) -> float:
+        """Acquisition at one reachable (2,) point: :meth:`values` without its batch set-up.
+
+        The same terms in the same units (COBYLA's objective, called tens of times per
+        decision); equal to ``values(x)[0]`` up to rounding.
+        """
+        px, py = float(self.position[0]), float(self.position[1])
+        ox, oy = float(x[0]) - px, float(x[1]) - py
+        samples = self.path_base + self.path_u[:, None] * np.array([ox, oy])
+        std = self.ext.std(samples)
+        sigma = math.hypot(ox, oy) * float(self.path_weights @ std) * self.sigma_scale
+        ex, ey = float(x[0]) - float(self.expected[0]), float(x[1]) - float(self.expected[1])
+        omega_value = 1.0 / (1.0 + (ex * ex + ey * ey) / self.omega_unit_m**2)
+        gamma = 1.0
+        if self.peer_waypoints.shape[0]:
+            dist = np.hypot(self.peer_waypoints[:, 0] - x[0], self.peer_waypoints[:, 1] - x[1])
+            z = (self.lipschitz * dist + self.peer_shift) * self.peer_scale
+            gamma = float(np.prod(0.5 * erfc(-z)))
+        return (self.alpha * omega_value + (1.0 - self.alpha) * sigma) * gamma
 
     def values(self, points: np.ndarray) -> np.ndarray:
         """Acquisition (q,) at arbitrary (q, 2) reachable points (paths sampled uniformly)."""
@@ -590,7 +620,7 @@ class _OuterProblem:
             {'type': 'ineq', 'fun': lambda x: arena.y_max_m - x[1]},
         ]
         result = minimize(
-            lambda x: -float(self.values(x)[0]),
+            lambda x: -self.value(x),
             x0,
             method='COBYLA',
             constraints=constraints,
@@ -608,7 +638,7 @@ class _OuterProblem:
         best: list[tuple[float, np.ndarray]] = []
 
         def objective(x: np.ndarray, _grad: np.ndarray) -> float:
-            value = -float(self.values(x)[0])
+            value = -self.value(x)
             improves = math.isfinite(value) and (not best or value < best[0][0])
             if improves and math.hypot(x[0] - px, x[1] - py) <= leg:
                 best[:] = [(value, np.array(x, dtype=float))]

@@ -5,9 +5,10 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+from bayes_swarm.acquisition import planned_path_points
 from bayes_swarm.errors import ConfigError, GpFitError
 from bayes_swarm.messages import DecisionKind, PeerUpdate
-from bayes_swarm.planner import BayesSwarmPlanner, first_waypoint
+from bayes_swarm.planner import BayesSwarmPlanner, _OuterProblem, first_waypoint
 from bayes_swarm.settings import Arena, BayesSwarmConfig, GlowwormConfig, GpConfig, LevyConfig
 
 
@@ -269,3 +270,39 @@ def test_both_cobyla_libraries_reach_the_same_waypoint_on_the_leg_constraint():
 def test_an_unknown_cobyla_library_is_rejected():
     with pytest.raises(ConfigError, match='cobyla_library'):
         BayesSwarmConfig(cobyla_library='fortran')
+
+
+@pytest.mark.parametrize(
+    'options',
+    [{}, {'authors_origin_paths': True}, {'dimensionless_acquisition': True}],
+    ids=['paper', 'origin-paths', 'dimensionless'],
+)
+def test_the_single_point_acquisition_equals_the_batch_one(options):
+    """COBYLA's objective (value) is the batch acquisition (values) at one point."""
+    planner = planner_with_data(peer_waypoint=[1.0, 1.2])
+    planner._cfg = replace(planner.config, **options)
+    planner.decide([0.71, 0.71], 50.0)
+    gp = planner.gp
+    peers = np.array([[1.0, 1.2], [0.3, 1.9]])
+    mean, std = gp.predict(peers)
+    position = np.array([0.71, 0.71])
+    problem = _OuterProblem(
+        planner.config,
+        position,
+        np.array([1.1, 1.8]),
+        0.6,
+        gp.extended_std(planned_path_points(position[None], peers[:1], 0.1, 400)),
+        peers,
+        mean,
+        std,
+        1.2,
+        2.0,
+    )
+    rng = np.random.default_rng(3)
+    radius = np.sqrt(rng.uniform(0.0, 1.0, 40))
+    angle = rng.uniform(0.0, 2.0 * math.pi, 40)
+    points = position + radius[:, None] * np.c_[np.cos(angle), np.sin(angle)]
+    batch = problem.values(points)
+    single = np.array([problem.value(p) for p in points])
+    np.testing.assert_allclose(single, batch, rtol=1e-12, atol=1e-15)
+    assert np.ptp(batch) > 0.01  # the points see different values
