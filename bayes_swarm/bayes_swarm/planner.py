@@ -654,8 +654,9 @@ class _OuterProblem:
         opt.set_maxeval(cfg.cobyla_max_iterations)
         try:
             return np.asarray(opt.optimize(np.asarray(x0, dtype=float)), dtype=float)
-        except nlopt.RoundoffLimited:
-            # Stopped by rounding errors: the best feasible point evaluated so far.
+        except (nlopt.RoundoffLimited, nlopt.ForcedStop, RuntimeError):
+            # Stopped by rounding errors or a generic nlopt failure: the best feasible point
+            # evaluated so far (the start if none).
             return best[0][1] if best else np.asarray(x0, dtype=float)
 
     def _pso(self, rng: np.random.Generator) -> np.ndarray:
