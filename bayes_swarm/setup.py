@@ -24,7 +24,7 @@ setup(
         (f'share/{PACKAGE_NAME}', ['package.xml']),
         *share_files('config'),
     ],
-    install_requires=['numpy', 'swarm_common', 'scipy', 'swarm_runtime'],
+    install_requires=['numpy', 'swarm_common', 'scipy', 'nlopt', 'swarm_runtime'],
     zip_safe=True,
     maintainer='Swarm search maintainers',
     maintainer_email='maintainers@swarm-search.org',

@@ -10,15 +10,15 @@ It is driven from outside, by the ROS node or by the batch simulator, with the s
 * :meth:`BayesSwarmPlanner.broadcast` after a decision (Algorithm 3, SENDINFORMATION).
 
 Solvers. The inner problem (Eq. 5, argmax of the GP mean) is solved from several starts (the
-best grid/data points, the previous solution and a random point) by a projected trust-region
-Newton ascent with the analytic gradient and Hessian, all starts at once ('newton'); the
-paper's multi-start L-BFGS-B is available as 'lbfgsb'. The outer problem (Eq. 1 s.t. Eq. 2)
-is by default 'grid': the acquisition is evaluated on a polar grid of the reachable disk,
-where paths along one heading share their samples so every candidate's path integral comes
-from one cumulative sum, and a local polar pattern search refines the best grid point.
-'cobyla' is the authors' choice (COBYLA from the current position; note that scipy 1.17
-ships a pure-Python COBYLA costing tens of milliseconds per call); 'pso' is a particle swarm
-over the reachable disk.
+best grid/data points, the previous solution and a random point) by the paper's L-BFGS-B
+('lbfgsb', the default) or by a projected trust-region Newton ascent with the analytic
+gradient and Hessian, all starts at once ('newton'). The outer problem (Eq. 1 s.t. Eq. 2) is
+by default the paper's 'cobyla', COBYLA from the current position (``cobyla_library``: the
+compiled nlopt version of Powell's code, or scipy's, which since scipy 1.16 is a pure-Python
+rewrite costing tens of milliseconds per call); 'grid' evaluates the acquisition on a polar
+grid of the reachable disk, where paths along one heading share their samples so every
+candidate's path integral comes from one cumulative sum, and a local polar pattern search
+refines the best grid point; 'pso' is a particle swarm over the reachable disk.
 """
 
 from __future__ import annotations
@@ -29,6 +29,7 @@ import time
 import numpy as np
 from scipy.linalg import LinAlgError
 from scipy.optimize import minimize
+from scipy.special import erfc
 
 from bayes_swarm.acquisition import acquisition, omega, planned_path_points, ray_integrals
 from bayes_swarm.alpha import AlphaBranch, AlphaDecision, exploitation_weight
@@ -489,6 +490,15 @@ class _OuterProblem:
         self.ray_step_m = cfg.max_leg_m / self.n_steps
         # Path parameter u in [0, 1] (n_steps + 1,) of the paths sampled by values().
         self.path_u = np.linspace(0.0, 1.0, self.n_steps + 1)
+        # Trapezoid weights on path_u: the path integral of one candidate is one dot product.
+        self.path_weights = np.full(self.n_steps + 1, 1.0 / self.n_steps)
+        self.path_weights[[0, -1]] *= 0.5
+        self.path_base = np.zeros(2) if cfg.authors_origin_paths else position
+        # The penalty's per-peer constants of value(): z = (L d - M + mu) / (sqrt(2) sigma).
+        self.peer_shift = np.asarray(peer_mean, dtype=float) - max_signal
+        self.peer_scale = 1.0 / (
+            math.sqrt(2.0) * np.maximum(np.asarray(peer_std, dtype=float), cfg.penalty_std_floor)
+        )
         # The paper's units: Omega with distances in metres, Sigma in signal * m. Dimensionless:
         # Omega with distances in leg lengths V T, Sigma divided by its largest value (the prior
         # std along the longest leg); both then lie in [0, 1] whatever the field's scale.
@@ -509,6 +519,26 @@ class _OuterProblem:
             lipschitz=self.lipschitz,
             std_floor=self.cfg.penalty_std_floor,
         )
+
+    def value(self, x: np.ndarray) -> float:
+        """Acquisition at one reachable (2,) point: :meth:`values` without its batch set-up.
+
+        The same terms in the same units (COBYLA's objective, called tens of times per
+        decision); equal to ``values(x)[0]`` up to rounding.
+        """
+        px, py = float(self.position[0]), float(self.position[1])
+        ox, oy = float(x[0]) - px, float(x[1]) - py
+        samples = self.path_base + self.path_u[:, None] * np.array([ox, oy])
+        std = self.ext.std(samples)
+        sigma = math.hypot(ox, oy) * float(self.path_weights @ std) * self.sigma_scale
+        ex, ey = float(x[0]) - float(self.expected[0]), float(x[1]) - float(self.expected[1])
+        omega_value = 1.0 / (1.0 + (ex * ex + ey * ey) / self.omega_unit_m**2)
+        gamma = 1.0
+        if self.peer_waypoints.shape[0]:
+            dist = np.hypot(self.peer_waypoints[:, 0] - x[0], self.peer_waypoints[:, 1] - x[1])
+            z = (self.lipschitz * dist + self.peer_shift) * self.peer_scale
+            gamma = float(np.prod(0.5 * erfc(-z)))
+        return (self.alpha * omega_value + (1.0 - self.alpha) * sigma) * gamma
 
     def values(self, points: np.ndarray) -> np.ndarray:
         """Acquisition (q,) at arbitrary (q, 2) reachable points (paths sampled uniformly)."""
@@ -570,6 +600,16 @@ class _OuterProblem:
         )
 
     def _cobyla(self, x0: np.ndarray, rhobeg: float) -> np.ndarray:
+        """COBYLA from ``x0``: the leg constraint of Eq. 2 and the arena, final step 1e-4 m.
+
+        ``cobyla_library`` 'nlopt' is the compiled C version of Powell's COBYLA (the
+        algorithm of the Fortran code that the authors' scipy 1.10 wrapped), with the arena
+        as bounds, so no candidate outside it is evaluated; 'scipy' is scipy's COBYLA, which
+        since scipy 1.16 is PRIMA's rewrite in pure Python (its own iterations cost more
+        than the acquisition), the arena as four linear constraints as in the authors' code.
+        """
+        if self.cfg.cobyla_library == 'nlopt':
+            return self._cobyla_nlopt(x0, rhobeg)
         cfg = self.cfg
         arena = cfg.arena
         constraints = [
@@ -580,13 +620,44 @@ class _OuterProblem:
             {'type': 'ineq', 'fun': lambda x: arena.y_max_m - x[1]},
         ]
         result = minimize(
-            lambda x: -float(self.values(x)[0]),
+            lambda x: -self.value(x),
             x0,
             method='COBYLA',
             constraints=constraints,
             options={'rhobeg': rhobeg, 'maxiter': cfg.cobyla_max_iterations, 'tol': 1e-4},
         )
         return np.asarray(result.x, dtype=float)
+
+    def _cobyla_nlopt(self, x0: np.ndarray, rhobeg: float) -> np.ndarray:
+        import nlopt
+
+        cfg = self.cfg
+        arena = cfg.arena
+        px, py = float(self.position[0]), float(self.position[1])
+        leg = cfg.max_leg_m
+        best: list[tuple[float, np.ndarray]] = []
+
+        def objective(x: np.ndarray, _grad: np.ndarray) -> float:
+            value = -self.value(x)
+            improves = math.isfinite(value) and (not best or value < best[0][0])
+            if improves and math.hypot(x[0] - px, x[1] - py) <= leg:
+                best[:] = [(value, np.array(x, dtype=float))]
+            return value if math.isfinite(value) else math.inf
+
+        opt = nlopt.opt(nlopt.LN_COBYLA, 2)
+        opt.set_lower_bounds([arena.x_min_m, arena.y_min_m])
+        opt.set_upper_bounds([arena.x_max_m, arena.y_max_m])
+        opt.set_min_objective(objective)
+        opt.add_inequality_constraint(lambda x, _g: math.hypot(x[0] - px, x[1] - py) - leg, 0.0)
+        opt.set_initial_step(rhobeg)
+        opt.set_xtol_abs(1e-4)
+        opt.set_maxeval(cfg.cobyla_max_iterations)
+        try:
+            return np.asarray(opt.optimize(np.asarray(x0, dtype=float)), dtype=float)
+        except (nlopt.RoundoffLimited, nlopt.ForcedStop, RuntimeError):
+            # Stopped by rounding errors or a generic nlopt failure: the best feasible point
+            # evaluated so far (the start if none).
+            return best[0][1] if best else np.asarray(x0, dtype=float)
 
     def _pso(self, rng: np.random.Generator) -> np.ndarray:
         cfg = self.cfg

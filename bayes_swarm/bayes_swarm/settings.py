@@ -26,6 +26,7 @@ from swarm_common.params import parameter, section
 from bayes_swarm.errors import ConfigError
 
 __all__ = [
+    'COBYLA_LIBRARIES',
     'INNER_OPTIMIZERS',
     'OUTER_OPTIMIZERS',
     'Arena',
@@ -38,6 +39,7 @@ __all__ = [
 
 OUTER_OPTIMIZERS = ('grid', 'cobyla', 'pso')
 INNER_OPTIMIZERS = ('newton', 'lbfgsb')
+COBYLA_LIBRARIES = ('nlopt', 'scipy')
 OuterOptimizer = Literal['grid', 'cobyla', 'pso']
 
 
@@ -193,6 +195,11 @@ class BayesSwarmConfig:
     cobyla_max_iterations: int = parameter(
         1000, 'iteration limit of COBYLA (scipy default, as the authors)', ge=1
     )
+    cobyla_library: Literal['nlopt', 'scipy'] = parameter(
+        'nlopt',
+        "COBYLA implementation: nlopt (compiled Powell COBYLA, as the authors' scipy) or scipy",
+        choices=COBYLA_LIBRARIES,
+    )
     pso_particles: int = 40
     pso_iterations: int = 40
     max_peer_path_points: int = 400
@@ -241,6 +248,11 @@ class BayesSwarmConfig:
         _require(self.n_candidate_headings >= 4, 'n_candidate_headings must be >= 4')
         _require(self.n_inner_starts >= 1, 'n_inner_starts must be >= 1')
         _require(self.cobyla_max_iterations >= 1, 'cobyla_max_iterations must be >= 1')
+        _require(
+            self.cobyla_library in COBYLA_LIBRARIES,
+            f'cobyla_library must be one of {", ".join(COBYLA_LIBRARIES)}, '
+            f'got {self.cobyla_library!r}',
+        )
         _require(self.pso_particles >= 2, 'pso_particles must be >= 2')
         _require(self.pso_iterations >= 1, 'pso_iterations must be >= 1')
         _require(self.max_peer_path_points >= 0, 'max_peer_path_points must be >= 0')

@@ -5,9 +5,10 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+from bayes_swarm.acquisition import planned_path_points
 from bayes_swarm.errors import ConfigError, GpFitError
 from bayes_swarm.messages import DecisionKind, PeerUpdate
-from bayes_swarm.planner import BayesSwarmPlanner, first_waypoint
+from bayes_swarm.planner import BayesSwarmPlanner, _OuterProblem, first_waypoint
 from bayes_swarm.settings import Arena, BayesSwarmConfig, GlowwormConfig, GpConfig, LevyConfig
 
 
@@ -225,14 +226,20 @@ def _with_data(cfg, peer_waypoint):
     return planner
 
 
-def test_a_penalty_ball_over_the_whole_arena_stalls_cobyla_and_the_estimate_frees_it():
+@pytest.mark.parametrize('library', ['nlopt', 'scipy'])
+def test_a_penalty_ball_over_the_whole_arena_stalls_cobyla_and_the_estimate_frees_it(library):
     """With M far above the field (47 on a field of 1) and L = 2, the exclusion ball around
-    the peer's waypoint is ~23 m wide: Gamma is 0 on the whole arena, the acquisition is flat
-    and COBYLA ends one rhobeg from the start. The belief-estimated M and L keep it local."""
-    fixed = BayesSwarmConfig(max_signal=47.0, lipschitz=2.0)
+    the peer's waypoint is ~23 m wide: Gamma is 0 on the whole arena and the acquisition is
+    flat. Powell's COBYLA (nlopt) then stays at its start and Algorithm 1 jumps at random;
+    scipy's (PRIMA's) ends one rhobeg from the start. The belief-estimated M and L keep the
+    ball local."""
+    fixed = BayesSwarmConfig(max_signal=47.0, lipschitz=2.0, cobyla_library=library)
     decision = _with_data(fixed, [1.2, 1.2]).decide([0.71, 0.71], 50.0)
-    assert np.hypot(*(decision.waypoint_m - [0.71, 0.71])) == pytest.approx(1.0, abs=1e-6)
-    assert decision.waypoint_m[1] == pytest.approx(0.71, abs=1e-6)  # the first COBYLA step
+    if library == 'nlopt':
+        assert decision.kind is DecisionKind.RANDOM_JUMP
+    else:
+        assert np.hypot(*(decision.waypoint_m - [0.71, 0.71])) == pytest.approx(1.0, abs=1e-6)
+        assert decision.waypoint_m[1] == pytest.approx(0.71, abs=1e-6)  # the first step
     estimating = _with_data(replace(fixed, penalty_estimate=True), [1.2, 1.2])
     free = estimating.decide([0.71, 0.71], 50.0)
     assert free.kind is DecisionKind.ACQUISITION
@@ -243,3 +250,59 @@ def test_a_penalty_ball_over_the_whole_arena_stalls_cobyla_and_the_estimate_free
     _, grad, _ = estimating.gp.mean_derivatives(estimating.gp.training_inputs)
     assert lipschitz >= float(np.max(np.hypot(grad[:, 0], grad[:, 1]))) - 1e-12
     assert lipschitz < 2.0
+
+
+def test_both_cobyla_libraries_reach_the_same_waypoint_on_the_leg_constraint():
+    """Powell's COBYLA (nlopt) and PRIMA's (scipy) solve the same Eq. 1 to COBYLA's 1e-4 m."""
+    waypoints = {}
+    for library in ('nlopt', 'scipy'):
+        planner = planner_with_data()
+        planner._cfg = replace(planner.config, cobyla_library=library)
+        decision = planner.decide([0.71, 0.71], 50.0)
+        assert decision.kind is DecisionKind.ACQUISITION
+        # The optimum lies on the leg constraint (Eq. 2), kept on the disc.
+        assert np.hypot(*(decision.waypoint_m - [0.71, 0.71])) <= 1.0 + 1e-9
+        assert np.hypot(*(decision.waypoint_m - [0.71, 0.71])) > 1.0 - 1e-4
+        waypoints[library] = decision.waypoint_m
+    assert np.hypot(*(waypoints['nlopt'] - waypoints['scipy'])) < 1e-4
+
+
+def test_an_unknown_cobyla_library_is_rejected():
+    with pytest.raises(ConfigError, match='cobyla_library'):
+        BayesSwarmConfig(cobyla_library='fortran')
+
+
+@pytest.mark.parametrize(
+    'options',
+    [{}, {'authors_origin_paths': True}, {'dimensionless_acquisition': True}],
+    ids=['paper', 'origin-paths', 'dimensionless'],
+)
+def test_the_single_point_acquisition_equals_the_batch_one(options):
+    """COBYLA's objective (value) is the batch acquisition (values) at one point."""
+    planner = planner_with_data(peer_waypoint=[1.0, 1.2])
+    planner._cfg = replace(planner.config, **options)
+    planner.decide([0.71, 0.71], 50.0)
+    gp = planner.gp
+    peers = np.array([[1.0, 1.2], [0.3, 1.9]])
+    mean, std = gp.predict(peers)
+    position = np.array([0.71, 0.71])
+    problem = _OuterProblem(
+        planner.config,
+        position,
+        np.array([1.1, 1.8]),
+        0.6,
+        gp.extended_std(planned_path_points(position[None], peers[:1], 0.1, 400)),
+        peers,
+        mean,
+        std,
+        1.2,
+        2.0,
+    )
+    rng = np.random.default_rng(3)
+    radius = np.sqrt(rng.uniform(0.0, 1.0, 40))
+    angle = rng.uniform(0.0, 2.0 * math.pi, 40)
+    points = position + radius[:, None] * np.c_[np.cos(angle), np.sin(angle)]
+    batch = problem.values(points)
+    single = np.array([problem.value(p) for p in points])
+    np.testing.assert_allclose(single, batch, rtol=1e-12, atol=1e-15)
+    assert np.ptp(batch) > 0.01  # the points see different values

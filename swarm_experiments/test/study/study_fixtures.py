@@ -73,6 +73,14 @@ def synthetic_run(spec: RunSpec) -> Mapping[str, Any]:
     }
 
 
+def blas_threads_run(spec: RunSpec) -> Mapping[str, Any]:
+    """The BLAS thread variables the worker that runs ``spec`` sees (0: unset)."""
+    return {
+        name.lower(): int(os.environ.get(name, '0'))
+        for name in ('OMP_NUM_THREADS', 'OPENBLAS_NUM_THREADS', 'MKL_NUM_THREADS')
+    }
+
+
 def dying_run(spec: RunSpec) -> Mapping[str, Any]:
     """Kills the process running it, every time."""
     os._exit(13)

@@ -5,7 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from study_fixtures import dying_run, search_study
+from study_fixtures import blas_threads_run, dying_run, search_study
 from study_helpers import comparable
 from swarm_experiments.study import (
     EngineError,
@@ -173,3 +173,19 @@ def test_a_run_that_keeps_killing_dask_workers_gets_a_failed_row(tmp_path: Path)
     assert row['status'] == 'failed'
     assert row['error'].startswith('KilledWorker: ')
     assert row['run_id'] == plan.specs[0].run_id
+
+
+def test_pool_workers_get_one_blas_thread_unless_the_caller_chose(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    for name in ('OMP_NUM_THREADS', 'OPENBLAS_NUM_THREADS', 'MKL_NUM_THREADS'):
+        monkeypatch.delenv(name, raising=False)
+    monkeypatch.setenv('MKL_NUM_THREADS', '3')
+    study = search_study(run=blas_threads_run)
+    plan = make_specs(study, runs=1, overrides=parse_overrides(['robots=2']))
+    with PoolEngine(1) as engine:
+        run_study(plan, tmp_path, engine, code_version=VERSION)
+    rows = read_rows(tmp_path / study.name)
+    assert set(rows['metric.omp_num_threads']) == {1}
+    assert set(rows['metric.openblas_num_threads']) == {1}
+    assert set(rows['metric.mkl_num_threads']) == {3}
