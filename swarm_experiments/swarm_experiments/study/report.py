@@ -500,7 +500,8 @@ def write_reports(
     A study found in ``registry`` adds its ``report`` hook's sections. A hook that raises is
     reported through ``on_hook_error`` (and the page notes it) when given, else re-raised.
     When the page exports tables, ``results.json`` beside it holds them with the commands
-    that made them (:func:`results_document`; ``report_command`` is this report's command).
+    that made them (:func:`results_document`; ``report_command`` is this report's command);
+    a page whose hook failed exports nothing (an older ``results.json`` is removed).
     Returns the pages written.
     """
     pages = []
@@ -510,6 +511,7 @@ def write_reports(
         page = ReportPage(study_dir, manifest, rows)
         _generic_sections(page)
         study = registry.find(page.study) if registry is not None else None
+        hook_failed = False
         if study is not None and study.report is not None and len(page.rows):
             try:
                 study.report(page)
@@ -517,12 +519,13 @@ def write_reports(
                 if on_hook_error is None:
                     raise
                 on_hook_error(page.study, exc)
+                hook_failed = True
                 page.add_text(f"_The study's report hook failed: {type(exc).__name__}: {exc}_")
         path = study_dir / 'report.md'
         try:
             path.write_text(page.markdown())
             results = study_dir / RESULTS_NAME
-            if page.exports:
+            if page.exports and not hook_failed:
                 document = results_document(page, report_command)
                 text = json.dumps(document, indent=1, ensure_ascii=False) + '\n'
                 temporary = results.with_name(results.name + '.tmp')
