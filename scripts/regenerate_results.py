@@ -26,7 +26,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from swarm_experiments.study.docs_results import MARKER, collect, load_store, update_text
+from swarm_experiments.study.docs_results import collect, load_store, markers, update_text
 from swarm_experiments.study.errors import ResultsError
 
 REPO = Path(__file__).resolve().parents[1]
@@ -39,7 +39,7 @@ def expected_pages(repo: Path = REPO) -> dict[Path, str]:
     pages: dict[Path, str] = {}
     for path in sorted((repo / 'docs').glob('**/*.md')):
         text = path.read_text(encoding='utf-8')
-        if MARKER.search(text) is None:
+        if not markers(text):
             continue
         relative = path.relative_to(repo).as_posix()
         pages[path] = update_text(text, documents, page=relative, store_label=STORE)

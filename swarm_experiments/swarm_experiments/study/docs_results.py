@@ -32,12 +32,26 @@ __all__ = [
     'MARKER',
     'collect',
     'load_store',
+    'markers',
     'render_region',
     'update_text',
 ]
 
 #: A marker line; group 1 is STUDY/TABLE, group 2 ``begin`` or ``end``.
 MARKER = re.compile(r'^<!-- results:([A-Za-z0-9_.-]+/[a-z0-9_-]+) (begin|end) -->$', re.M)
+_FENCE = re.compile(r'^(```|~~~)', re.M)
+
+
+def _fenced_spans(text: str) -> list[tuple[int, int]]:
+    """The character spans of fenced code blocks (markers shown in examples are not regions)."""
+    fences = [m.start() for m in _FENCE.finditer(text)]
+    return [(fences[i], fences[i + 1]) for i in range(0, len(fences) - 1, 2)]
+
+
+def markers(text: str) -> list[re.Match[str]]:
+    """The marker lines of ``text`` outside fenced code blocks, in order."""
+    spans = _fenced_spans(text)
+    return [m for m in MARKER.finditer(text) if not any(a <= m.start() < b for a, b in spans)]
 
 
 def load_store(store: Path) -> dict[str, dict[str, Any]]:
@@ -135,7 +149,7 @@ def update_text(
     position = 0
     open_name: str | None = None
     open_line = 0
-    for match in MARKER.finditer(text):
+    for match in markers(text):
         name, kind = match.group(1), match.group(2)
         line = text.count('\n', 0, match.start()) + 1
         if kind == 'begin':

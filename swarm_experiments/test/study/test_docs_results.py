@@ -77,6 +77,14 @@ def test_a_region_is_rewritten_from_the_store_and_check_sees_stale_text(
     assert update_text(new, documents, page='p.md', store_label='store') != new
 
 
+def test_markers_inside_code_blocks_are_examples_not_regions() -> None:
+    page = (
+        '```markdown\n<!-- results:synthetic-search/coverage begin -->\n'
+        '<!-- results:synthetic-search/coverage end -->\n```\n'
+    )
+    assert update_text(page, {}, page='p.md', store_label='store') == page
+
+
 @pytest.mark.parametrize(
     ('page', 'message'),
     [
