@@ -229,12 +229,16 @@ def _median_ms(values: list[float]) -> float:
 
 
 # ---------------------------------------------------------------------------- reports
-_VARIED = ('param.profile', 'param.seed_offset')
+_VARIED = ('param.profile', 'param.seed_offset', 'config.source')
 
 
 def _with_varied(rows: Any, by: list[str]) -> list[str]:
     """``by`` plus the fixed parameters that differ between the stored runs (``--set``)."""
-    extra = [c for c in _VARIED if c in rows.columns and rows[c].nunique(dropna=False) > 1]
+    extra = [
+        c
+        for c in _VARIED
+        if c not in by and c in rows.columns and rows[c].nunique(dropna=False) > 1
+    ]
     return [*extra, *by]
 
 
@@ -272,8 +276,11 @@ def _reference_section(page: ReportPage, key: str, by: list[str]) -> None:
     rows = page.rows
     if rows.empty:
         return
-    if len(_with_varied(rows, [])) > 0:
-        rows = rows[rows['param.profile'] == 'paper'] if 'param.profile' in rows else rows
+    # Beside the paper's figures: the paper profile on the paper's fields, where stored
+    # rows hold several profiles or source placements.
+    for column in ('param.profile', 'config.source'):
+        if column in rows and rows[column].nunique() > 1:
+            rows = rows[rows[column] == 'paper']
     found = rows[rows['metric.found'].astype(bool)]
     reference = {k: v[0] for k, v in PAPER[key].items()}
     if len(by) == 1:

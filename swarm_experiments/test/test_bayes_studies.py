@@ -104,3 +104,41 @@ def test_the_penalty_tables_lead_with_the_paper_profile_and_pair_p_with_o(tmp_pa
     assert by_profile['estimated-penalty']['losses'] == '6'  # P faster on every seed
     assert float(by_profile['estimated-penalty']['mean_diff']) == -0.1
     assert float(by_profile['estimated-penalty']['p_wilcoxon']) < 0.05
+
+
+def test_random_source_rows_stay_apart_and_out_of_the_paper_comparison(tmp_path):
+    import pandas as pd
+    from swarm_experiments.study import ReportPage
+
+    from swarm_experiments import bayes_studies
+
+    records = [
+        {
+            'status': 'ok',
+            'seed': seed,
+            'param.profile': 'paper',
+            'config.case': 'case2',
+            'config.source': source,
+            'config.variant': variant,
+            'metric.found': True,
+            'metric.tau': tau + 0.01 * seed,
+            'metric.tau_censored': tau + 0.01 * seed,
+        }
+        for source, tau in (('paper', 0.5), ('random', 2.0))
+        for seed in range(3)
+        for variant in ('p', 'o')
+    ]
+    page = ReportPage(tmp_path, {'study': 'bayes-table5-penalty'}, pd.DataFrame(records))
+    bayes_studies._report_penalty(page)
+    tau = page.exports['tau']
+    assert tau['columns'][:3] == ['source', 'case', 'variant']
+    means = {(row[0], row[2]): float(row[5]) for row in tau['rows']}
+    assert means == {
+        ('paper', 'p'): 0.51,
+        ('paper', 'o'): 0.51,
+        ('random', 'p'): 2.01,
+        ('random', 'o'): 2.01,
+    }
+    paper = {row[1]: row for row in page.exports['paper']['rows'] if row[0] == 'case2'}
+    assert float(paper['p'][2]) == 0.51  # the paper's field only
+    assert len(page.exports['paired']['rows']) == 2  # one per source placement
