@@ -229,19 +229,35 @@ def _median_ms(values: list[float]) -> float:
 
 
 # ---------------------------------------------------------------------------- reports
-_VARIED = ('param.profile', 'param.seed_offset')
+_VARIED = ('param.profile', 'param.seed_offset', 'config.source')
 
 
 def _with_varied(rows: Any, by: list[str]) -> list[str]:
     """``by`` plus the fixed parameters that differ between the stored runs (``--set``)."""
-    extra = [c for c in _VARIED if c in rows.columns and rows[c].nunique(dropna=False) > 1]
+    extra = [
+        c
+        for c in _VARIED
+        if c not in by and c in rows.columns and rows[c].nunique(dropna=False) > 1
+    ]
     return [*extra, *by]
+
+
+def _paper_first(frame: Any) -> Any:
+    """``frame`` with the rows of the ``paper`` profile first (the as-published setting leads
+    every table), the other profiles after it in name order; other rows keep their order."""
+    column = next((c for c in ('param.profile', 'profile') if c in frame.columns), None)
+    if column is None or frame.empty:
+        return frame
+    rank = frame[column].map(lambda name: (name != 'paper', str(name)))
+    order = sorted(range(len(frame)), key=lambda i: rank.iloc[i])
+    return frame.iloc[order].reset_index(drop=True)
 
 
 def _mean_std(rows: Any, by: list[str]) -> Any:
     import pandas as pd
 
     by = _with_varied(rows, by)
+    rows = _paper_first(rows)
     found = rows[rows['metric.found'].astype(bool)]
     table = (
         rows.groupby(by, sort=False)
@@ -260,8 +276,11 @@ def _reference_section(page: ReportPage, key: str, by: list[str]) -> None:
     rows = page.rows
     if rows.empty:
         return
-    if len(_with_varied(rows, [])) > 0:
-        rows = rows[rows['param.profile'] == 'paper'] if 'param.profile' in rows else rows
+    # Beside the paper's figures: the paper profile on the paper's fields, where stored
+    # rows hold several profiles or source placements.
+    for column in ('param.profile', 'config.source'):
+        if column in rows and rows[column].nunique() > 1:
+            rows = rows[rows[column] == 'paper']
     found = rows[rows['metric.found'].astype(bool)]
     reference = {k: v[0] for k, v in PAPER[key].items()}
     if len(by) == 1:
@@ -272,10 +291,14 @@ def _reference_section(page: ReportPage, key: str, by: list[str]) -> None:
         for r in table[by].itertuples(index=False)
     ]
     page.add_table(
-        _mean_std(page.rows, by), title='tau over the successful runs, and how many succeeded'
+        _mean_std(page.rows, by),
+        title='tau over the successful runs, and how many succeeded',
+        export='tau',
     )
     page.add_table(
-        table, title="tau beside the paper's published figures (paper profile, successful runs)"
+        table,
+        title="tau beside the paper's published figures (paper profile, successful runs)",
+        export='paper',
     )
 
 
@@ -292,7 +315,8 @@ def _paired_section(
         baseline=baseline,
         group_by=_with_varied(rows, group_by),
     )
-    page.add_table(table, title=title)
+    table = _paper_first(table)
+    page.add_table(table, title=title, export='paired')
     page.add_text(
         'Paired on the seed (the same scenario); tau_censored counts a failed run at the tau '
         'of the mission time limit. mean_diff < 0: the compared configuration is faster.'

@@ -267,7 +267,7 @@ def _report_oabug_faults(page: ReportPage) -> None:
         },
         OABUG_FAULTS,
     )
-    page.add_table(table, title='Reliability: OA-Bug Gas+Sound, Small, 10 robots')
+    page.add_table(table, title='Reliability: OA-Bug Gas+Sound, Small, 10 robots', export='faults')
 
 
 def _report_bayes_faults(page: ReportPage) -> None:
@@ -281,7 +281,7 @@ def _report_bayes_faults(page: ReportPage) -> None:
         {'metric.tau': 'tau (complete runs)', 'metric.found_pct': 'runs finding the source %'},
         BAYES_FAULTS,
     )
-    page.add_table(table, title='Reliability: Bayes-Swarm-P, case 1')
+    page.add_table(table, title='Reliability: Bayes-Swarm-P, case 1', export='faults')
 
 
 def _report_msc_faults(page: ReportPage) -> None:
@@ -299,7 +299,9 @@ def _report_msc_faults(page: ReportPage) -> None:
         },
         MSC_FAULTS,
     )
-    page.add_table(table, title='Reliability: MSC + PF (proposed), 15 robots, 10 targets')
+    page.add_table(
+        table, title='Reliability: MSC + PF (proposed), 15 robots, 10 targets', export='faults'
+    )
 
 
 def _report_sensors(page: ReportPage) -> None:
@@ -313,7 +315,11 @@ def _report_sensors(page: ReportPage) -> None:
         {'metric.coverage': 'coverage %', 'metric.complete_pct': 'runs covering all rooms %'},
         (),
     )
-    page.add_table(table, title='OA-Bug variants under both sensor profiles, Small, 10 robots')
+    page.add_table(
+        table,
+        title='OA-Bug variants under both sensor profiles, Small, 10 robots',
+        export='sensors',
+    )
 
 
 def studies() -> list[Study]:

@@ -63,3 +63,82 @@ def test_the_papers_published_numbers_are_written_down_for_every_table():
     assert PAPER['table5'][('case2', 'o')] == (0.75, 0.42)
     assert PAPER['table8'][('bayes_swarm_p', 0.47)] == (0.66, 0.47)
     assert set(PAPER) == {'table3', 'table4', 'table5', 'table6', 'table7', 'table8'}
+
+
+def test_the_penalty_tables_lead_with_the_paper_profile_and_pair_p_with_o(tmp_path):
+    import pandas as pd
+    from swarm_experiments.study import ReportPage
+
+    from swarm_experiments import bayes_studies
+
+    records = []
+    # The estimated-penalty rows come first in storage; the tables must still lead with paper.
+    for profile, p_gain in (('estimated-penalty', 0.1), ('paper', 0.0)):
+        for seed in range(6):
+            for variant in ('p', 'o'):
+                tau = 0.5 + 0.01 * seed - (p_gain if variant == 'p' else 0.0)
+                records.append(
+                    {
+                        'status': 'ok',
+                        'seed': seed,
+                        'param.profile': profile,
+                        'param.seed_offset': 101,
+                        'config.case': 'case1',
+                        'config.source': 'paper',
+                        'config.variant': variant,
+                        'metric.found': True,
+                        'metric.tau': tau,
+                        'metric.tau_censored': tau,
+                    }
+                )
+    page = ReportPage(tmp_path, {'study': 'bayes-table5-penalty'}, pd.DataFrame(records))
+    bayes_studies._report_penalty(page)
+    tau = page.exports['tau']
+    assert [row[0] for row in tau['rows']] == ['paper', 'paper', *['estimated-penalty'] * 2]
+    paired = page.exports['paired']
+    assert paired['columns'][:2] == ['variant', 'profile']
+    by_profile = {row[1]: dict(zip(paired['columns'], row, strict=True)) for row in paired['rows']}
+    assert [row[1] for row in paired['rows']] == ['paper', 'estimated-penalty']
+    assert by_profile['paper']['ties'] == '6'  # P = O on every seed: no test possible
+    assert by_profile['paper']['p_wilcoxon'] == ''
+    assert by_profile['estimated-penalty']['losses'] == '6'  # P faster on every seed
+    assert float(by_profile['estimated-penalty']['mean_diff']) == -0.1
+    assert float(by_profile['estimated-penalty']['p_wilcoxon']) < 0.05
+
+
+def test_random_source_rows_stay_apart_and_out_of_the_paper_comparison(tmp_path):
+    import pandas as pd
+    from swarm_experiments.study import ReportPage
+
+    from swarm_experiments import bayes_studies
+
+    records = [
+        {
+            'status': 'ok',
+            'seed': seed,
+            'param.profile': 'paper',
+            'config.case': 'case2',
+            'config.source': source,
+            'config.variant': variant,
+            'metric.found': True,
+            'metric.tau': tau + 0.01 * seed,
+            'metric.tau_censored': tau + 0.01 * seed,
+        }
+        for source, tau in (('paper', 0.5), ('random', 2.0))
+        for seed in range(3)
+        for variant in ('p', 'o')
+    ]
+    page = ReportPage(tmp_path, {'study': 'bayes-table5-penalty'}, pd.DataFrame(records))
+    bayes_studies._report_penalty(page)
+    tau = page.exports['tau']
+    assert tau['columns'][:3] == ['source', 'case', 'variant']
+    means = {(row[0], row[2]): float(row[5]) for row in tau['rows']}
+    assert means == {
+        ('paper', 'p'): 0.51,
+        ('paper', 'o'): 0.51,
+        ('random', 'p'): 2.01,
+        ('random', 'o'): 2.01,
+    }
+    paper = {row[1]: row for row in page.exports['paper']['rows'] if row[0] == 'case2'}
+    assert float(paper['p'][2]) == 0.51  # the paper's field only
+    assert len(page.exports['paired']['rows']) == 2  # one per source placement

@@ -11,6 +11,7 @@ from __future__ import annotations
 import argparse
 import logging
 import os
+import shlex
 import sys
 from collections.abc import Sequence
 from pathlib import Path
@@ -148,6 +149,11 @@ def _cmd_list(registry: StudyRegistry) -> int:
     return EXIT_OK
 
 
+def _command_line(argv: Sequence[str]) -> str:
+    """The command as typed, for the study's history (where the rows came from)."""
+    return shlex.join([PROG, *argv])
+
+
 def _cmd_run(registry: StudyRegistry, args: argparse.Namespace) -> int:
     plan = _plan(registry, args)
     if args.workers is not None and args.workers < 1:
@@ -171,7 +177,12 @@ def _cmd_run(registry: StudyRegistry, args: argparse.Namespace) -> int:
         return EXIT_INTERRUPTED
     with engine:
         summary = run_study(
-            plan, args.out, engine, progress=not args.quiet, batch_rows=args.batch_rows
+            plan,
+            args.out,
+            engine,
+            progress=not args.quiet,
+            batch_rows=args.batch_rows,
+            command=_command_line(args.argv),
         )
     print(
         f'{summary.study}: {summary.ok} ok, {summary.failed} failed, {summary.skipped} '
@@ -191,7 +202,12 @@ def _cmd_report(registry: StudyRegistry, args: argparse.Namespace) -> int:
     import matplotlib
 
     matplotlib.use('Agg')
-    pages = write_reports(args.directory, registry, on_hook_error=hook_error)
+    pages = write_reports(
+        args.directory,
+        registry,
+        on_hook_error=hook_error,
+        report_command=_command_line(args.argv),
+    )
     incomplete = 0
     for page in pages:
         directory = page.parent
@@ -228,6 +244,7 @@ def main(argv: Sequence[str] | None = None, *, registry: StudyRegistry | None = 
 
     def body(args_list: list[str]) -> int:
         args = build_parser().parse_args(args_list)
+        args.argv = list(args_list)
         studies = registry
         if studies is None:
             studies = load_registry(args.studies)

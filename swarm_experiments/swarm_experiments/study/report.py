@@ -9,6 +9,7 @@ configuration. A study's ``report`` hook then adds its own sections through the
 
 from __future__ import annotations
 
+import json
 import math
 import os
 import re
@@ -33,14 +34,19 @@ __all__ = [
     'markdown_table',
     'paired_differences',
     'reference_table',
+    'render_cells',
+    'results_document',
     'study_directories',
     'summary_table',
+    'table_cells',
     'write_reports',
 ]
 
 #: Most lines (configurations) one plot draws; more are left to the tables.
 MAX_LINES = 12
 MAX_BARS = 40
+#: The exported tables of a study, beside its report.md.
+RESULTS_NAME = 'results.json'
 
 
 def _short(column: str) -> str:
@@ -65,19 +71,35 @@ def _format(value: Any, digits: int) -> str:
     return str(value).replace('|', '\\|').replace('\n', ' ')
 
 
+def table_cells(frame: pd.DataFrame, *, digits: int = 3) -> dict[str, Any]:
+    """``frame`` as the plain data of a table: column names, which columns are numeric, and
+    every cell as the text the markdown table shows (index dropped)."""
+    return {
+        'columns': [_short(str(name)) for name in frame.columns],
+        'numeric': [bool(pd.api.types.is_numeric_dtype(frame[name])) for name in frame.columns],
+        'rows': [
+            [_format(value, digits) for value in row] for row in frame.itertuples(index=False)
+        ],
+    }
+
+
+def render_cells(cells: Mapping[str, Any]) -> str:
+    """The GitHub markdown table of :func:`table_cells` data (numbers right-aligned)."""
+    if not cells['rows']:
+        return '_no rows_'
+    lines = [
+        '| ' + ' | '.join(cells['columns']) + ' |',
+        '| ' + ' | '.join('---:' if flag else '---' for flag in cells['numeric']) + ' |',
+    ]
+    lines.extend('| ' + ' | '.join(row) + ' |' for row in cells['rows'])
+    return '\n'.join(lines)
+
+
 def markdown_table(frame: pd.DataFrame, *, digits: int = 3) -> str:
     """``frame`` as a GitHub markdown table (index dropped; numbers right-aligned)."""
     if frame.empty:
         return '_no rows_'
-    names = [_short(str(name)) for name in frame.columns]
-    numeric = [pd.api.types.is_numeric_dtype(frame[name]) for name in frame.columns]
-    lines = [
-        '| ' + ' | '.join(names) + ' |',
-        '| ' + ' | '.join('---:' if flag else '---' for flag in numeric) + ' |',
-    ]
-    for row in frame.itertuples(index=False):
-        lines.append('| ' + ' | '.join(_format(value, digits) for value in row) + ' |')
-    return '\n'.join(lines)
+    return render_cells(table_cells(frame, digits=digits))
 
 
 def _axes_columns(rows: pd.DataFrame, axes: Sequence[str]) -> list[str]:
@@ -270,6 +292,8 @@ class ReportPage:
         self.figure_dir = directory / 'figures'
         self._blocks: list[str] = []
         self._figures: list[Path] = []
+        #: Tables marked for the docs (``add_table(..., export=KEY)``): KEY -> title and cells.
+        self.exports: dict[str, dict[str, Any]] = {}
 
     @property
     def study(self) -> str:
@@ -281,10 +305,25 @@ class ReportPage:
     def add_text(self, text: str) -> None:
         self._blocks.append(text.strip())
 
-    def add_table(self, frame: pd.DataFrame, *, title: str | None = None, digits: int = 3) -> None:
+    def add_table(
+        self,
+        frame: pd.DataFrame,
+        *,
+        title: str | None = None,
+        digits: int = 3,
+        export: str | None = None,
+    ) -> None:
+        """Add a table; with ``export`` it is also written to ``results.json`` under that key,
+        for the docs' generated results sections (scripts/regenerate_results.py)."""
         if title:
             self.add_heading(title, 3)
         self._blocks.append(markdown_table(frame, digits=digits))
+        if export is not None:
+            if not re.fullmatch(r'[a-z0-9][a-z0-9_-]*', export):
+                raise UsageError(f'export key {export!r}: use lower-case letters, digits, - and _')
+            if export in self.exports:
+                raise UsageError(f'{self.study}: two tables exported as {export!r}')
+            self.exports[export] = {'title': title or '', **table_cells(frame, digits=digits)}
 
     def add_figure(self, figure: Figure, name: str, *, caption: str = '') -> Path:
         """Save ``figure`` as PNG beside the page, link it, and close it if pyplot made it."""
@@ -454,11 +493,15 @@ def write_reports(
     registry: StudyRegistry | None = None,
     *,
     on_hook_error: Callable[[str, Exception], None] | None = None,
+    report_command: str | None = None,
 ) -> list[Path]:
     """Write ``report.md`` (and ``figures/*.png``) in each study directory under ``directory``.
 
     A study found in ``registry`` adds its ``report`` hook's sections. A hook that raises is
     reported through ``on_hook_error`` (and the page notes it) when given, else re-raised.
+    When the page exports tables, ``results.json`` beside it holds them with the commands
+    that made them (:func:`results_document`; ``report_command`` is this report's command);
+    a page whose hook failed exports nothing (an older ``results.json`` is removed).
     Returns the pages written.
     """
     pages = []
@@ -468,6 +511,7 @@ def write_reports(
         page = ReportPage(study_dir, manifest, rows)
         _generic_sections(page)
         study = registry.find(page.study) if registry is not None else None
+        hook_failed = False
         if study is not None and study.report is not None and len(page.rows):
             try:
                 study.report(page)
@@ -475,11 +519,49 @@ def write_reports(
                 if on_hook_error is None:
                     raise
                 on_hook_error(page.study, exc)
+                hook_failed = True
                 page.add_text(f"_The study's report hook failed: {type(exc).__name__}: {exc}_")
         path = study_dir / 'report.md'
         try:
             path.write_text(page.markdown())
+            results = study_dir / RESULTS_NAME
+            if page.exports and not hook_failed:
+                document = results_document(page, report_command)
+                text = json.dumps(document, indent=1, ensure_ascii=False) + '\n'
+                temporary = results.with_name(results.name + '.tmp')
+                temporary.write_text(text, encoding='utf-8')
+                temporary.replace(results)
+            elif results.exists():
+                results.unlink()
         except OSError as exc:
             raise ResultsError(f'{path}: cannot write ({exc})') from exc
         pages.append(path)
     return pages
+
+
+def results_document(page: ReportPage, report_command: str | None = None) -> dict[str, Any]:
+    """The data of ``results.json``: the page's exported tables and where they came from.
+
+    ``commands`` lists the distinct ``swarm_study run`` command lines of the study's history
+    in the order first given (calls made without a recorded command are left out), then
+    ``report_command``.
+    """
+    commands: list[str] = []
+    for call in page.manifest.get('history', []):
+        command = call.get('command')
+        if command and command not in commands:
+            commands.append(command)
+    if report_command:
+        commands.append(report_command)
+    rows = page.rows
+    versions = sorted(str(v) for v in rows['code_version'].dropna().unique()) if len(rows) else []
+    return {
+        'study': page.study,
+        'smoke': bool(page.manifest.get('smoke', False)),
+        'commands': commands,
+        'runs_ok': len(rows),
+        'runs_failed': len(page.all_rows) - len(rows),
+        'cpu_s': round(float(rows['cpu_s'].sum()), 1) if 'cpu_s' in rows else None,
+        'code_versions': versions,
+        'tables': page.exports,
+    }

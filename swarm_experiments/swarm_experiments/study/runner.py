@@ -93,6 +93,7 @@ def run_study(
     batch_s: float = 30.0,
     code_version: str | None = None,
     on_row: Callable[[dict[str, Any]], None] | None = None,
+    command: str | None = None,
 ) -> RunSummary:
     """Execute the plan's runs that have no ``ok`` row in ``out_dir/<study>`` yet.
 
@@ -112,7 +113,10 @@ def run_study(
         history: list[dict[str, Any]] = []
         if (directory / 'study.json').exists():
             history = list(read_manifest(directory).get('history', []))
-        history.append({'started_utc': now, 'engine': engine.name, 'code_version': version})
+        call: dict[str, Any] = {'started_utc': now, 'engine': engine.name, 'code_version': version}
+        if command is not None:
+            call['command'] = command
+        history.append(call)
         manifest['history'] = history
         write_manifest(directory, manifest)
 
