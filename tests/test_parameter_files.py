@@ -58,6 +58,7 @@ ADDED = {
         'inner_optimizer': 'lbfgsb',
         'cobyla_max_iterations': 1000,
         'penalty_estimate': False,
+        'cobyla_library': 'nlopt',
     },
 }
 # Defaults changed on purpose since the recording (name -> new default): the Bayes-Swarm
