@@ -272,6 +272,38 @@ class MissionResult:
     bag_path: Path | None = None
     extension_outcomes: tuple[Mapping[str, Any], ...] = ()
 
+    @classmethod
+    def of_engine(
+        cls,
+        engine: SimEngine,
+        *,
+        robot_names: Sequence[str],
+        site: Any,
+        stop_reason: str,
+        wall_time_s: float,
+        times: list[float],
+        poses: list[np.ndarray],
+        bag_path: Path | None = None,
+    ) -> MissionResult:
+        """The outcome of a run that ended on ``engine``, with the poses stored at ``times``
+        (the final pose is appended when the last sample is older than the engine's time)."""
+        if times[-1] < engine.time_s:
+            times.append(engine.time_s)
+            poses.append(engine.world.poses)
+        return cls(
+            robot_names=tuple(robot_names),
+            site=site,
+            stop_reason=stop_reason,
+            sim_time_s=engine.time_s,
+            wall_time_s=wall_time_s,
+            rooms_total=engine.coverage.rooms_total,
+            room_entries=engine.coverage.entries,
+            trajectory_times_s=np.array(times),
+            trajectories=np.stack(poses),
+            distance_travelled_m=engine.distance_travelled_m.copy(),
+            bag_path=bag_path,
+        )
+
     @property
     def rooms_covered(self) -> int:
         """Rooms entered by the end."""
@@ -469,20 +501,14 @@ def run_mission(
         final = snapshot()
         if progress is not None:
             progress(final)
-        if observer.times[-1] < engine.time_s:
-            observer.times.append(engine.time_s)
-            observer.poses.append(engine.world.poses)
-        return MissionResult(
+        return MissionResult.of_engine(
+            engine,
             robot_names=bridge.robot_names,
             site=spec.site,
             stop_reason=str(state['reason']),
-            sim_time_s=engine.time_s,
             wall_time_s=final.wall_time_s,
-            rooms_total=engine.coverage.rooms_total,
-            room_entries=engine.coverage.entries,
-            trajectory_times_s=np.array(observer.times),
-            trajectories=np.stack(observer.poses),
-            distance_travelled_m=engine.distance_travelled_m.copy(),
+            times=observer.times,
+            poses=observer.poses,
             bag_path=spec.recording.path if spec.recording is not None else None,
         )
     finally:

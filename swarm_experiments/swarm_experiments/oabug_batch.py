@@ -252,20 +252,14 @@ def run_oabug_batch(
     final = snapshot()
     if progress is not None:
         progress(final)
-    if times[-1] < engine.time_s:
-        times.append(engine.time_s)
-        poses.append(engine.world.poses)
-    return MissionResult(
+    return MissionResult.of_engine(
+        engine,
         robot_names=names,
         site=site,
         stop_reason=reason,
-        sim_time_s=engine.time_s,
         wall_time_s=final.wall_time_s,
-        rooms_total=engine.coverage.rooms_total,
-        room_entries=engine.coverage.entries,
-        trajectory_times_s=np.array(times),
-        trajectories=np.stack(poses),
-        distance_travelled_m=engine.distance_travelled_m.copy(),
+        times=times,
+        poses=poses,
     )
 
 
