@@ -148,7 +148,9 @@ class OABugNode(Node):
     # Control loop.
 
     def _on_control(self) -> None:
-        now_s = self._now_s()
+        now = self.get_clock().now()
+        now_s = now.nanoseconds * 1e-9
+        stamp = now.to_msg()
         loop = self.loop
         try:
             loop.update_features(now_s)
@@ -156,18 +158,18 @@ class OABugNode(Node):
             self._log_once_per_period('scan', f'ignoring laser scan: {err}')
         output = loop.step(now_s)
         if output.stale:
-            self._hold_stopped(now_s, output.stale)
+            self._hold_stopped(now_s, stamp, output.stale)
             return
         command = output.command
         self._cmd_pub.publish(command_to_twist(command))
         self._pump_pub.publish(command_to_pump(command.pump_on))
-        self._publish_state(now_s, pump_on=command.pump_on, stale=False)
+        self._publish_state(now_s, stamp, pump_on=command.pump_on, stale=False)
 
-    def _hold_stopped(self, now_s: float, stale: Sequence[str]) -> None:
+    def _hold_stopped(self, now_s: float, stamp: Any, stale: Sequence[str]) -> None:
         """Fail safe: zero velocity and pump off while an input is missing or stale."""
         self._cmd_pub.publish(stop_twist())
         self._pump_pub.publish(command_to_pump(False))
-        self._publish_state(now_s, pump_on=False, stale=True)
+        self._publish_state(now_s, stamp, pump_on=False, stale=True)
         never = [name for name in stale if name not in self.loop.heard]
         if never:
             self._log_once_per_period(
@@ -179,8 +181,11 @@ class OABugNode(Node):
                 f'holding still, no fresh {", ".join(stale)} within {self._stale_timeout_s:.2f} s',
             )
 
-    def _publish_state(self, now_s: float, *, pump_on: bool, stale: bool) -> None:
-        """Publish the state at ``state_rate_hz``, and at once on an event or a stale change."""
+    def _publish_state(self, now_s: float, stamp: Any, *, pump_on: bool, stale: bool) -> None:
+        """Publish the state at ``state_rate_hz``, and at once on an event or a stale change.
+
+        ``stamp`` is the control step's time (the time ``now_s`` in seconds) as a message.
+        """
         due = not 0.0 <= now_s - self._last_state_s < self._state_period_s
         changed = stale != self._last_state_stale
         event = not stale and self.fsm.memory.event is not Event.NONE
@@ -193,7 +198,7 @@ class OABugNode(Node):
             state_to_ros(
                 self.fsm.memory,
                 self._config,
-                stamp=self.get_clock().now().to_msg(),
+                stamp=stamp,
                 heading_rad=loop.yaw_rad,
                 pump_on=pump_on,
                 gas_raw=loop.gas_raw,
