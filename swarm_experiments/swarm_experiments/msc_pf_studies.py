@@ -50,6 +50,28 @@ VARIANTS: dict[str, tuple[str, dict[str, Any]]] = {
     'msc-gather': ('msc', {'swarm.search_alone': True}),
     'proposed-solo': ('proposed', {'swarm.max_size': 1}),
     'proposed-gather': ('proposed', {'swarm.search_alone': True}),
+    'msc-sweep': ('msc', {'swarm.search_alone': True, 'search.mode': 'sector'}),
+    'msc-sweep-swarm': ('msc', {'search.mode': 'sector'}),
+    'msc-sweep-pbest': (
+        'msc',
+        {'swarm.search_alone': True, 'search.mode': 'sector', **PBEST_FINISHING},
+    ),
+    'proposed-sweep': (
+        'proposed',
+        {
+            'swarm.search_alone': True,
+            'search.mode': 'sector',
+            'search.coverage_prior_weight': 0.05,
+            'phases.non_detection_window_s': 120.0,
+            'particle_filter.censored_likelihood': False,
+            'phases.pursue_memory_s': 30.0,
+            'phases.far_aim': 'estimate',
+            'phases.near_estimate_spread_m': 15.0,
+            'phases.max_pursuers': 2,
+            'phases.converged_give_up_m': 200.0,
+            'phases.converged_max_age_s': 600.0,
+        },
+    ),
 }
 
 MSC_VARIANTS = tuple(v for v, (scheme, _) in VARIANTS.items() if scheme == 'msc')
