@@ -95,6 +95,21 @@ class SectorSweep:
         row = np.clip((points[:, 1] // self.cell_size_m).astype(np.int64), 0, last)
         return self.covered[row, col]
 
+    def sector_offset(self, point_m: np.ndarray) -> int:
+        """How many sectors the point's sector is from the own one (0 without a plan)."""
+        if self.sector is None or self.centre_m is None:
+            return 0
+        rank, n = self.sector
+        other = int(sector_of(np.asarray(point_m, dtype=np.float64), self.centre_m, n)[0])
+        step = abs(other - rank)
+        return min(step, n - step)
+
+    def own_sector_covered(self) -> bool:
+        """True when every cell of the own sector is covered (False without a plan)."""
+        if self._sector_cells is None:
+            return False
+        return bool(self.covered.ravel()[self._sector_cells].all())
+
     def covered_share(self, sector_only: bool = False) -> float:
         """Share of the field (or of the own sector) covered as far as this robot knows."""
         if sector_only and self._sector_cells is not None:

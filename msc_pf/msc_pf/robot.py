@@ -534,7 +534,7 @@ class RobotController:
                 if p.target_id == target and math.isfinite(p.target_rssi_dbm)
             ]
             n_closer = count_closer_heading_to(mean, others)
-            if 0 < self.config.phases.max_pursuers <= n_closer:
+            if 0 < self.config.phases.max_pursuers <= n_closer or self._beyond_reach(target):
                 continue
             value = evaluation_value(
                 mean, n_closer, msc.dispersion_degree, msc.dispersion_threshold
@@ -546,6 +546,17 @@ class RobotController:
         ):
             return self.target_id
         return best
+
+    def _beyond_reach(self, target: int) -> bool:
+        """Sector search: ``target``'s estimate lies beyond ``search.sector_reach`` sectors
+        of the own one, which is not covered yet (the robot leaves it to others)."""
+        reach = self.config.search.sector_reach
+        sweep, bank = self._sweep, self._bank
+        if reach < 0 or sweep is None or bank is None or not bank.is_tracked(target):
+            return False
+        if sweep.sector_offset(bank.estimate(target).position_m) <= reach:
+            return False
+        return not sweep.own_sector_covered()
 
     def _keeps_converged(self, target: int) -> bool:
         """True when a lost ``target`` is still pursued on its converged estimate."""
@@ -568,6 +579,7 @@ class RobotController:
             and target not in self._captured
             and self._bank.is_tracked(target)
             and now_s - self._last_sampled_s.get(target, -math.inf) <= memory
+            and not self._beyond_reach(target)
         )
 
     def _evaluation(self, target: int, now_s: float) -> float:
@@ -599,6 +611,7 @@ class RobotController:
             for e in self._bank.estimates()
             if e.converged
             and e.target_id not in self._captured
+            and not self._beyond_reach(e.target_id)
             and (
                 max_age <= 0.0
                 or self._last_sampled_s.get(e.target_id, -math.inf) >= now_s - max_age
@@ -616,6 +629,7 @@ class RobotController:
                 for e in self._bank.estimates()
                 if not e.converged
                 and e.target_id not in self._captured
+                and not self._beyond_reach(e.target_id)
                 and self._last_sampled_s.get(e.target_id, -math.inf) >= oldest
             ]
             choice = select_retarget(

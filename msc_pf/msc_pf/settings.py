@@ -277,6 +277,16 @@ class SearchConfig:
         ge=0.0,
         le=1.0,
     )
+    sector_reach: int = parameter(
+        -1,
+        (
+            "'sector' search, PF schemes: until its own sector is covered, a robot takes "
+            'only targets whose estimate lies within this many sectors of its own (0: its '
+            'own sector only) and leaves the others to the robots sweeping there; -1 = any '
+            'target. Targets near the start are heard by every robot at once.'
+        ),
+        ge=-1,
+    )
     sweep_radius_m: float = parameter(
         250.0,
         (
