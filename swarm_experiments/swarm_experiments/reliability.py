@@ -8,6 +8,11 @@ Registered with ``swarm_study`` (entry point ``swarm_experiments.studies``):
 * ``faults-bayes``: Bayes-Swarm-P, case 1, on the batch runner: tau and the detection rate;
 * ``faults-msc``: MSC + PF, the proposed scheme (15 robots, 10 targets): the capture
   completion time (CCT) and the share of runs that capture every target;
+* ``faults-crash``: one robot's node process killed mid-run, and killed and restarted, for
+  each algorithm, on real rclpy with one process per node (``--processes``): the mission's
+  metric, and whether the crashed robot stopped, moved again after the restart and how long
+  the restart took. These runs are in real time, so unlike the other studies they are not
+  deterministic (the machine's load is recorded with each run);
 * ``sensors-oabug``: every OA-Bug variant on Small sites from both departures, under the
   ``ideal`` and the ``realistic`` sensor profile.
 
@@ -21,6 +26,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import time
 from collections.abc import Mapping, Sequence
 from typing import Any
 
@@ -204,6 +210,208 @@ def run_msc_fault(spec: RunSpec) -> dict[str, Any]:
     }
 
 
+@dataclasses.dataclass(frozen=True)
+class CrashMission:
+    """The mission of one algorithm in the ``faults-crash`` study.
+
+    Attributes:
+        spawner: the spawner's console script.
+        argv: its options (the seed options are added per run).
+        seed_options: the options that take the run's seed.
+        time_scale: the bridge's real-time factor.
+        crash_s: when robot ``CRASH_ROBOT``'s node is killed [s sim].
+        restart_after_s: how much later it is started again [s sim].
+    """
+
+    spawner: str
+    argv: tuple[str, ...]
+    seed_options: tuple[str, ...]
+    time_scale: float
+    crash_s: float
+    restart_after_s: float
+
+
+#: The crashed robot (r1: never the bridge's first robot, never the last).
+CRASH_ROBOT = 1
+#: Per algorithm, a small swarm and a short mission: real-time runs on a shared machine.
+CRASH_MISSIONS = {
+    'oabug': CrashMission(
+        'spawn',
+        ('--robots', '4', '--actions', '300', '--profile', 'paper'),
+        ('--seed', '--site-seed'),
+        2.0,
+        30.0,
+        10.0,
+    ),
+    'bayes_swarm': CrashMission(
+        'spawn_bayes_swarm', ('--robots', '3'), ('--seed',), 1.0, 10.0, 5.0
+    ),
+    'msc_pf': CrashMission(
+        'spawn_msc_pf',
+        (
+            '--robots',
+            '4',
+            '--targets',
+            '2',
+            '--target-positions',
+            '1000,1060;1060,1000',
+            '--t-max',
+            '250',
+        ),
+        ('--seed',),
+        2.0,
+        40.0,
+        20.0,
+    ),
+}
+CRASH_SCENARIOS = ('none', 'crash', 'restart')
+# A robot counts as moving again once it is this far from where it stood [m].
+_MOVED_M = 0.05
+
+
+def crash_item(mission: CrashMission, scenario: str) -> list[str]:
+    """The ``--fault`` options of a scenario: none, a crash, or a crash and a restart."""
+    if scenario == 'none':
+        return []
+    item = f'crash:r{CRASH_ROBOT}@{mission.crash_s:g}'
+    if scenario == 'restart':
+        item += f'+{mission.restart_after_s:g}'
+    return ['--fault', item]
+
+
+def path_length_m(
+    times_s: np.ndarray, positions_m: np.ndarray, start_s: float, end_s: float
+) -> float:
+    """Length [m] of the (T, 2) sampled path between ``start_s`` and ``end_s``."""
+    inside = (times_s >= start_s - 1e-9) & (times_s <= end_s + 1e-9)
+    if np.count_nonzero(inside) < 2:
+        return 0.0
+    return float(np.hypot(*np.diff(positions_m[inside], axis=0).T).sum())
+
+
+def first_move_s(times_s: np.ndarray, positions_m: np.ndarray, after_s: float) -> float:
+    """The first sample time from ``after_s`` on at which the robot is more than 5 cm from
+    where it stood at ``after_s`` (NaN: it never moved again)."""
+    inside = np.flatnonzero(times_s >= after_s - 1e-9)
+    if inside.size == 0:
+        return math.nan
+    start = positions_m[inside[0]]
+    away = np.hypot(*(positions_m[inside] - start).T) > _MOVED_M
+    return float(times_s[inside[np.argmax(away)]]) if away.any() else math.nan
+
+
+def crash_metrics(
+    mission: CrashMission, scenario: str, outcome: Mapping[str, Any]
+) -> dict[str, Any]:
+    """The ``faults-crash`` row of one run from its bridge outcome (``outcome.json``)."""
+    times = np.asarray(outcome['trajectory_times_s'], dtype=float)
+    n = len(outcome['robot_names'])
+    paths = np.asarray(outcome['trajectories'], dtype=float).reshape(len(times), n, 3)[..., :2]
+    end_s = float(outcome['sim_time_s'])
+    row: dict[str, Any] = {'sim_time_s': end_s, 'stop_reason': str(outcome['stop_reason'])}
+    extension = (outcome.get('extensions') or [{}])[0]
+    if extension.get('kind') == 'signal':
+        row['found'] = bool(extension['found'])
+        row['tau'] = math.nan if extension['tau'] is None else float(extension['tau'])
+    elif extension.get('kind') == 'rssi':
+        captured = [t for t in extension['capture_times_s'] if t is not None]
+        row['captured'] = len(captured)
+        row['all_captured'] = bool(extension['all_captured'])
+        row['cct_s'] = max(captured) if row['all_captured'] else math.nan
+    else:
+        entries = outcome['room_entries']
+        row['coverage'] = 100.0 * len({int(e[0]) for e in entries}) / int(outcome['rooms_total'])
+    crashed = paths[:, CRASH_ROBOT]
+    others = [i for i in range(n) if i != CRASH_ROBOT]
+    nan = math.nan
+    row.update(down_moved_m=nan, restart_delay_s=nan, restart_moved_m=nan, others_moved_m=nan)
+    if scenario == 'none' or end_s < mission.crash_s:
+        return row
+    # Down from the kill plus the bridge's cmd_vel timeout, up at the restart (or the end).
+    restart_s = mission.crash_s + mission.restart_after_s if scenario == 'restart' else end_s
+    down_end_s = min(restart_s, end_s)
+    row['down_moved_m'] = path_length_m(times, crashed, mission.crash_s + 1.0, down_end_s)
+    row['others_moved_m'] = min(
+        path_length_m(times, paths[:, i], mission.crash_s, down_end_s) for i in others
+    )
+    if scenario == 'restart' and restart_s < end_s:
+        moving_s = first_move_s(times, crashed, restart_s)
+        row['restart_delay_s'] = moving_s - restart_s
+        row['restart_moved_m'] = path_length_m(times, crashed, restart_s, end_s)
+    return row
+
+
+def run_crash(spec: RunSpec) -> dict[str, Any]:
+    """One ``faults-crash`` run: the spawner with ``--processes`` in a DDS domain of its own
+    (kept on this machine), the crash fault of the scenario, metrics from its outcome."""
+    import json
+    import os
+    import resource
+    import subprocess
+    import sys
+    import tempfile
+    from pathlib import Path
+
+    from swarm_runtime.dds_isolation import reserve_test_domain
+
+    cfg = spec.config
+    mission = CRASH_MISSIONS[cfg['algorithm']]
+    seed = [str(v) for option in mission.seed_options for v in (option, spec.seed)]
+    reservation = reserve_test_domain(int(cfg['domain_id']))
+    env = dict(
+        os.environ,
+        ROS_DOMAIN_ID=str(reservation.domain_id),
+        ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST',
+    )
+    children_cpu = resource.getrusage(resource.RUSAGE_CHILDREN)
+    load = os.getloadavg()[0]
+    wall_start = time.perf_counter()
+    try:
+        with tempfile.TemporaryDirectory(prefix='faults-crash-') as directory:
+            run_dir = Path(directory)
+            argv = [
+                str(Path(sys.executable).parent / mission.spawner),
+                *mission.argv,
+                *seed,
+                '--processes',
+                '--run-dir',
+                str(run_dir),
+                '--time-scale',
+                f'{mission.time_scale:g}',
+                '--no-plots',
+                '--quiet',
+                *crash_item(mission, cfg['scenario']),
+            ]
+            done = subprocess.run(argv, capture_output=True, text=True, env=env, check=False)
+            if done.returncode not in (0, 1):
+                lines = done.stderr.strip().splitlines()
+                msg = f'{mission.spawner} exited {done.returncode}: {lines[-1] if lines else ""}'
+                raise RuntimeError(msg)
+            outcome = json.loads((run_dir / 'outcome.json').read_text())
+    finally:
+        reservation.release()
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    row = crash_metrics(mission, cfg['scenario'], outcome)
+    row['processes_cpu_s'] = (after.ru_utime + after.ru_stime) - (
+        children_cpu.ru_utime + children_cpu.ru_stime
+    )
+    row['wall_s'] = time.perf_counter() - wall_start
+    row['load'] = 0.5 * (load + os.getloadavg()[0])
+    return row
+
+
+def check_crash(config: Mapping[str, Any]) -> None:
+    """The ``faults-crash`` runs need real rclpy (``--processes``)."""
+    import importlib.util
+
+    from swarm_experiments.study.errors import UsageError
+
+    if importlib.util.find_spec('rclpy') is None:
+        raise UsageError('faults-crash runs the nodes with --processes: it needs real rclpy')
+    if config['algorithm'] not in CRASH_MISSIONS or config['scenario'] not in CRASH_SCENARIOS:
+        raise UsageError(f'faults-crash: unknown algorithm or scenario in {dict(config)}')
+
+
 def _planned(page: ReportPage, order: Sequence[str]) -> pd.DataFrame:
     """The rows of the seeds of the last plan and, when ``order`` is given, of the fault
     scenarios the study declares now (rows of older plans stay stored but are left out)."""
@@ -304,6 +512,60 @@ def _report_msc_faults(page: ReportPage) -> None:
     )
 
 
+_CRASH_TABLES = {
+    'oabug': (
+        'OA-Bug Gas+Sound (paper profile), Small, 4 robots, 100 s',
+        {
+            'metric.coverage': 'coverage %',
+        },
+    ),
+    'bayes_swarm': (
+        'Bayes-Swarm-P (paper profile), case 1, 3 robots',
+        {
+            'metric.tau': 'tau (complete runs)',
+            'metric.found_pct': 'runs finding the source %',
+        },
+    ),
+    'msc_pf': (
+        'MSC + PF (proposed), 4 robots, 2 targets, 250 s',
+        {
+            'metric.cct_s': 'CCT s (complete runs)',
+            'metric.all_pct': 'runs capturing all %',
+        },
+    ),
+}
+_CRASH_COLUMNS = {
+    'metric.down_moved_m': 'r1 moved while down m',
+    'metric.restart_delay_s': 'restart to moving s',
+    'metric.restart_moved_m': 'r1 moved after restart m',
+    'metric.others_moved_m': 'least others moved while r1 down m',
+    'metric.wall_s': 'wall s',
+    'metric.load': 'load',
+}
+
+
+def _report_crash(page: ReportPage) -> None:
+    rows = _planned(page, ())
+    if rows.empty:
+        return
+    for column, share in (
+        ('metric.found', 'metric.found_pct'),
+        ('metric.all_captured', 'metric.all_pct'),
+    ):
+        if column in rows.columns:
+            rows = rows.assign(**{share: 100.0 * pd.to_numeric(rows[column]).astype(float)})
+    for algorithm, (title, metrics) in _CRASH_TABLES.items():
+        of = rows[rows['config.algorithm'] == algorithm]
+        if of.empty:
+            continue
+        table = _summary(of, ['config.scenario'], {**metrics, **_CRASH_COLUMNS}, ())
+        rank = {s: i for i, s in enumerate(CRASH_SCENARIOS)}
+        table = table.sort_values('scenario', key=lambda s: s.map(rank), kind='stable')
+        page.add_table(
+            table.reset_index(drop=True), title=f'Node crash: {title}', export=f'crash-{algorithm}'
+        )
+
+
 def _report_sensors(page: ReportPage) -> None:
     rows = _planned(page, ())
     if rows.empty:
@@ -374,6 +636,20 @@ def studies() -> list[Study]:
                 params={'targets': 3, 'max_time_s': 3000.0},
             ),
             report=_report_msc_faults,
+        ),
+        Study(
+            name='faults-crash',
+            run=run_crash,
+            axes={'algorithm': tuple(CRASH_MISSIONS), 'scenario': CRASH_SCENARIOS},
+            params={'domain_id': 90},
+            runs=3,
+            description=(
+                'A robot node killed (and restarted) mid-run, one process per node on real '
+                'rclpy, in real time.'
+            ),
+            smoke=Smoke(runs=1, axes={'algorithm': ('oabug',), 'scenario': ('restart',)}),
+            report=_report_crash,
+            check=check_crash,
         ),
         Study(
             name='sensors-oabug',

@@ -1,5 +1,6 @@
 """The reliability studies: registered, their scenarios valid, their tables right."""
 
+import numpy as np
 import pandas as pd
 import pytest
 from swarm_experiments.study import ReportPage, load_registry, make_specs
@@ -9,7 +10,7 @@ from swarm_experiments import reliability
 
 def test_the_studies_are_registered_through_the_entry_point():
     registry = load_registry()
-    for name in ('faults-oabug', 'faults-bayes', 'faults-msc', 'sensors-oabug'):
+    for name in ('faults-oabug', 'faults-bayes', 'faults-msc', 'faults-crash', 'sensors-oabug'):
         study = registry.get(name)
         assert make_specs(study, smoke=True).specs
 
@@ -45,3 +46,49 @@ def test_the_reliability_table_keeps_the_planned_seeds_and_orders_the_faults(tmp
     assert lines[0].startswith('| center | none | 2 | 95 ± 7.1 | 50 |')
     assert lines[1].startswith('| center | dropout_robots=2 | 2 | 85 ± 7.1 | 0 |')
     assert lines[1].split('|')[7].strip() == '1'  # one run had a stuck survivor
+
+
+def _outcome(times, r1_x, extension=None):
+    """A bridge outcome of 3 robots driving along x at 0.1 m/s, r1 along ``r1_x``."""
+    n = len(times)
+    poses = np.zeros((n, 3, 3))
+    poses[:, 0, 0] = poses[:, 2, 0] = 0.1 * times
+    poses[:, 1, 0] = r1_x
+    return {
+        'trajectory_times_s': times.tolist(),
+        'robot_names': ['r0', 'r1', 'r2'],
+        'trajectories': poses.tolist(),
+        'sim_time_s': float(times[-1]),
+        'stop_reason': 'budget',
+        'room_entries': [[0, 0, 1.0], [3, 2, 5.0], [3, 1, 9.0]],
+        'rooms_total': 10,
+        'extensions': [] if extension is None else [extension],
+    }
+
+
+def test_crash_metrics_see_the_robot_stop_and_move_again():
+    mission = reliability.CrashMission('spawn', (), ('--seed',), 1.0, 30.0, 10.0)
+    times = np.arange(0.0, 100.5, 0.5)
+    # r1 drives, stops 0.5 s after the kill at 30 s, moves again 4 s after the restart at 40 s.
+    speed = np.where((times > 30.5) & (times < 44.0), 0.0, 0.1)
+    r1_x = np.concatenate(([0.0], np.cumsum(speed[1:] * 0.5)))
+    row = reliability.crash_metrics(mission, 'restart', _outcome(times, r1_x))
+    assert row['coverage'] == 20.0  # rooms 0 and 3 of 10
+    assert row['down_moved_m'] == 0.0
+    assert row['restart_delay_s'] == 4.5  # the first sample more than 5 cm away
+    assert row['restart_moved_m'] == pytest.approx(0.1 * (100.0 - 43.5))
+    assert row['others_moved_m'] == pytest.approx(1.0)
+    # Killed for good: it stays where it stopped; no restart figures.
+    frozen = np.minimum(r1_x, r1_x[times == 30.5][0])
+    row = reliability.crash_metrics(mission, 'crash', _outcome(times, frozen))
+    assert row['down_moved_m'] == 0.0
+    assert np.isnan(row['restart_delay_s'])
+    assert np.isnan(row['restart_moved_m'])
+    signal = {'kind': 'signal', 'found': True, 'tau': 0.5, 'found_time_s': 20.0, 'finder': 0}
+    row = reliability.crash_metrics(mission, 'none', _outcome(times, 0.1 * times, signal))
+    assert (row['found'], row['tau']) == (True, 0.5)
+    assert np.isnan(row['down_moved_m'])
+    rssi = {'kind': 'rssi', 'capture_times_s': [50.0, None], 'all_captured': False}
+    row = reliability.crash_metrics(mission, 'crash', _outcome(times, frozen, rssi))
+    assert (row['captured'], row['all_captured']) == (1, False)
+    assert np.isnan(row['cct_s'])
