@@ -54,10 +54,18 @@ OABUG_FAULTS = (
     'dropout_robots=2',
     'dropout_robots=5',
     'dropout_robots=8',
+    'stale_lidar_robots=1',
     'stale_lidar_robots=2',
+    'stale_lidar_robots=4',
     'stuck_gas_robots=3',
-    'drifting_gas_robots=3',
-    'imu_drift_robots=3',
+    'drifting_gas_robots=3;gas_drift_per_s=0.5',
+    'drifting_gas_robots=3;gas_drift_per_s=2',
+    'drifting_gas_robots=3;gas_drift_per_s=8',
+    'imu_drift_robots=3;imu_drift_radps=0.00175',  # 0.1 deg/s
+    'imu_drift_robots=3;imu_drift_radps=0.00873',  # 0.5 deg/s
+    'imu_drift_robots=3;imu_drift_radps=0.0349',  # 2 deg/s
+    'bearing_dropout_probability=0.3',
+    'bearing_dropout_probability=0.6',
     'bearing_dropout_probability=0.9',
 )
 BAYES_FAULTS = (
@@ -65,27 +73,60 @@ BAYES_FAULTS = (
     'dropout_robots=1',
     'dropout_robots=2',
     'dropout_robots=4',
-    'comm_loss_probability=0.5',
+    'comm_loss_probability=0.3',
+    'comm_loss_probability=0.6',
     'comm_loss_probability=0.9',
+    'comm_loss_probability=1',
+    'comm_range_m=1',
     'comm_range_m=0.5',
+    'comm_range_m=0.25',
+    'stuck_gas_robots=1',
+    'stuck_gas_robots=2',
+    'drifting_gas_robots=1;gas_drift_per_s=0.002',
+    'drifting_gas_robots=1;gas_drift_per_s=0.01',
+    'drifting_gas_robots=1;gas_drift_per_s=0.05',
 )
 MSC_FAULTS = (
     'none',
     'dropout_robots=3',
     'dropout_robots=7',
     'comm_loss_probability=0.5',
+    'comm_loss_probability=0.9',
+    'comm_range_m=150',
     'comm_range_m=75',
 )
 # A robot that stood still longer than this while it should work counts as stuck [s].
 STUCK_LIMIT_S = 20.0
+# Two robots whose centres are this close touch, or nearly (bodies of 0.1 m radius) [m].
+CONTACT_M = 0.25
 
 
 def parse_fault(scenario: str, onset_s: float) -> FaultConfig:
-    """The faults of a scenario string (comma-separated ``--fault`` items, or ``'none'``),
-    with dropouts and sensor faults starting at ``onset_s``."""
-    items = [] if scenario == 'none' else [i for i in scenario.split(',') if i.strip()]
+    """The faults of a scenario string (``--fault`` items joined by ``;`` or ``,``, or
+    ``'none'``), with dropouts and sensor faults starting at ``onset_s``. The studies' own
+    scenarios use ``;``, so that ``--set fault=A,B`` can pick several of them."""
+    parts = scenario.replace(';', ',').split(',')
+    items = [] if scenario == 'none' else [i.strip() for i in parts if i.strip()]
     items += [f'dropout_time_s={onset_s}', f'sensor_time_s={onset_s}']
     return fault_config(items)
+
+
+def still_spell(
+    times_s: np.ndarray, positions_m: np.ndarray, *, tolerance_m: float = 0.05
+) -> tuple[float, float, float]:
+    """The longest interval over which a robot's (T, 2) sampled positions stayed within
+    ``tolerance_m`` of where the interval began: (duration, start, end) [s]; a robot that
+    never stood still gives (0, 0, 0)."""
+    longest = (0.0, 0.0, 0.0)
+    anchor = 0
+    for k in range(1, len(times_s)):
+        if np.hypot(*(positions_m[k] - positions_m[anchor])) > tolerance_m:
+            anchor = k
+        else:
+            duration = float(times_s[k] - times_s[anchor])
+            if duration > longest[0]:
+                longest = (duration, float(times_s[anchor]), float(times_s[k]))
+    return longest
 
 
 def still_time_s(
@@ -93,14 +134,34 @@ def still_time_s(
 ) -> float:
     """The longest interval [s] over which a robot's (T, 2) sampled positions stayed within
     ``tolerance_m`` of where the interval began (0 for a robot that never stood still)."""
-    longest = 0.0
-    anchor = 0
-    for k in range(1, len(times_s)):
-        if np.hypot(*(positions_m[k] - positions_m[anchor])) > tolerance_m:
-            anchor = k
+    return still_spell(times_s, positions_m, tolerance_m=tolerance_m)[0]
+
+
+def stuck_causes(
+    times_s: np.ndarray, positions_m: np.ndarray, working: np.ndarray, stopped_from_s: float
+) -> dict[str, int]:
+    """The working robots (``working``: (N,) bool) that stood still longer than
+    :data:`STUCK_LIMIT_S`, by what touched them meanwhile (``positions_m``: (T, N, 2)):
+    ``stuck_by_stopped``: a robot that no longer worked (one of ``~working``, from
+    ``stopped_from_s`` on); ``stuck_by_peer``: only working robots; ``stuck_alone``: no robot
+    within :data:`CONTACT_M` (walls only)."""
+    causes = {'stuck_by_stopped': 0, 'stuck_by_peer': 0, 'stuck_alone': 0}
+    for i in np.flatnonzero(working):
+        duration, start, end = still_spell(times_s, positions_m[:, i])
+        if duration <= STUCK_LIMIT_S:
+            continue
+        during = (times_s >= start) & (times_s <= end)
+        gaps = np.hypot(*np.moveaxis(positions_m[during] - positions_m[during, i][:, None], -1, 0))
+        touching = gaps <= CONTACT_M  # (T', N)
+        touching[:, i] = False
+        stopped = touching[times_s[during] >= stopped_from_s][:, ~working]
+        if stopped.any():
+            causes['stuck_by_stopped'] += 1
+        elif touching.any():
+            causes['stuck_by_peer'] += 1
         else:
-            longest = max(longest, float(times_s[k] - times_s[anchor]))
-    return longest
+            causes['stuck_alone'] += 1
+    return causes
 
 
 def _oabug(spec: RunSpec, engine: EngineConfig, variant: str, departure: str) -> Any:
@@ -116,6 +177,7 @@ def _oabug(spec: RunSpec, engine: EngineConfig, variant: str, departure: str) ->
         robots=int(cfg['robots']),
         departure=departure,
         engine=engine,
+        profile=str(cfg.get('profile', 'tuned')),
     )
     return run_spawn_batch(settings).mission
 
@@ -131,11 +193,12 @@ def run_oabug_fault(spec: RunSpec) -> dict[str, Any]:
     # The robots expected to keep driving: all but the dropped and the lidar-less ones.
     idle = plan.mask('dropout') | plan.mask('stale_lidar')
     times = mission.trajectory_times_s
-    still = [still_time_s(times, mission.trajectories[:, i, :2]) for i in range(n) if not idle[i]]
+    positions = mission.trajectories[:, :, :2]
+    still = [still_time_s(times, positions[:, i]) for i in range(n) if not idle[i]]
     # A lidar-less robot must stop within the stale timeout (0.5 s) plus a control period.
     late = times >= onset + 2.0
     stopped_moves = [
-        float(np.hypot(*np.diff(mission.trajectories[late, i, :2], axis=0).T).sum())
+        float(np.hypot(*np.diff(positions[late, i], axis=0).T).sum())
         for i in np.flatnonzero(plan.mask('stale_lidar'))
     ]
     return {
@@ -145,6 +208,7 @@ def run_oabug_fault(spec: RunSpec) -> dict[str, Any]:
         'survivors': int(n - plan.mask('dropout').sum()),
         'max_still_s': max(still, default=0.0),
         'stuck_survivors': int(sum(s > STUCK_LIMIT_S for s in still)),
+        **stuck_causes(times, positions, ~idle, onset),
         'faulty_moved_m': max(stopped_moves, default=0.0),
     }
 
@@ -161,6 +225,15 @@ def run_oabug_sensors(spec: RunSpec) -> dict[str, Any]:
     }
 
 
+def decisions_after_s(waypoints_m: np.ndarray, speed_mps: float, time_s: float) -> int:
+    """How many of a Bayes-Swarm robot's legs started at or after ``time_s``: the robot flies
+    its (k, 2) path (start, waypoints, end) at ``speed_mps`` without stopping, and every
+    waypoint but the end was a decision."""
+    legs = np.hypot(*np.diff(waypoints_m, axis=0).T)
+    starts_s = np.concatenate(([0.0], np.cumsum(legs)))[:-1] / speed_mps
+    return int(np.count_nonzero(starts_s >= time_s - 1e-9))
+
+
 def run_bayes_fault(spec: RunSpec) -> dict[str, Any]:
     """One Bayes-Swarm run of the ``faults-bayes`` study."""
     from swarm_sim.signal_fields import get_case
@@ -170,20 +243,31 @@ def run_bayes_fault(spec: RunSpec) -> dict[str, Any]:
 
     cfg = spec.config
     case = get_case(cfg['case'])
+    onset = float(cfg['fault_time_s'])
     mission = batch_mission_spec(
-        case,
-        noise_std=float(cfg['noise_std']),
-        planner_options={'outer_optimizer': cfg['outer_optimizer']},
+        case, noise_std=float(cfg['noise_std']), profile=str(cfg['profile'])
     )
+    stop = cfg.get('stop_time_s')
     mission = dataclasses.replace(
-        mission, faults=parse_fault(cfg['fault'], float(cfg['fault_time_s']))
+        mission,
+        faults=parse_fault(cfg['fault'], onset),
+        stop_time_s=None if stop is None else float(stop),
     )
     robots = int(cfg['robots']) or case.default_robots
     result = run_mission(mission, cfg['algorithm'], robots, spec.seed)
+    plan = FaultPlan(mission.faults, robots, spec.seed)
+    survivors = np.flatnonzero(~plan.mask('dropout'))
+    speed = mission.planner.velocity_mps
+    # The survivors go on deciding (on new samples) after the fault: the fewest decisions
+    # one of them took after the onset, among the runs that lasted a while after it.
+    after = [decisions_after_s(result.trajectories[i], speed, onset) for i in survivors]
     return {
         'found': bool(result.found),
         'tau': float(result.tau) if result.found else math.nan,
         'end_time_s': float(result.end_time_s),
+        'survivor_decisions_after_fault': (
+            min(after) if after and result.end_time_s >= onset + 10.0 else math.nan
+        ),
     }
 
 
@@ -192,22 +276,42 @@ def run_msc_fault(spec: RunSpec) -> dict[str, Any]:
     from swarm_experiments.msc_pf_batch import BatchScenario, run_batch
 
     cfg = spec.config
+    onset = float(cfg['fault_time_s'])
     scenario = BatchScenario(
         scheme=cfg['scheme'],
         n_robots=int(cfg['robots']),
         n_targets=int(cfg['targets']),
         seed=spec.seed,
         max_time_s=float(cfg['max_time_s']),
-        faults=parse_fault(cfg['fault'], float(cfg['fault_time_s'])),
+        faults=parse_fault(cfg['fault'], onset),
     )
-    result = run_batch(scenario)
+    result = run_batch(scenario, record=True)
     captured = np.isfinite(result.capture_times_s)
-    return {
+    row = {
         'cct_s': float(result.cct_s),
         'all_captured': bool(captured.all()),
         'captured': int(captured.sum()),
         'duration_s': float(result.duration_s),
+        'survivor_min_moved_m': math.nan,
+        'survivor_max_still_s': math.nan,
     }
+    # The survivors keep searching after the fault: the least one of them drove after the
+    # onset, and the longest time one of them stood (within 1 m of a spot) after it.
+    paths = result.paths_m
+    assert paths is not None
+    times = np.arange(len(paths), dtype=float) * (result.duration_s / max(len(paths) - 1, 1))
+    after = times >= onset
+    if np.count_nonzero(after) > 1:
+        plan = FaultPlan(scenario.faults, scenario.n_robots, spec.seed)
+        survivors = np.flatnonzero(~plan.mask('dropout'))
+        late = paths[after]
+        row['survivor_min_moved_m'] = min(
+            float(np.hypot(*np.diff(late[:, i], axis=0).T).sum()) for i in survivors
+        )
+        row['survivor_max_still_s'] = max(
+            still_time_s(times[after], late[:, i], tolerance_m=1.0) for i in survivors
+        )
+    return row
 
 
 @dataclasses.dataclass(frozen=True)
@@ -347,6 +451,7 @@ def run_crash(spec: RunSpec) -> dict[str, Any]:
     import json
     import os
     import resource
+    import signal
     import subprocess
     import sys
     import tempfile
@@ -383,6 +488,8 @@ def run_crash(spec: RunSpec) -> dict[str, Any]:
                 *crash_item(mission, cfg['scenario']),
             ]
             done = subprocess.run(argv, capture_output=True, text=True, env=env, check=False)
+            if done.returncode in (130, -signal.SIGINT):  # Ctrl-C reached the spawner too
+                raise KeyboardInterrupt
             if done.returncode not in (0, 1):
                 lines = done.stderr.strip().splitlines()
                 msg = f'{mission.spawner} exited {done.returncode}: {lines[-1] if lines else ""}'
@@ -458,24 +565,93 @@ def _summary(
     return frame.reset_index(drop=True)
 
 
+def _mean_sd(values: pd.Series) -> str:
+    finite = pd.to_numeric(values, errors='coerce').astype(float).dropna()
+    if not len(finite):
+        return 'n/a'
+    spread = finite.std(ddof=1) if len(finite) > 1 else 0.0
+    return f'{finite.mean():.3g} ± {spread:.2g}'
+
+
+def _paired_change(rows: pd.DataFrame, column: str, by: Sequence[str]) -> pd.Series:
+    """Per row, ``column`` minus its value in the fault-free run of the same seed and
+    configuration (``by``); NaN where that run is missing."""
+    base = rows[rows['config.fault'] == 'none'].set_index([*by, 'seed'])[column]
+    keys = pd.MultiIndex.from_frame(rows[[*by, 'seed']])
+    reference = base.reindex(keys).to_numpy(dtype=float)
+    return pd.Series(rows[column].to_numpy(dtype=float) - reference, index=rows.index)
+
+
 def _report_oabug_faults(page: ReportPage) -> None:
     rows = _planned(page, OABUG_FAULTS)
     if rows.empty:
         return
-    rows = rows.assign(**{'metric.complete_pct': 100.0 * rows['metric.complete'].astype(float)})
-    table = _summary(
-        rows,
-        ['config.departure', 'config.fault'],
-        {
-            'metric.coverage': 'coverage %',
-            'metric.complete_pct': 'runs covering all rooms %',
-            'metric.max_still_s': 'longest still survivor s',
-            'metric.stuck_survivors': 'runs with a stuck survivor',
-            'metric.faulty_moved_m': 'lidar-less robot moved m',
-        },
-        OABUG_FAULTS,
+    if 'config.profile' not in rows.columns:
+        rows = rows.assign(**{'config.profile': 'tuned'})
+    rows = rows.assign(
+        **{
+            'metric.complete_pct': 100.0 * rows['metric.complete'].astype(float),
+            'change': _paired_change(
+                rows, 'metric.coverage', ['config.profile', 'config.departure']
+            ),
+        }
     )
-    page.add_table(table, title='Reliability: OA-Bug Gas+Sound, Small, 10 robots', export='faults')
+    rank = {f: i for i, f in enumerate(OABUG_FAULTS)}
+    profiles = sorted(pd.unique(rows['config.profile']), key=lambda p: (p != 'paper', p))
+    for profile in profiles:
+        table = []
+        of_profile = rows[rows['config.profile'] == profile]
+        for fault, group in sorted(of_profile.groupby('config.fault'), key=lambda g: rank[g[0]]):
+            line: dict[str, Any] = {'fault': fault, 'sites': group['seed'].nunique()}
+            for departure in ('center', 'edge'):
+                runs = group[group['config.departure'] == departure]
+                if runs.empty:
+                    continue
+                line[f'{departure}: coverage %'] = _mean_sd(runs['metric.coverage'])
+                line[f'{departure}: change (paired) %'] = (
+                    '' if fault == 'none' else _mean_sd(runs['change'])
+                )
+                line[f'{departure}: all rooms %'] = f'{runs["metric.complete_pct"].mean():.0f}'
+                line[f'{departure}: stuck survivors'] = int(runs['metric.stuck_survivors'].sum())
+            moved = pd.to_numeric(group['metric.faulty_moved_m']).max()
+            line['lidar-less robot moved m (max)'] = f'{moved:.2g}' if 'stale' in fault else ''
+            table.append(line)
+        page.add_table(
+            pd.DataFrame(table),
+            title=f'Reliability: OA-Bug Gas+Sound, profile {profile}, Small, 10 robots',
+            export=f'faults-{profile}',
+        )
+    causes = [
+        c for c in ('stuck_by_stopped', 'stuck_by_peer', 'stuck_alone') if f'metric.{c}' in rows
+    ]
+    if causes:
+        table = []
+        for (profile, departure), group in rows.groupby(['config.profile', 'config.departure']):
+            line = {'profile': profile, 'departure': departure, 'runs': len(group)}
+            line['stuck survivors'] = int(group['metric.stuck_survivors'].sum())
+            for cause, label in zip(
+                causes,
+                ('beside a stopped robot', 'beside working peers only', 'no robot within 0.25 m'),
+                strict=True,
+            ):
+                line[label] = int(group[f'metric.{cause}'].sum())
+            table.append(line)
+        frame = pd.DataFrame(table)
+        frame = frame.sort_values('profile', key=lambda s: s != 'paper', kind='stable')
+        page.add_table(
+            frame.reset_index(drop=True),
+            title='OA-Bug survivors that stood still longer than 20 s, by what touched them',
+            export='stuck',
+        )
+
+
+def _extreme(rows: pd.DataFrame, column: str, how: str, fmt: str = '.3g') -> dict[Any, str]:
+    """Per fault, the smallest (``how='min'``) or largest value of ``column`` over the runs."""
+    out: dict[Any, str] = {}
+    for fault, group in rows.groupby('config.fault'):
+        values = pd.to_numeric(group[column], errors='coerce').astype(float).dropna()
+        out[fault] = format(getattr(values, how)(), fmt) if len(values) else 'n/a'
+    return out
 
 
 def _report_bayes_faults(page: ReportPage) -> None:
@@ -489,7 +665,17 @@ def _report_bayes_faults(page: ReportPage) -> None:
         {'metric.tau': 'tau (complete runs)', 'metric.found_pct': 'runs finding the source %'},
         BAYES_FAULTS,
     )
-    page.add_table(table, title='Reliability: Bayes-Swarm-P, case 1', export='faults')
+    medians = rows.groupby('config.fault')['metric.tau'].median()
+    table.insert(3, 'median tau', [f'{medians.get(f, math.nan):.3g}' for f in table['fault']])
+    if 'metric.survivor_decisions_after_fault' in rows:
+        fewest = _extreme(rows, 'metric.survivor_decisions_after_fault', 'min', '.0f')
+        table['fewest decisions of a survivor after the fault'] = [
+            '' if f == 'none' else fewest[f] for f in table['fault']
+        ]
+    profile = str(rows['param.profile'].iloc[0]) if 'param.profile' in rows else 'grid'
+    page.add_table(
+        table, title=f'Reliability: Bayes-Swarm-P, profile {profile}, case 1', export='faults'
+    )
 
 
 def _report_msc_faults(page: ReportPage) -> None:
@@ -507,8 +693,17 @@ def _report_msc_faults(page: ReportPage) -> None:
         },
         MSC_FAULTS,
     )
+    if 'metric.survivor_min_moved_m' in rows:
+        least = _extreme(rows, 'metric.survivor_min_moved_m', 'min', '.0f')
+        still = _extreme(rows, 'metric.survivor_max_still_s', 'max', '.0f')
+        table['least a survivor drove after the fault m'] = [least[f] for f in table['fault']]
+        table['longest a survivor stood after the fault s'] = [still[f] for f in table['fault']]
+    robots = int(rows['param.robots'].iloc[0])
+    targets = int(rows['param.targets'].iloc[0])
     page.add_table(
-        table, title='Reliability: MSC + PF (proposed), 15 robots, 10 targets', export='faults'
+        table,
+        title=f'Reliability: MSC + PF (proposed), {robots} robots, {targets} targets',
+        export='faults',
     )
 
 
@@ -590,13 +785,22 @@ def studies() -> list[Study]:
         Study(
             name='faults-oabug',
             run=run_oabug_fault,
-            axes={'departure': ('center', 'edge'), 'fault': OABUG_FAULTS},
+            axes={
+                'profile': ('paper', 'tuned'),
+                'departure': ('center', 'edge'),
+                'fault': OABUG_FAULTS,
+            },
             params={'site': 'small', 'robots': 10, 'variant': 'gas_sound', 'fault_time_s': 60.0},
             runs=3,
             seed_label='site',
             description='OA-Bug Gas+Sound coverage under injected faults (onset at 60 s).',
             smoke=Smoke(
-                runs=1, axes={'departure': ('center',), 'fault': ('none', 'dropout_robots=5')}
+                runs=1,
+                axes={
+                    'profile': ('paper',),
+                    'departure': ('center',),
+                    'fault': ('none', 'dropout_robots=5'),
+                },
             ),
             report=_report_oabug_faults,
         ),
@@ -609,8 +813,9 @@ def studies() -> list[Study]:
                 'algorithm': 'bayes_swarm_p',
                 'robots': 0,
                 'noise_std': 0.0,
-                'outer_optimizer': 'grid',
+                'profile': 'paper',
                 'fault_time_s': 10.0,
+                'stop_time_s': None,
             },
             runs=3,
             description='Bayes-Swarm-P tau under injected faults (onset at 10 s).',

@@ -26,26 +26,42 @@ def test_every_fault_scenario_of_the_studies_parses(scenario):
 
 
 def test_the_reliability_table_keeps_the_planned_seeds_and_orders_the_faults(tmp_path):
+    faults = ['dropout_robots=2', 'dropout_robots=2', 'none', 'none', 'none', 'none', 'none']
     rows = pd.DataFrame(
         {
             'status': 'ok',
-            'seed': [0, 1, 0, 1, 7],
+            'seed': [0, 1, 0, 1, 7, 0, 1],
+            'config.profile': ['paper'] * 5 + ['tuned'] * 2,
             'config.departure': 'center',
-            'config.fault': ['dropout_robots=2', 'dropout_robots=2', 'none', 'none', 'none'],
-            'metric.coverage': [80.0, 90.0, 100.0, 90.0, 0.0],
-            'metric.complete': [False, False, True, False, False],
-            'metric.max_still_s': [3.0, 4.0, 2.0, 2.0, 60.0],
-            'metric.stuck_survivors': [0, 1, 0, 0, 5],
+            'config.fault': faults,
+            'metric.coverage': [80.0, 90.0, 100.0, 90.0, 0.0, 100.0, 100.0],
+            'metric.complete': [False, False, True, False, False, True, True],
+            'metric.max_still_s': [3.0, 4.0, 2.0, 2.0, 60.0, 1.0, 1.0],
+            'metric.stuck_survivors': [0, 2, 0, 0, 5, 0, 0],
+            'metric.stuck_by_stopped': [0, 1, 0, 0, 5, 0, 0],
+            'metric.stuck_by_peer': [0, 1, 0, 0, 0, 0, 0],
+            'metric.stuck_alone': 0,
             'metric.faulty_moved_m': 0.0,
         }
     )
     page = ReportPage(tmp_path, {'study': 'faults-oabug', 'seeds': [0, 1]}, rows)
     reliability._report_oabug_faults(page)
     text = page.markdown()
-    lines = [line for line in text.splitlines() if line.startswith('| center')]
-    assert lines[0].startswith('| center | none | 2 | 95 ± 7.1 | 50 |')
-    assert lines[1].startswith('| center | dropout_robots=2 | 2 | 85 ± 7.1 | 0 |')
-    assert lines[1].split('|')[7].strip() == '1'  # one run had a stuck survivor
+    # The paper profile's table comes first; seed 7 (not planned) is left out.
+    paper, tuned = text.index('profile paper'), text.index('profile tuned')
+    assert paper < tuned
+    lines = [line for line in text[paper:tuned].splitlines() if line.startswith('| ')]
+    cells = [[c.strip() for c in line.split('|')[1:-1]] for line in lines]
+    header = cells[0]
+    none, dropped = (dict(zip(header, row, strict=True)) for row in cells[2:4])
+    assert (none['fault'], dropped['fault']) == ('none', 'dropout_robots=2')
+    assert none['center: coverage %'] == '95 ± 7.1'
+    assert dropped['center: coverage %'] == '85 ± 7.1'
+    # Paired with the fault-free run of the same site: -20 and 0.
+    assert dropped['center: change (paired) %'] == '-10 ± 14'
+    assert dropped['center: stuck survivors'] == '2'
+    stuck = text[text.index('stood still longer') :]
+    assert '| paper | center | 4 | 2 | 1 | 1 | 0 |' in stuck
 
 
 def _outcome(times, r1_x, extension=None):
@@ -92,3 +108,28 @@ def test_crash_metrics_see_the_robot_stop_and_move_again():
     row = reliability.crash_metrics(mission, 'crash', _outcome(times, frozen, rssi))
     assert (row['captured'], row['all_captured']) == (1, False)
     assert np.isnan(row['cct_s'])
+
+
+def test_stuck_survivors_are_told_apart_by_what_touched_them():
+    times = np.arange(0.0, 61.0)
+    positions = np.zeros((len(times), 5, 2))
+    positions[:, 1] = [0.2, 0.0]  # touches r0 all along; it stopped working at 10 s
+    positions[:, 2] = [5.0, 0.0]  # stands alone
+    positions[:, 3, 0] = 0.1 * times + 9.0  # drives
+    positions[:, 4] = [5.0, 0.2]  # r2's working neighbour, which stands too
+    positions[:30, 4, 1] = 3.0  # ... arriving at 30 s: r2 stood 30 s alone before
+    working = np.array([True, False, True, True, True])
+    causes = reliability.stuck_causes(times, positions, working, stopped_from_s=10.0)
+    # r0: still 60 s beside a stopped robot; r2: beside a working one (from 30 s);
+    # r4: still 30 s (from 30 s) beside working r2; r3 never stood.
+    assert causes == {'stuck_by_stopped': 1, 'stuck_by_peer': 2, 'stuck_alone': 0}
+    # Before its fault a robot is a working peer.
+    causes = reliability.stuck_causes(times, positions, working, stopped_from_s=100.0)
+    assert causes == {'stuck_by_stopped': 0, 'stuck_by_peer': 3, 'stuck_alone': 0}
+
+
+def test_decisions_after_a_time_count_the_legs_started_since():
+    path = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [2.0, 1.0]])  # legs at 0, 10, 20 s
+    assert reliability.decisions_after_s(path, 0.1, 0.0) == 3
+    assert reliability.decisions_after_s(path, 0.1, 10.0) == 2
+    assert reliability.decisions_after_s(path, 0.1, 25.0) == 0
