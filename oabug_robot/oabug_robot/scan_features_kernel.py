@@ -244,7 +244,8 @@ def features_kernel(
         sides: (K,) the side whose wall is wanted: +1 left, -1 right, 0 none.
         params: range_min, limit, front_half_width, follow_capture, cone_cos,
             peer_mask_range, robot_radius, peer_distance_factor, side_lookahead,
-            side_window_behind, side_wall_band, abeam_behind, abeam_reach.
+            side_window_behind, side_wall_band, abeam_behind, abeam_reach,
+            side_wall_fit_tolerance, min_fit_spread, robot_contact_distance, contact_cos.
         front_wall, front_robot: (K,) outputs [m].
         near_count, peer_count: (K,) outputs: returns within range, those of peers.
         side_count: (K,) number of returns of the wanted side's nearest band.
@@ -269,6 +270,8 @@ def features_kernel(
         abeam_reach,
         fit_tolerance,
         min_spread,
+        contact,
+        contact_cos,
     ) = params
     body = 2.0 * radius
     num_scans, num_rays = ranges.shape
@@ -336,7 +339,8 @@ def features_kernel(
             y = r * sin_t[j]
             if is_peer[m]:
                 peer_count[k] += 1
-                if c >= cone_cos and r < front_robot[k]:
+                ahead = c >= cone_cos or (c >= contact_cos and r <= contact)
+                if ahead and r < front_robot[k]:
                     front_robot[k] = r
                 continue
             if x > 0.0 and abs(y) <= front_half_width and x < front_wall[k]:
@@ -394,6 +398,8 @@ def _kernel_parameters(
             cfg.abeam_reach_m,
             cfg.side_wall_fit_tolerance_m,
             MIN_FIT_SPREAD_M,
+            cfg.robot_contact_distance_m,
+            math.cos(cfg.robot_contact_half_angle_rad),
         )
     )
 
