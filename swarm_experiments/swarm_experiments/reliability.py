@@ -261,12 +261,28 @@ def run_bayes_fault(spec: RunSpec) -> dict[str, Any]:
     # The survivors go on deciding (on new samples) after the fault: the fewest decisions
     # one of them took after the onset, among the runs that lasted a while after it.
     after = [decisions_after_s(result.trajectories[i], speed, onset) for i in survivors]
+    # Where the swarm believed the source was at the end: the median of the survivors' last
+    # GP-mean maxima; how far from the source, and from the nearest robot whose signal
+    # sensor failed (where a misleading sensor pulls the belief).
+    beliefs = [
+        d.expected_source_m
+        for i in survivors
+        for d in result.decisions[i][-1:]
+        if d.expected_source_m is not None
+    ]
+    belief = np.median(beliefs, axis=0) if beliefs else np.full(2, np.nan)
+    faulty = np.flatnonzero(plan.mask('stuck_gas') | plan.mask('drifting_gas'))
+    ends = np.array([result.trajectories[i][-1] for i in faulty]).reshape(-1, 2)
     return {
         'found': bool(result.found),
         'tau': float(result.tau) if result.found else math.nan,
         'end_time_s': float(result.end_time_s),
         'survivor_decisions_after_fault': (
             min(after) if after and result.end_time_s >= onset + 10.0 else math.nan
+        ),
+        'belief_error_m': float(np.hypot(*(belief - mission.source_m))),
+        'belief_to_faulty_sensor_m': (
+            float(np.hypot(*(ends - belief).T).min()) if len(ends) else math.nan
         ),
     }
 
@@ -667,6 +683,17 @@ def _report_bayes_faults(page: ReportPage) -> None:
     )
     medians = rows.groupby('config.fault')['metric.tau'].median()
     table.insert(3, 'median tau', [f'{medians.get(f, math.nan):.3g}' for f in table['fault']])
+    if 'metric.belief_error_m' in rows:
+        failed = rows[~rows['metric.found'].astype(bool)]
+        for column, label in (
+            ('metric.belief_error_m', 'failed runs: belief to source m'),
+            ('metric.belief_to_faulty_sensor_m', 'failed runs: belief to faulty sensor m'),
+        ):
+            values = failed.groupby('config.fault')[column].median()
+            table[label] = [
+                f'{values[f]:.2g}' if f in values and np.isfinite(values[f]) else ''
+                for f in table['fault']
+            ]
     if 'metric.survivor_decisions_after_fault' in rows:
         fewest = _extreme(rows, 'metric.survivor_decisions_after_fault', 'min', '.0f')
         table['fewest decisions of a survivor after the fault'] = [
