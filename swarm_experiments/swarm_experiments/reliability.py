@@ -511,6 +511,9 @@ def run_crash(spec: RunSpec) -> dict[str, Any]:
                 msg = f'{mission.spawner} exited {done.returncode}: {lines[-1] if lines else ""}'
                 raise RuntimeError(msg)
             outcome = json.loads((run_dir / 'outcome.json').read_text())
+            if outcome['stop_reason'] == 'interrupted':  # a node failed: not a crash fault
+                lines = done.stderr.strip().splitlines()
+                raise RuntimeError(lines[-1] if lines else f'{mission.spawner} was interrupted')
     finally:
         reservation.release()
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
