@@ -164,7 +164,9 @@ def stuck_causes(
     return causes
 
 
-def _oabug(spec: RunSpec, engine: EngineConfig, variant: str, departure: str) -> Any:
+def _oabug(
+    spec: RunSpec, engine: EngineConfig, variant: str, departure: str, profile: str = 'tuned'
+) -> Any:
     from swarm_experiments.oabug_batch import run_spawn_batch
     from swarm_experiments.spawn import SpawnSettings
 
@@ -177,7 +179,7 @@ def _oabug(spec: RunSpec, engine: EngineConfig, variant: str, departure: str) ->
         robots=int(cfg['robots']),
         departure=departure,
         engine=engine,
-        profile=str(cfg.get('profile', 'tuned')),
+        profile=profile,
     )
     return run_spawn_batch(settings).mission
 
@@ -187,7 +189,8 @@ def run_oabug_fault(spec: RunSpec) -> dict[str, Any]:
     cfg = spec.config
     onset = float(cfg['fault_time_s'])
     faults = parse_fault(cfg['fault'], onset)
-    mission = _oabug(spec, EngineConfig(faults=faults), cfg['variant'], cfg['departure'])
+    engine = EngineConfig(faults=faults)
+    mission = _oabug(spec, engine, cfg['variant'], cfg['departure'], cfg['profile'])
     n = len(mission.robot_names)
     plan = FaultPlan(faults, n, spec.seed)
     # The robots expected to keep driving: all but the dropped and the lidar-less ones.
