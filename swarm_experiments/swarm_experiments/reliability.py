@@ -541,18 +541,29 @@ def check_crash(config: Mapping[str, Any]) -> None:
         raise UsageError(f'faults-crash: unknown algorithm or scenario in {dict(config)}')
 
 
-def _planned(page: ReportPage, order: Sequence[str]) -> pd.DataFrame:
-    """The rows of the seeds of the last plan and, when ``order`` is given, of the fault
-    scenarios the study declares now (rows of older plans stay stored but are left out)."""
+def _planned(
+    page: ReportPage,
+    order: Sequence[str],
+    by: Sequence[str] = ('config.fault',),
+    per: str | None = None,
+) -> pd.DataFrame:
+    """The rows a table averages: of the fault scenarios the study declares now (``order``;
+    rows of older scenarios stay stored but are left out; every row when empty), on the
+    seeds that every configuration (``by``) has run, within each value of ``per``. So every
+    row of a table averages the same seeds (sites), and a call that ran some scenarios on
+    more seeds than the others adds nothing to those alone."""
     rows = page.rows
     if rows.empty:
         return rows
-    seeds = page.manifest.get('seeds')
-    if seeds:
-        rows = rows[rows['seed'].isin(seeds)]
     if order and 'config.fault' in rows.columns:
         rows = rows[rows['config.fault'].isin(order)]
-    return rows.reset_index(drop=True)
+    groups = [group for _, group in rows.groupby(per)] if per in rows.columns else [rows]
+    kept = []
+    for group in groups:
+        seeds = group.groupby(list(by))['seed'].agg(frozenset)
+        common = frozenset.intersection(*seeds) if len(seeds) else frozenset()
+        kept.append(group[group['seed'].isin(common)])
+    return pd.concat(kept).reset_index(drop=True) if kept else rows.iloc[:0]
 
 
 def _summary(
@@ -605,7 +616,7 @@ def _paired_change(rows: pd.DataFrame, column: str, by: Sequence[str]) -> pd.Ser
 
 
 def _report_oabug_faults(page: ReportPage) -> None:
-    rows = _planned(page, OABUG_FAULTS)
+    rows = _planned(page, OABUG_FAULTS, ('config.departure', 'config.fault'), 'config.profile')
     if rows.empty:
         return
     if 'config.profile' not in rows.columns:
@@ -773,7 +784,7 @@ _CRASH_COLUMNS = {
 
 
 def _report_crash(page: ReportPage) -> None:
-    rows = _planned(page, ())
+    rows = _planned(page, (), ('config.algorithm', 'config.scenario'))
     if rows.empty:
         return
     for column, share in (
@@ -795,7 +806,7 @@ def _report_crash(page: ReportPage) -> None:
 
 
 def _report_sensors(page: ReportPage) -> None:
-    rows = _planned(page, ())
+    rows = _planned(page, (), ('config.variant', 'config.departure', 'config.profile'))
     if rows.empty:
         return
     rows = rows.assign(**{'metric.complete_pct': 100.0 * rows['metric.complete'].astype(float)})

@@ -25,7 +25,7 @@ def test_every_fault_scenario_of_the_studies_parses(scenario):
     assert (scenario == 'none') == (config.describe() == 'dropout_time_s=12.0, sensor_time_s=12.0')
 
 
-def test_the_reliability_table_keeps_the_planned_seeds_and_orders_the_faults(tmp_path):
+def test_the_reliability_table_averages_the_same_sites_and_orders_the_faults(tmp_path):
     faults = ['dropout_robots=2', 'dropout_robots=2', 'none', 'none', 'none', 'none', 'none']
     rows = pd.DataFrame(
         {
@@ -44,10 +44,10 @@ def test_the_reliability_table_keeps_the_planned_seeds_and_orders_the_faults(tmp
             'metric.faulty_moved_m': 0.0,
         }
     )
-    page = ReportPage(tmp_path, {'study': 'faults-oabug', 'seeds': [0, 1]}, rows)
+    page = ReportPage(tmp_path, {'study': 'faults-oabug', 'seeds': [0, 1, 7]}, rows)
     reliability._report_oabug_faults(page)
     text = page.markdown()
-    # The paper profile's table comes first; seed 7 (not planned) is left out.
+    # The paper profile's table comes first; site 7 (run without faults only) is left out.
     paper, tuned = text.index('profile paper'), text.index('profile tuned')
     assert paper < tuned
     lines = [line for line in text[paper:tuned].splitlines() if line.startswith('| ')]
