@@ -649,8 +649,12 @@ def _report_oabug_faults(page: ReportPage) -> None:
             moved = pd.to_numeric(group['metric.faulty_moved_m']).max()
             line['lidar-less robot moved m (max)'] = f'{moved:.2g}' if 'stale' in fault else ''
             table.append(line)
+        frame = pd.DataFrame(table)
+        for column in frame.columns:
+            if column.endswith('stuck survivors'):  # a count, blank where not run
+                frame[column] = ['' if pd.isna(v) else str(int(v)) for v in frame[column]]
         page.add_table(
-            pd.DataFrame(table),
+            frame,
             title=f'Reliability: OA-Bug Gas+Sound, profile {profile}, Small, 10 robots',
             export=f'faults-{profile}',
         )
@@ -658,8 +662,16 @@ def _report_oabug_faults(page: ReportPage) -> None:
         c for c in ('stuck_by_stopped', 'stuck_by_peer', 'stuck_alone') if f'metric.{c}' in rows
     ]
     if causes:
+        # Only the scenarios and sites that every profile and departure ran, so that the
+        # rows compare the same runs.
+        keys = ['config.fault', 'seed']
+        runs = rows.groupby(['config.profile', 'config.departure'])[keys]
+        shared = frozenset.intersection(
+            *(frozenset(map(tuple, group.to_numpy())) for _, group in runs)
+        )
+        common = rows[[tuple(key) in shared for key in rows[keys].to_numpy()]]
         table = []
-        for (profile, departure), group in rows.groupby(['config.profile', 'config.departure']):
+        for (profile, departure), group in common.groupby(['config.profile', 'config.departure']):
             line = {'profile': profile, 'departure': departure, 'runs': len(group)}
             line['stuck survivors'] = int(group['metric.stuck_survivors'].sum())
             for cause, label in zip(
@@ -673,7 +685,10 @@ def _report_oabug_faults(page: ReportPage) -> None:
         frame = frame.sort_values('profile', key=lambda s: s != 'paper', kind='stable')
         page.add_table(
             frame.reset_index(drop=True),
-            title='OA-Bug survivors that stood still longer than 20 s, by what touched them',
+            title=(
+                'OA-Bug survivors that stood still longer than 20 s, by what touched them '
+                '(the scenarios and sites every row ran)'
+            ),
             export='stuck',
         )
 

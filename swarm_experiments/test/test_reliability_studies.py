@@ -26,20 +26,22 @@ def test_every_fault_scenario_of_the_studies_parses(scenario):
 
 
 def test_the_reliability_table_averages_the_same_sites_and_orders_the_faults(tmp_path):
-    faults = ['dropout_robots=2', 'dropout_robots=2', 'none', 'none', 'none', 'none', 'none']
+    faults = ['dropout_robots=2', 'dropout_robots=2', 'none', 'none', 'none']
+    faults += ['stale_lidar_robots=1', 'stale_lidar_robots=1']
+    faults += ['none', 'none', 'dropout_robots=2', 'dropout_robots=2']
     rows = pd.DataFrame(
         {
             'status': 'ok',
-            'seed': [0, 1, 0, 1, 7, 0, 1],
-            'config.profile': ['paper'] * 5 + ['tuned'] * 2,
+            'seed': [0, 1, 0, 1, 7, 0, 1, 0, 1, 0, 1],
+            'config.profile': ['paper'] * 7 + ['tuned'] * 4,
             'config.departure': 'center',
             'config.fault': faults,
-            'metric.coverage': [80.0, 90.0, 100.0, 90.0, 0.0, 100.0, 100.0],
-            'metric.complete': [False, False, True, False, False, True, True],
-            'metric.max_still_s': [3.0, 4.0, 2.0, 2.0, 60.0, 1.0, 1.0],
-            'metric.stuck_survivors': [0, 2, 0, 0, 5, 0, 0],
-            'metric.stuck_by_stopped': [0, 1, 0, 0, 5, 0, 0],
-            'metric.stuck_by_peer': [0, 1, 0, 0, 0, 0, 0],
+            'metric.coverage': [80.0, 90.0, 100.0, 90.0, 0.0, 90.0, 90.0] + [100.0] * 4,
+            'metric.complete': [False, False, True, False, False, False, False] + [True] * 4,
+            'metric.max_still_s': [3.0, 4.0, 2.0, 2.0, 60.0, 30.0, 30.0] + [1.0] * 4,
+            'metric.stuck_survivors': [0, 2, 0, 0, 5, 3, 3, 0, 0, 1, 0],
+            'metric.stuck_by_stopped': [0, 1, 0, 0, 5, 1, 1, 0, 0, 1, 0],
+            'metric.stuck_by_peer': [0, 1, 0, 0, 0, 2, 2, 0, 0, 0, 0],
             'metric.stuck_alone': 0,
             'metric.faulty_moved_m': 0.0,
         }
@@ -53,15 +55,19 @@ def test_the_reliability_table_averages_the_same_sites_and_orders_the_faults(tmp
     lines = [line for line in text[paper:tuned].splitlines() if line.startswith('| ')]
     cells = [[c.strip() for c in line.split('|')[1:-1]] for line in lines]
     header = cells[0]
-    none, dropped = (dict(zip(header, row, strict=True)) for row in cells[2:4])
+    none, dropped, stale = (dict(zip(header, row, strict=True)) for row in cells[2:5])
     assert (none['fault'], dropped['fault']) == ('none', 'dropout_robots=2')
     assert none['center: coverage %'] == '95 ± 7.1'
     assert dropped['center: coverage %'] == '85 ± 7.1'
     # Paired with the fault-free run of the same site: -20 and 0.
     assert dropped['center: change (paired) %'] == '-10 ± 14'
     assert dropped['center: stuck survivors'] == '2'
+    assert stale['center: stuck survivors'] == '6'
+    # The stuck table compares the scenarios and sites both profiles ran: not the paper's
+    # stale lidars.
     stuck = text[text.index('stood still longer') :]
     assert '| paper | center | 4 | 2 | 1 | 1 | 0 |' in stuck
+    assert '| tuned | center | 4 | 1 | 1 | 0 | 0 |' in stuck
 
 
 def _outcome(times, r1_x, extension=None):
