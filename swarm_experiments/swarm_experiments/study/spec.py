@@ -215,6 +215,11 @@ def _coerce(name: str, value: Any, text: str, declared: Sequence[Any]) -> Any:
         return value
     if kind == 'float' and got == 'int':
         return float(value)
+    if kind == 'float' and got == 'str':
+        try:
+            return float(value)  # 'inf', '1e3': numbers YAML 1.1 reads as words
+        except ValueError:
+            pass
     if kind == 'str' and got in ('int', 'float', 'bool'):
         return text.strip()
     example = next(item for item in declared if item is not None)

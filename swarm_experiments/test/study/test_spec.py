@@ -113,13 +113,13 @@ def test_overrides_of_the_wrong_type_name_the_parameter(items: list[str], messag
 
 
 def test_overrides_take_the_declared_type() -> None:
-    items = ['sim.speed_scale=2', 'variant=1,gas', 'sleep_s=0']
+    items = ['sim.speed_scale=2', 'variant=1,gas', 'sleep_s=1e-3']
     plan = make_specs(search_study(), overrides=parse_overrides(items))
     config = plan.specs[0].config
     assert config['sim']['speed_scale'] == 2.0
     assert isinstance(config['sim']['speed_scale'], float)
     assert {spec.config['variant'] for spec in plan.specs} == {'1', 'gas'}
-    assert isinstance(config['sleep_s'], float)
+    assert config['sleep_s'] == 0.001
 
 
 def test_parse_overrides_rejects_malformed_and_repeated_items() -> None:
