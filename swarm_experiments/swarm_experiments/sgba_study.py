@@ -1,13 +1,13 @@
 """The SGBA comparison for ``swarm_study``: SGBA beside OA-Bug on the same sites and seeds.
 
-Study ``sgba-vs-oabug``: the OA-Bug paper's Fig. 4 setting (Small sites at the Table II
-budget, 10 robots, centre and edge departure, coverage every 100 actions), with the method
-as an axis: OA-Bug's Gas+Sound and Gas in the as-published profile (``profile=paper``, the
-rows that lead), then SGBA (:mod:`oabug_robot.sgba`) with the authors' parameters
-(``sgba``) and with its distances halved for the sites' doors (``sgba_scaled``). The seed
-is the site index, so every method runs on the same sites and starts and results pair by
-site. Fixed parameters: ``actions`` (None: the Table II budget), ``speed`` [m/s],
-``profile`` (OA-Bug's), and ``sgba.<name>`` for every SGBA node parameter (None: its default).
+Study ``sgba-vs-oabug``: the OA-Bug paper's Fig. 4 setting (Small and Medium sites at the Table
+II budget, 2-10 robots, centre and edge departure, coverage every 100 actions), with the method
+as an axis: OA-Bug's Gas+Sound and Gas in the as-published profile (``profile=paper``, the rows
+that lead), then SGBA (:mod:`oabug_robot.sgba`) with the authors' parameters (``sgba``) and
+with its distances halved for the sites' doors (``sgba_scaled``). The seed is the site index,
+so every method runs on the same sites and starts and results pair by site. Fixed parameters:
+``actions`` (None: the Table II budget), ``speed`` [m/s], ``profile`` (OA-Bug's), and
+``sgba.<name>`` for every SGBA node parameter (None: its default).
 """
 
 from __future__ import annotations
@@ -138,7 +138,7 @@ def studies() -> list[Study]:
             axes={
                 'site': ('small', 'medium'),
                 'method': METHODS,
-                'robots': (10,),
+                'robots': (2, 4, 6, 8, 10),
                 'departure': ('center', 'edge'),
             },
             params=params,
