@@ -276,7 +276,7 @@ class BayesSwarmPlanner:
             keep = keep[keep < pts.shape[0] - 1]
         else:
             keep = downsample_indices(pts.shape[0], cfg.n_max)
-        return pts[keep], vals[keep]
+        return pts[keep], vals[keep] / cfg.signal_scale
 
     def _estimated_penalty_constants(self, values: np.ndarray) -> tuple[float, float]:
         """M and L of the penalty from the belief (local penalization, Gonzalez et al. 2016).
