@@ -271,11 +271,23 @@ def test_a_penalty_ball_over_the_whole_arena_stalls_cobyla_and_the_estimate_free
     estimating = _with_data(replace(fixed, penalty_estimate=True), [1.2, 1.2])
     free = estimating.decide([0.71, 0.71], 50.0)
     assert free.kind is DecisionKind.ACQUISITION
-    assert abs(free.waypoint_m[1] - 0.71) > 0.05
-    values = np.array([0.2, 0.9, 0.4])
-    m, lipschitz = estimating._estimated_penalty_constants(values)
-    assert m == 0.9
-    _, grad, _ = estimating.gp.mean_derivatives(estimating.gp.training_inputs)
+    assert np.hypot(*(free.waypoint_m - [0.71, 0.71])) > 0.5  # a real leg, not a stall
+    assert abs(free.waypoint_m[1] - 0.71) > 0.02  # not COBYLA's first step either
+    gp = estimating.gp
+    expected = free.expected_source_m
+    peak = float(gp.predict_mean(expected[None])[0])
+    # M: the larger of the largest observation and the believed maximum (Eq. 5's value).
+    m, lipschitz = estimating._estimated_penalty_constants(np.array([0.2, 0.9, 0.4]), expected)
+    assert m == max(0.9, peak)
+    m, _ = estimating._estimated_penalty_constants(np.array([0.2, 5.0]), expected)
+    assert m == 5.0
+    # L: the largest gradient norm of the GP mean over the arena (a fine grid's maximum,
+    # to its spacing), above the data points' and below the paper's 2 here.
+    g = np.linspace(0.0, 2.4, 241)
+    grid = np.stack(np.meshgrid(g, g), axis=-1).reshape(-1, 2)
+    _, grad, _ = gp.mean_derivatives(grid)
+    assert lipschitz == pytest.approx(float(np.max(np.hypot(grad[:, 0], grad[:, 1]))), rel=1e-3)
+    _, grad, _ = gp.mean_derivatives(gp.training_inputs)
     assert lipschitz >= float(np.max(np.hypot(grad[:, 0], grad[:, 1]))) - 1e-12
     assert lipschitz < 2.0
 
