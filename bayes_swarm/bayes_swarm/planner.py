@@ -278,17 +278,13 @@ class BayesSwarmPlanner:
             keep = downsample_indices(pts.shape[0], cfg.n_max)
         return pts[keep], vals[keep] / cfg.signal_scale
 
-    def _estimated_penalty_constants(
-        self, values: np.ndarray, expected: np.ndarray
-    ) -> tuple[float, float]:
+    def _estimated_penalty_constants(self, values: np.ndarray) -> tuple[float, float]:
         """M and L of the penalty from the belief (local penalization, Gonzalez et al. 2016).
 
-        M is the larger of the largest observation (Gonzalez et al.'s estimate) and the GP
-        mean at the expected source (Eq. 5's maximum), so that it bounds the believed field
-        from above as Sec. 2.5 asks. L is the largest norm of the GP mean's gradient over the
-        arena: the best of the arena grid and the data points, refined by L-BFGS-B on the
-        analytic gradient of that norm (as GPyOpt estimates it); the configured L if the
-        belief is flat (below 1e-7).
+        M is the largest observation (their estimate of the maximum). L is the largest norm
+        of the GP mean's gradient over the arena: the best of the arena grid and the data
+        points, refined by L-BFGS-B on the analytic gradient of that norm (as GPyOpt
+        estimates it); the configured L if the belief is flat (below 1e-7).
         """
         gp = self._gp
         points = np.vstack([self._mean_grid, gp.training_inputs])
@@ -309,8 +305,7 @@ class BayesSwarmPlanner:
                 lipschitz = max(lipschitz, -float(result.fun))
         else:
             lipschitz = self._cfg.lipschitz
-        peak = float(gp.predict_mean(expected.reshape(1, 2))[0])
-        return max(float(np.max(values)), peak), lipschitz
+        return float(np.max(values)), lipschitz
 
     def _bayes_decision(self, position: np.ndarray, time_s: float) -> Decision:
         cfg = self._cfg
@@ -349,7 +344,7 @@ class BayesSwarmPlanner:
             else:
                 max_signal = cfg.max_signal
             if cfg.penalty_estimate:
-                max_signal, lipschitz = self._estimated_penalty_constants(vals, expected)
+                max_signal, lipschitz = self._estimated_penalty_constants(vals)
         else:
             peer_waypoints = np.zeros((0, 2))
             peer_mean = peer_std = np.zeros(0)
