@@ -276,18 +276,34 @@ class BayesSwarmPlanner:
             keep = keep[keep < pts.shape[0] - 1]
         else:
             keep = downsample_indices(pts.shape[0], cfg.n_max)
-        return pts[keep], vals[keep]
+        return pts[keep], vals[keep] / cfg.signal_scale
 
     def _estimated_penalty_constants(self, values: np.ndarray) -> tuple[float, float]:
         """M and L of the penalty from the belief (local penalization, Gonzalez et al. 2016).
 
-        M is the largest observed value; L the largest norm of the GP mean's gradient over
-        the arena grid and the data points (the configured L if that is below 1e-7).
+        M is the largest observation (their estimate of the maximum). L is the largest norm
+        of the GP mean's gradient over the arena: the best of the arena grid and the data
+        points, refined by L-BFGS-B on the analytic gradient of that norm (as GPyOpt
+        estimates it); the configured L if the belief is flat (below 1e-7).
         """
-        points = np.vstack([self._mean_grid, self._gp.training_inputs])
-        _, grad, _ = self._gp.mean_derivatives(points)
-        lipschitz = float(np.max(np.hypot(grad[:, 0], grad[:, 1])))
-        if not (math.isfinite(lipschitz) and lipschitz > 1e-7):
+        gp = self._gp
+        points = np.vstack([self._mean_grid, gp.training_inputs])
+        _, grad, _ = gp.mean_derivatives(points)
+        norms = np.hypot(grad[:, 0], grad[:, 1])
+        best = int(np.argmax(norms))
+        lipschitz = float(norms[best])
+        if math.isfinite(lipschitz) and lipschitz > 1e-7:
+            result = minimize(
+                _negated_gradient_norm,
+                points[best],
+                args=(gp,),
+                jac=True,
+                method='L-BFGS-B',
+                bounds=list(zip(self._cfg.arena.lower, self._cfg.arena.upper, strict=True)),
+            )
+            if np.isfinite(result.fun):
+                lipschitz = max(lipschitz, -float(result.fun))
+        else:
             lipschitz = self._cfg.lipschitz
         return float(np.max(values)), lipschitz
 
@@ -407,6 +423,16 @@ class BayesSwarmPlanner:
             if np.isfinite(result.fun) and -float(result.fun) > best_f:
                 best_x, best_f = result.x, -float(result.fun)
         return arena.clip(np.asarray(best_x, dtype=float))
+
+
+def _negated_gradient_norm(x: np.ndarray, gp: GaussianProcess) -> tuple[float, np.ndarray]:
+    """-|grad mu(x)| and its gradient -H g / |g| (L-BFGS-B objective of the estimated L)."""
+    _, grad, hess = gp.mean_derivatives(np.asarray(x, dtype=float).reshape(1, 2))
+    g, h = grad[0], hess[0]
+    norm = float(np.hypot(g[0], g[1]))
+    if norm < 1e-300:
+        return -norm, np.zeros(2)
+    return -norm, -(h @ g) / norm
 
 
 def _negated_mean(x: np.ndarray, gp: GaussianProcess) -> tuple[float, np.ndarray]:
