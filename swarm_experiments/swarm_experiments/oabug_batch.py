@@ -60,6 +60,9 @@ from swarm_experiments.spawn import OABugRun, SpawnSettings, run
 
 __all__ = ['BatchRobot', 'run_oabug_batch', 'run_spawn_batch']
 
+# Scan ranges this far beyond every robot's feature range [m] read inf on the batch path.
+_SCAN_HORIZON_MARGIN_M = 1e-3
+
 
 class BatchRobot:
     """One OA-Bug robot as its node runs it, fed with readings instead of messages.
@@ -205,11 +208,15 @@ def run_oabug_batch(
     unused = {'odometry'}
     if not any(robot.needs_gas for robot in robots):
         unused.add('gas')
+    # No feature reads a range beyond the robots' feature range: the engine may read the
+    # farther ones as inf (the margin is far beyond the float32 rounding of a range).
+    horizon_m = max(robot.loop.extractor.feature_range_m for robot in robots)
     engine = SimEngine(
         geometry,
         np.asarray(spec.initial_poses, dtype=float),
         dataclasses.replace(engine_config, sensors=engine_config.sensors - unused),
         bearing_cycles=True,
+        scan_horizon_m=horizon_m + _SCAN_HORIZON_MARGIN_M,
     )
     n = engine.num_robots
     names = tuple(f'r{i}' for i in range(n))

@@ -237,6 +237,7 @@ class SimEngine:
         config: EngineConfig | None = None,
         *,
         bearing_cycles: bool = False,
+        scan_horizon_m: float | None = None,
     ) -> None:
         """Build the world and its models.
 
@@ -247,8 +248,13 @@ class SimEngine:
             bearing_cycles: hand the bearings over as one :class:`BearingCycle` of flat
                 arrays (``StepOutput.bearing_cycle``) instead of a report per robot (the
                 same values and random draws).
+            scan_horizon_m: when given, scan ranges beyond it read ``inf`` (the others,
+                and every random draw, as without it), and the lidar skips the walls that
+                only farther rays reach (:meth:`LidarModel.measure`). For a consumer that
+                reads no farther range; a bridge publishes the full scans.
         """
         self._bearing_cycles = bearing_cycles
+        self._scan_horizon_m = scan_horizon_m
         self.config = config or EngineConfig()
         cfg = self.config
         self.site = site
@@ -439,7 +445,7 @@ class SimEngine:
         out.new_room_entries = self.coverage.update(poses, self.time_s)
         sched = self._schedules
         if sched['scan'].due(self.time_s)[0] and self.lidar is not None:
-            out.scans = self.lidar.measure(poses)
+            out.scans = self.lidar.measure(poses, self._scan_horizon_m)
         due, elapsed = sched['gas'].due(self.time_s)
         if due and self.gas is not None and self.scent is not None:
             if headings is None:
