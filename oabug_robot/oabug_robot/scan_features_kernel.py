@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
+from functools import lru_cache
 from typing import TypeVar
 
 import numpy as np
@@ -39,6 +40,7 @@ from oabug_robot.scan_features import (
     ScanFeatures,
     SideWall,
 )
+from oabug_robot.settings import PerceptionConfig
 
 _F = TypeVar('_F', bound=Callable[..., object])
 
@@ -60,10 +62,12 @@ except ImportError:  # a robot install: the same loops run uncompiled (slowly), 
 
 __all__ = [
     'HAVE_NUMBA',
+    'extract_held',
     'extract_many',
     'extract_many_flat',
     'features_kernel',
     'pairwise_sum',
+    'select_kernel',
     'side_wall_fit',
 ]
 
@@ -372,15 +376,87 @@ def features_kernel(
         )
 
 
+@njit(cache=True)
+def select_kernel(
+    ranges: np.ndarray,
+    range_min: float,
+    limit: float,
+    peer_mask_range: float,
+    held_azimuths: np.ndarray,
+    held_distances: np.ndarray,
+    held_start: np.ndarray,
+    rotation: np.ndarray,
+    max_distance: float,
+) -> tuple:  # pragma: no cover - compiled
+    """What the features of K scans need before the transcendental functions: the -inf
+    ranges replaced by ``range_min`` (in place), the peers that may be near and the rays
+    whose peer window is read.
+
+    Args:
+        ranges: (K, B) ranges [m]; -inf entries are set to ``range_min``.
+        range_min, limit: rays with a range in [range_min, limit] are returns.
+        peer_mask_range: only returns up to this range can be a peer's.
+        held_azimuths: (H,) held peer bearings [rad], the scans' in order.
+        held_distances: (H,) their coarse distances [m] (NaN unknown).
+        held_start: (K + 1,) slice bounds of each scan's held bearings.
+        rotation: (K,) per scan, the angle added to its bearings (the robot's rotation since
+            they were heard, ``yaw_at_stamp - yaw`` [rad]); empty: none is added.
+        max_distance: bearings whose distance exceeds this are left out (NaN kept).
+
+    Returns:
+        The kept bearings [rad] and distances [m], their (K + 1,) slice bounds, the indices
+        of the finite kept bearings, and the flat (K * B) indices of the rays whose peer
+        window is read (the returns within the peer mask range of the scans with a finite
+        kept bearing).
+    """
+    num_scans, num_rays = ranges.shape
+    total = held_azimuths.shape[0]
+    azimuths = np.empty(total)
+    distances = np.empty(total)
+    start = np.empty(num_scans + 1, dtype=np.int64)
+    finite = np.empty(total, dtype=np.int64)
+    windows = np.empty(num_scans * num_rays, dtype=np.int64)
+    kept = 0
+    num_finite = 0
+    num_windows = 0
+    rotate = rotation.shape[0] > 0
+    for k in range(num_scans):
+        start[k] = kept
+        any_finite = False
+        for b in range(held_start[k], held_start[k + 1]):
+            d = held_distances[b]
+            if d > max_distance:
+                continue
+            a = held_azimuths[b] + rotation[k] if rotate else held_azimuths[b]
+            azimuths[kept] = a
+            distances[kept] = d
+            if math.isfinite(a):
+                finite[num_finite] = kept
+                num_finite += 1
+                any_finite = True
+            kept += 1
+        for j in range(num_rays):
+            r = ranges[k, j]
+            if r == -np.inf:
+                r = range_min
+                ranges[k, j] = r
+            if any_finite and r >= range_min and r <= limit and r <= peer_mask_range:
+                windows[num_windows] = k * num_rays + j
+                num_windows += 1
+    start[num_scans] = kept
+    return azimuths[:kept], distances[:kept], start, finite[:num_finite], windows[:num_windows]
+
+
+@lru_cache(maxsize=64)
 def _kernel_parameters(
-    extractor: ScanFeatureExtractor, range_min_m: float, range_max_m: float
+    config: PerceptionConfig, feature_range_m: float, range_min_m: float, range_max_m: float
 ) -> tuple[float, ...]:
-    cfg = extractor.config
+    cfg = config
     return tuple(
         float(value)
         for value in (
             range_min_m,
-            min(range_max_m, extractor.feature_range_m),
+            min(range_max_m, feature_range_m),
             cfg.front_half_width_m,
             cfg.follow_capture_m,
             math.cos(cfg.robot_cone_half_angle_rad),
@@ -405,7 +481,7 @@ def _frame(scan: LaserScanData) -> tuple[float, float, float, float]:
 def extract_many(
     extractor: ScanFeatureExtractor,
     scans: Sequence[LaserScanData],
-    peers: Sequence[tuple[np.ndarray, np.ndarray]],
+    peers: Sequence[tuple[np.ndarray, np.ndarray | None]],
     sides: Sequence[int],
 ) -> list[ScanFeatures]:
     """The features ``extractor.extract`` gives for each scan, computed in one call.
@@ -414,7 +490,7 @@ def extract_many(
         extractor: the extractor whose configuration (and ray table) every robot shares.
         scans: K scans with the same angles, limits and number of rays.
         peers: per scan, the peers' bearings [rad] and coarse distances [m] (NaN where
-            unknown), as passed to ``extract``.
+            unknown; None: all unknown), as passed to ``extract``.
         sides: per scan, the side whose wall is wanted (+1 left, -1 right, 0 none): the
             same as ``extract(..., sides=(side,) if side else ())``.
 
@@ -470,6 +546,86 @@ def extract_many_flat(
     if len(azimuths) != bearing_start[-1] or len(distances) != bearing_start[-1]:
         msg = f'{bearing_start[-1]} peers, {len(azimuths)} azimuths, {len(distances)} distances'
         raise ValueError(msg)
+    return _extract(
+        extractor,
+        scans,
+        np.asarray(azimuths, dtype=float),
+        np.asarray(distances, dtype=float),
+        np.asarray(bearing_start, dtype=np.int64),
+        _NO_ROTATION,
+        math.inf,
+        sides,
+    )
+
+
+def extract_held(
+    extractor: ScanFeatureExtractor,
+    scans: Sequence[LaserScanData],
+    held: Sequence[tuple[np.ndarray, np.ndarray, float] | None],
+    sides: Sequence[int],
+) -> list[ScanFeatures]:
+    """What each robot's control loop computes for its scan
+    (:meth:`oabug_robot.robot_loop.RobotLoop.update_features`): ``extractor.extract`` of the
+    scan with the near peers of the held bearings
+    (:meth:`oabug_robot.sound.PeerBearings.near_peers_now`, the same element-wise
+    operations), all scans in one compiled call.
+
+    Args:
+        extractor: as for :func:`extract_many`.
+        scans: K scans, as for :func:`extract_many`.
+        held: per scan, what :meth:`~oabug_robot.robot_loop.RobotLoop.peer_bearings` returns:
+            the held bearings [rad], their distances [m] and the rotation since they were
+            heard [rad], or None.
+        sides: per scan, the side whose wall is wanted (+1 left, -1 right, 0 none).
+
+    Raises:
+        ScanError: the scans have no rays or their angles are not finite.
+        ValueError: the scans differ in angles, limits or number of rays, or the
+            argument lengths differ.
+    """
+    if not len(scans) == len(held) == len(sides):
+        msg = f'{len(scans)} scans, {len(held)} peer sets and {len(sides)} sides'
+        raise ValueError(msg)
+    counts = [0 if h is None else len(h[0]) for h in held]
+    start = np.zeros(len(held) + 1, dtype=np.int64)
+    np.cumsum(counts, out=start[1:])
+    rotation = np.array([0.0 if h is None else h[2] for h in held])
+    if start[-1]:
+        present = [h for h in held if h is not None]
+        azimuths = np.concatenate([h[0] for h in present])
+        distances = np.concatenate([h[1] for h in present])
+    else:
+        azimuths = distances = _NO_ROTATION
+    return _extract(
+        extractor,
+        scans,
+        np.asarray(azimuths, dtype=float),
+        np.asarray(distances, dtype=float),
+        start,
+        rotation,
+        extractor.config.peer_bearing_max_distance_m,
+        sides,
+    )
+
+
+_NO_ROTATION = np.zeros(0)
+_NO_WALL = SideWall()
+_NO_WALL_RIGHT = SideWall(math.inf, -0.0, False)
+_NO_FEATURES = ScanFeatures()
+
+
+def _extract(
+    extractor: ScanFeatureExtractor,
+    scans: Sequence[LaserScanData],
+    held_azimuths: np.ndarray,
+    held_distances: np.ndarray,
+    held_start: np.ndarray,
+    rotation: np.ndarray,
+    max_distance: float,
+    sides: Sequence[int],
+) -> list[ScanFeatures]:
+    """The features of the scans with the peers :func:`select_kernel` keeps of the held
+    bearings (rotated by ``rotation``, per scan, unless it is empty)."""
     if not scans:
         return []
     first = scans[0]
@@ -483,24 +639,32 @@ def extract_many_flat(
     angles, cos_t, sin_t = extractor.ray_directions(first, ranges.shape[1])
     cfg = extractor.config
     range_min = max(float(first.range_min_m), 0.0)
+    params = _kernel_parameters(
+        cfg, extractor.feature_range_m, range_min, float(first.range_max_m)
+    )
     # REP 117: -inf means "too close to measure", i.e. an obstacle at range_min.
-    ranges[ranges == -math.inf] = range_min
-    if bearing_start[-1]:
-        azimuths = np.asarray(azimuths, dtype=float)
-        distances = np.asarray(distances, dtype=float)
-        finite = np.isfinite(azimuths)
-        bearing = np.full(azimuths.size, math.nan)
-        bearing[finite] = np.arctan2(np.sin(azimuths[finite]), np.cos(azimuths[finite]))
-        # The kernel reads a ray's window only where it may be a peer's: within the peer
-        # mask range (numpy's arctan2 of an element does not depend on the array around it).
-        half_width = np.full(ranges.shape, math.nan)
-        maskable = ranges <= cfg.peer_mask_range_m
-        half_width[maskable] = cfg.peer_bearing_tolerance_rad + np.arctan2(
-            cfg.robot_radius_m, ranges[maskable]
+    azimuths, distances, start, finite, windows = select_kernel(
+        ranges,
+        range_min,
+        params[1],
+        cfg.peer_mask_range_m,
+        held_azimuths,
+        held_distances,
+        held_start,
+        rotation,
+        max_distance,
+    )
+    # The transcendental functions in numpy, as the extractor computes them (numpy's value
+    # of an element does not depend on the array around it).
+    bearing = np.full(azimuths.size, math.nan)
+    if finite.size:
+        finite_azimuths = azimuths[finite]
+        bearing[finite] = np.arctan2(np.sin(finite_azimuths), np.cos(finite_azimuths))
+    half_width = np.empty(ranges.size)
+    if windows.size:
+        half_width[windows] = cfg.peer_bearing_tolerance_rad + np.arctan2(
+            cfg.robot_radius_m, ranges.ravel()[windows]
         )
-    else:
-        bearing = distances = np.zeros(0)
-        half_width = ranges  # not read: no scan has a peer
     k, num_rays = ranges.shape
     front_wall = np.empty(k)
     front_robot = np.empty(k)
@@ -514,15 +678,15 @@ def extract_many_flat(
     wall_angle = np.empty(k)
     features_kernel(
         ranges,
-        half_width,
+        half_width.reshape(ranges.shape),
         angles,
         cos_t,
         sin_t,
-        np.asarray(bearing_start, dtype=np.int64),
+        start,
         bearing,
         distances,
         np.asarray(sides, dtype=np.int64),
-        _kernel_parameters(extractor, range_min, float(first.range_max_m)),
+        params,
         front_wall,
         front_robot,
         near_count,
@@ -542,17 +706,18 @@ def extract_many_flat(
     result = []
     for i, side in enumerate(sides):
         if nears[i] == 0:
-            result.append(ScanFeatures())
+            result.append(_NO_FEATURES)
             continue
-        left = right = SideWall()
-        if side:
-            wall = SideWall()
-            if side_counts[i]:
-                wall = SideWall(wall_distances[i], wall_angles[i], abeams[i])
-            if side > 0:
-                left = wall
-            else:
-                right = SideWall(wall.distance_m, -wall.angle_rad, wall.abeam)
+        left = right = _NO_WALL
+        if side > 0 and side_counts[i]:
+            left = SideWall(wall_distances[i], wall_angles[i], abeams[i])
+        elif side < 0:
+            # The extractor mirrors the right side's wall, "no wall" (angle 0.0) too.
+            right = (
+                SideWall(wall_distances[i], -wall_angles[i], abeams[i])
+                if side_counts[i]
+                else _NO_WALL_RIGHT
+            )
         result.append(
             ScanFeatures(
                 front_wall_m=walls_ahead[i],
