@@ -639,9 +639,7 @@ def _extract(
     angles, cos_t, sin_t = extractor.ray_directions(first, ranges.shape[1])
     cfg = extractor.config
     range_min = max(float(first.range_min_m), 0.0)
-    params = _kernel_parameters(
-        cfg, extractor.feature_range_m, range_min, float(first.range_max_m)
-    )
+    params = _kernel_parameters(cfg, extractor.feature_range_m, range_min, float(first.range_max_m))
     # REP 117: -inf means "too close to measure", i.e. an obstacle at range_min.
     azimuths, distances, start, finite, windows = select_kernel(
         ranges,

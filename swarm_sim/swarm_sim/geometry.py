@@ -183,12 +183,12 @@ class WallGrid:
         ix, iy = np.meshgrid(np.arange(shape[0]), np.arange(shape[1]), indexing='ij')
         centres = lo + (np.column_stack([ix.ravel(), iy.ravel()]) + 0.5) * self.cell_m
         near = point_segment_distance(centres, segments) <= reach_m + self.cell_m * math.sqrt(0.5)
-        width = max(int(near.sum(axis=1).max()), 1)
-        table = np.full((len(centres), width), len(segments), dtype=int)
-        for c in np.flatnonzero(near.any(axis=1)):
-            idx = np.flatnonzero(near[c])
-            table[c, : len(idx)] = idx
-        self._table = table
+        counts = near.sum(axis=1)
+        width = max(int(counts.max()), 1)
+        # Per cell, its walls in index order (a stable sort puts the near ones first), then
+        # the padding index.
+        first = np.argsort(~near, axis=1, kind='stable')[:, :width]
+        self._table = np.where(np.arange(width) < counts[:, None], first, len(segments))
 
     def candidates(self, points: np.ndarray) -> np.ndarray:
         """(K, W) indices of the walls near each of the (K, 2) points; padding is M."""
