@@ -19,7 +19,6 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
-from swarm_common.angles import wrap_angle
 from swarm_common.params import parameter, section
 
 from swarm_sim.errors import ConfigurationError, WorldGeometryError
@@ -40,6 +39,7 @@ from swarm_sim.sensors.imu import GyroYawModel, ImuConfig
 from swarm_sim.sensors.lidar import LidarConfig, LidarModel
 from swarm_sim.sensors.odometry import OdometryConfig, WheelOdometry
 from swarm_sim.sensors.scent import PumpDepositor, ScentConfig, ScentField
+from swarm_sim.sensors_kernel import yaw_change_kernel
 from swarm_sim.world import BodyConfig
 
 __all__ = ['SENSORS', 'EngineConfig', 'SimEngine', 'SiteGeometry', 'StepOutput']
@@ -200,7 +200,10 @@ class StepOutput:
 
 def _headings(poses: np.ndarray) -> np.ndarray:
     """(N, 2) unit vectors cos(yaw), sin(yaw) of (N, 3) poses."""
-    return np.column_stack([np.cos(poses[:, 2]), np.sin(poses[:, 2])])
+    headings = np.empty((len(poses), 2))
+    np.cos(poses[:, 2], out=headings[:, 0])
+    np.sin(poses[:, 2], out=headings[:, 1])
+    return headings
 
 
 class _Schedule:
@@ -434,7 +437,8 @@ class SimEngine:
         self._step_index += 1
         self.time_s = self._step_index * dt
         poses = self.world.poses
-        self.distance_travelled_m += np.hypot(*(poses[:, :2] - before[:, :2]).T)
+        moved = poses[:, :2] - before[:, :2]
+        self.distance_travelled_m += np.hypot(moved[:, 0], moved[:, 1])
         # The headings serve the nozzles and the gas sensors: computed once, when needed.
         headings = None
         depositor = self._depositor
@@ -459,7 +463,7 @@ class SimEngine:
                 out.bearings = self.bearing_model.measure(poses)
         due, elapsed = sched['imu'].due(self.time_s)
         if due and self.imu is not None:
-            change = np.asarray(wrap_angle(poses[:, 2] - self._imu_last_yaw), dtype=float)
+            change = yaw_change_kernel(poses[:, 2], self._imu_last_yaw)
             self._imu_last_yaw = poses[:, 2].copy()
             out.imu = self.imu.update(change, elapsed)
         due, elapsed = sched['odometry'].due(self.time_s)

@@ -17,7 +17,7 @@ from numba import njit
 
 from swarm_sim.raycast_kernel import _wrap
 
-__all__ = ['gas_update_kernel', 'imu_message_yaw_kernel', 'imu_update_kernel']
+__all__ = ['gas_update_kernel', 'imu_message_yaw_kernel', 'imu_update_kernel', 'yaw_change_kernel']
 
 _FLOAT_MAX = np.finfo(np.float64).max
 
@@ -114,4 +114,16 @@ def imu_message_yaw_kernel(yaw_rad: np.ndarray) -> np.ndarray:  # pragma: no cov
             out[i] = math.nan
             continue
         out[i] = math.atan2(2.0 * (w * z + x * y), w * w + x * x - y * y - z * z)
+    return out
+
+
+@njit(cache=True)
+def yaw_change_kernel(
+    yaw_rad: np.ndarray, previous_yaw_rad: np.ndarray
+) -> np.ndarray:  # pragma: no cover - compiled
+    """``swarm_common.angles.wrap_angle(yaw_rad - previous_yaw_rad)`` of (N,) yaws [rad]
+    (the same operations: ``%`` here is numpy's ``mod``)."""
+    out = np.empty(yaw_rad.shape[0])
+    for i in range(yaw_rad.shape[0]):
+        out[i] = _wrap(yaw_rad[i] - previous_yaw_rad[i])
     return out

@@ -170,3 +170,42 @@ def rooms_touched_kernel(
             if dx * dx + dy * dy < radius2:
                 result[i, rect_room[r]] = True
     return result
+
+
+@njit(cache=True)
+def rooms_entered_kernel(
+    positions: np.ndarray,
+    rects: np.ndarray,
+    rect_room: np.ndarray,
+    radius2: float,
+    first_robot: np.ndarray,
+) -> np.ndarray:  # pragma: no cover - compiled
+    """The rooms first entered now: per room not yet entered (``first_robot`` < 0) that a
+    robot's disc overlaps (:func:`rooms_touched_kernel`'s test), the lowest such robot.
+
+    Args:
+        positions: (N, 2+) robot positions [m].
+        rects: (R, 4) x_min, y_min, x_max, y_max [m].
+        rect_room: (R,) the room of each rectangle.
+        radius2: the disc's squared radius [m^2].
+        first_robot: (K,) per room, the robot that entered it first (-1: none yet).
+
+    Returns:
+        (K,) per room, the robot entering it now (-1: none), -1 for rooms entered before.
+    """
+    entering = np.full(first_robot.shape[0], -1, dtype=np.int64)
+    for r in range(rects.shape[0]):
+        room = rect_room[r]
+        if first_robot[room] >= 0:
+            continue
+        for i in range(positions.shape[0]):
+            if 0 <= entering[room] <= i:
+                break
+            x = positions[i, 0]
+            y = positions[i, 1]
+            dx = max(max(rects[r, 0] - x, x - rects[r, 2]), 0.0)
+            dy = max(max(rects[r, 1] - y, y - rects[r, 3]), 0.0)
+            if dx * dx + dy * dy < radius2:
+                entering[room] = i
+                break
+    return entering

@@ -4,12 +4,12 @@ import math
 
 import numpy as np
 import pytest
-from swarm_common.angles import yaw_from_quaternion, yaw_to_quaternion
+from swarm_common.angles import wrap_angle, yaw_from_quaternion, yaw_to_quaternion
 from swarm_sim.errors import ConfigurationError
 from swarm_sim.sensors.bearings import BearingConfig, BearingModel
 from swarm_sim.sensors.imu import GyroYawModel, ImuConfig
 from swarm_sim.sensors.odometry import OdometryConfig, WheelOdometry
-from swarm_sim.sensors_kernel import imu_message_yaw_kernel
+from swarm_sim.sensors_kernel import imu_message_yaw_kernel, yaw_change_kernel
 
 
 def test_bearing_is_the_peer_direction_in_the_receiver_frame_with_a_few_degrees_of_noise():
@@ -188,3 +188,24 @@ def test_compiled_imu_message_yaw_is_the_nodes_quaternion_round_trip_bit_for_bit
         assert math.isnan(imu_message_yaw_kernel(np.array([bad]))[0])
         with pytest.raises(ValueError, match=r'orientation|domain'):
             yaw_from_quaternion(*yaw_to_quaternion(bad))
+
+
+def test_compiled_yaw_change_is_the_wrapped_difference_bit_for_bit():
+    """yaw_change_kernel (the engine's IMU input) equals wrap_angle of the difference, across
+    the +-pi seam, with signed zeros, exact multiples of pi, huge values, NaN and inf."""
+    rng = np.random.default_rng(10)
+    now = np.concatenate(
+        (
+            rng.uniform(-math.pi, math.pi, 3000),
+            [math.pi, -math.pi, 0.0, -0.0, 3 * math.pi, 1e300, math.nan, math.inf, 1e-300],
+        )
+    )
+    before = np.concatenate(
+        (
+            rng.uniform(-math.pi, math.pi, 3000),
+            [-math.pi, math.pi, -0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0],
+        )
+    )
+    with np.errstate(invalid='ignore'):
+        want = wrap_angle(now - before)
+    assert yaw_change_kernel(now, before).tobytes() == want.tobytes()

@@ -210,7 +210,7 @@ class PumpDepositor:
     def busy(self, pump_on: np.ndarray) -> bool:
         """False when a :meth:`step` with these pump states would do nothing (no pump runs
         and no puff is pending), so that the caller may skip it."""
-        return bool(np.any(pump_on)) or bool(self._on_time_s.any())
+        return bool(pump_on.any() or self._on_time_s.any())
 
     def step(self, pump_on: np.ndarray, nozzle_xy: np.ndarray, time_s: float, dt_s: float) -> None:
         """Account ``dt_s`` seconds of pumping and deposit the puffs that are complete.
