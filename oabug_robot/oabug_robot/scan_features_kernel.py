@@ -224,16 +224,8 @@ def features_kernel(
     bearing_distance: np.ndarray,
     sides: np.ndarray,
     params: tuple,
-    front_wall: np.ndarray,
-    front_robot: np.ndarray,
-    near_count: np.ndarray,
-    peer_count: np.ndarray,
-    side_count: np.ndarray,
-    side_x: np.ndarray,
-    side_l: np.ndarray,
-    abeam: np.ndarray,
-    wall_distance: np.ndarray,
-    wall_angle: np.ndarray,
+    real_out: np.ndarray,
+    int_out: np.ndarray,
 ) -> None:  # pragma: no cover - compiled
     """Features of K scans of B rays; the outputs are filled in place.
 
@@ -248,14 +240,13 @@ def features_kernel(
         sides: (K,) the side whose wall is wanted: +1 left, -1 right, 0 none.
         params: range_min, limit, front_half_width, follow_capture, cone_cos,
             peer_mask_range, robot_radius, peer_distance_factor, side_lookahead,
-            side_window_behind, side_wall_band, abeam_behind, abeam_reach.
-        front_wall, front_robot: (K,) outputs [m].
-        near_count, peer_count: (K,) outputs: returns within range, those of peers.
-        side_count: (K,) number of returns of the wanted side's nearest band.
-        side_x, side_l: (K, B) their forward and lateral coordinates [m].
-        abeam: (K,) one of them lies abeam.
-        wall_distance, wall_angle: (K,) the side wall fitted to those returns (distance [m]
-            and angle [rad] as seen on the left; read only where ``side_count`` > 0).
+            side_window_behind, side_wall_band, abeam_behind, abeam_reach, fit_tolerance,
+            min_spread.
+        real_out: (K, 4) output per scan: the wall ahead and the robot ahead [m], the
+            distance [m] and angle [rad, as seen on the left] of the wanted side's wall
+            (read only where its return count is not 0).
+        int_out: (K, 4) output per scan: the returns within range, those of peers, the
+            returns of the wanted side's nearest band, and 1 where one of them lies abeam.
     """
     (
         range_min,
@@ -280,13 +271,19 @@ def features_kernel(
     is_peer = np.empty(num_rays, dtype=np.bool_)
     xs = np.empty(num_rays)
     ls = np.empty(num_rays)
+    side_x = np.empty(num_rays)
+    side_l = np.empty(num_rays)
     scratch = np.empty((4, num_rays))
     for k in range(num_scans):
-        front_wall[k] = np.inf
-        front_robot[k] = np.inf
-        peer_count[k] = 0
-        side_count[k] = 0
-        abeam[k] = False
+        front_wall = np.inf
+        front_robot = np.inf
+        peers = 0
+        abeam = 0
+        real_out[k, 2] = np.inf
+        real_out[k, 3] = 0.0
+        int_out[k, 1] = 0
+        int_out[k, 2] = 0
+        int_out[k, 3] = 0
         kept = 0
         any_near = False
         for j in range(num_rays):
@@ -297,8 +294,10 @@ def features_kernel(
                 kept += 1
                 if r <= peer_mask_range:
                     any_near = True
-        near_count[k] = kept
+        int_out[k, 0] = kept
         if kept == 0:
+            real_out[k, 0] = np.inf
+            real_out[k, 1] = np.inf
             continue
         # The peer mask, bearing by bearing.
         if any_near:
@@ -339,12 +338,12 @@ def features_kernel(
             x = r * c
             y = r * sin_t[j]
             if is_peer[m]:
-                peer_count[k] += 1
-                if c >= cone_cos and r < front_robot[k]:
-                    front_robot[k] = r
+                peers += 1
+                if c >= cone_cos and r < front_robot:
+                    front_robot = r
                 continue
-            if x > 0.0 and abs(y) <= front_half_width and x < front_wall[k]:
-                front_wall[k] = x
+            if x > 0.0 and abs(y) <= front_half_width and x < front_wall:
+                front_wall = x
             if side == 0 or not (r <= follow_capture and x <= lookahead and x >= -behind):
                 continue
             if side > 0 and y > 0.0:
@@ -355,6 +354,9 @@ def features_kernel(
                 xs[count] = x
                 ls[count] = -y
                 count += 1
+        real_out[k, 0] = front_wall
+        real_out[k, 1] = front_robot
+        int_out[k, 1] = peers
         if count == 0:
             continue
         # Only the nearest wall: the returns within the band of the closest one.
@@ -365,14 +367,15 @@ def features_kernel(
         kept_side = 0
         for m in range(count):
             if ls[m] <= cut:
-                side_x[k, kept_side] = xs[m]
-                side_l[k, kept_side] = ls[m]
+                side_x[kept_side] = xs[m]
+                side_l[kept_side] = ls[m]
                 if xs[m] >= -abeam_behind and ls[m] <= abeam_reach:
-                    abeam[k] = True
+                    abeam = 1
                 kept_side += 1
-        side_count[k] = kept_side
-        wall_distance[k], wall_angle[k] = side_wall_fit(
-            side_x[k], side_l[k], kept_side, fit_tolerance, min_spread, scratch
+        int_out[k, 2] = kept_side
+        int_out[k, 3] = abeam
+        real_out[k, 2], real_out[k, 3] = side_wall_fit(
+            side_x, side_l, kept_side, fit_tolerance, min_spread, scratch
         )
 
 
@@ -387,6 +390,8 @@ def select_kernel(
     held_start: np.ndarray,
     rotation: np.ndarray,
     max_distance: float,
+    angles: np.ndarray,
+    widest_window: float,
 ) -> tuple:  # pragma: no cover - compiled
     """What the features of K scans need before the transcendental functions: the -inf
     ranges replaced by ``range_min`` (in place), the peers that may be near and the rays
@@ -402,12 +407,15 @@ def select_kernel(
         rotation: (K,) per scan, the angle added to its bearings (the robot's rotation since
             they were heard, ``yaw_at_stamp - yaw`` [rad]); empty: none is added.
         max_distance: bearings whose distance exceeds this are left out (NaN kept).
+        angles: (B,) the rays' directions in the robot frame, in [-pi, pi) [rad].
+        widest_window: an upper bound of any peer window's half width [rad].
 
     Returns:
         The kept bearings [rad] and distances [m], their (K + 1,) slice bounds, the indices
         of the finite kept bearings, and the flat (K * B) indices of the rays whose peer
-        window is read (the returns within the peer mask range of the scans with a finite
-        kept bearing).
+        window may be read: the returns within the peer mask range that lie within
+        ``widest_window`` of a finite kept bearing (the bearing wrapped here with ``%``,
+        within far less than the margin of the wrapped bearing the features use).
     """
     num_scans, num_rays = ranges.shape
     total = held_azimuths.shape[0]
@@ -416,13 +424,15 @@ def select_kernel(
     start = np.empty(num_scans + 1, dtype=np.int64)
     finite = np.empty(total, dtype=np.int64)
     windows = np.empty(num_scans * num_rays, dtype=np.int64)
+    directions = np.empty(total)
+    reach = widest_window + 1e-6
     kept = 0
     num_finite = 0
     num_windows = 0
     rotate = rotation.shape[0] > 0
     for k in range(num_scans):
         start[k] = kept
-        any_finite = False
+        first_finite = num_finite
         for b in range(held_start[k], held_start[k + 1]):
             d = held_distances[b]
             if d > max_distance:
@@ -432,19 +442,31 @@ def select_kernel(
             distances[kept] = d
             if math.isfinite(a):
                 finite[num_finite] = kept
+                directions[num_finite] = (a + math.pi) % _TWO_PI - math.pi
                 num_finite += 1
-                any_finite = True
             kept += 1
         for j in range(num_rays):
             r = ranges[k, j]
             if r == -np.inf:
                 r = range_min
                 ranges[k, j] = r
-            if any_finite and r >= range_min and r <= limit and r <= peer_mask_range:
-                windows[num_windows] = k * num_rays + j
-                num_windows += 1
+            if not (r >= range_min and r <= limit and r <= peer_mask_range):
+                continue
+            for f in range(first_finite, num_finite):
+                if _in_window(angles[j], directions[f], reach):
+                    windows[num_windows] = k * num_rays + j
+                    num_windows += 1
+                    break
     start[num_scans] = kept
     return azimuths[:kept], distances[:kept], start, finite[:num_finite], windows[:num_windows]
+
+
+@lru_cache(maxsize=64)
+def _widest_window(config: PerceptionConfig, range_min_m: float) -> float:
+    """An upper bound [rad] of the half width of a peer's window, at the shortest range
+    (``ScanFeatureExtractor``'s tolerance plus the angle a body spans; 1e-9 rad more than
+    ``math.atan2`` gives, far beyond numpy's difference from it)."""
+    return config.peer_bearing_tolerance_rad + math.atan2(config.robot_radius_m, range_min_m) + 1e-9
 
 
 @lru_cache(maxsize=64)
@@ -632,10 +654,14 @@ def _extract(
     frame = _frame(first)
     if any(_frame(scan) != frame for scan in scans[1:]):
         raise ValueError('the scans must share their angles and range limits')
-    ranges = np.stack([np.asarray(scan.ranges_m, dtype=float) for scan in scans])
-    if ranges.ndim != 2 or ranges.shape[1] == 0:
-        msg = f'scans must have at least one range, got shape {ranges.shape[1:]}'
+    num_rays = np.shape(first.ranges_m)
+    if len(num_rays) != 1 or num_rays[0] == 0:
+        msg = f'scans must have at least one range, got shape {num_rays}'
         raise ScanError(msg)
+    # Every scan's ranges in one array (the kernel rewrites -inf ranges: a copy).
+    ranges = np.empty((len(scans), num_rays[0]))
+    for i, scan in enumerate(scans):
+        ranges[i] = scan.ranges_m
     angles, cos_t, sin_t = extractor.ray_directions(first, ranges.shape[1])
     cfg = extractor.config
     range_min = max(float(first.range_min_m), 0.0)
@@ -651,6 +677,8 @@ def _extract(
         held_start,
         rotation,
         max_distance,
+        angles,
+        _widest_window(cfg, range_min),
     )
     # The transcendental functions in numpy, as the extractor computes them (numpy's value
     # of an element does not depend on the array around it).
@@ -658,22 +686,15 @@ def _extract(
     if finite.size:
         finite_azimuths = azimuths[finite]
         bearing[finite] = np.arctan2(np.sin(finite_azimuths), np.cos(finite_azimuths))
-    half_width = np.empty(ranges.size)
+    # NaN: no window (a ray this far from every bearing is in none).
+    half_width = np.full(ranges.size, math.nan)
     if windows.size:
         half_width[windows] = cfg.peer_bearing_tolerance_rad + np.arctan2(
             cfg.robot_radius_m, ranges.ravel()[windows]
         )
-    k, num_rays = ranges.shape
-    front_wall = np.empty(k)
-    front_robot = np.empty(k)
-    near_count = np.empty(k, dtype=np.int64)
-    peer_count = np.empty(k, dtype=np.int64)
-    side_count = np.empty(k, dtype=np.int64)
-    side_x = np.empty((k, num_rays))
-    side_l = np.empty((k, num_rays))
-    abeam = np.empty(k, dtype=np.bool_)
-    wall_distance = np.empty(k)
-    wall_angle = np.empty(k)
+    k = len(scans)
+    real_out = np.empty((k, 4))
+    int_out = np.empty((k, 4), dtype=np.int64)
     features_kernel(
         ranges,
         half_width.reshape(ranges.shape),
@@ -685,45 +706,22 @@ def _extract(
         distances,
         np.asarray(sides, dtype=np.int64),
         params,
-        front_wall,
-        front_robot,
-        near_count,
-        peer_count,
-        side_count,
-        side_x,
-        side_l,
-        abeam,
-        wall_distance,
-        wall_angle,
+        real_out,
+        int_out,
     )
     # The outputs as Python numbers once (the same values), not element by element.
-    walls_ahead, robots_ahead = front_wall.tolist(), front_robot.tolist()
-    nears, peer_counts = near_count.tolist(), peer_count.tolist()
-    side_counts, abeams = side_count.tolist(), abeam.tolist()
-    wall_distances, wall_angles = wall_distance.tolist(), wall_angle.tolist()
     result = []
-    for i, side in enumerate(sides):
-        if nears[i] == 0:
+    for side, (wall_ahead, robot_ahead, distance, angle), (near, peers, count, abeam) in zip(
+        sides, real_out.tolist(), int_out.tolist(), strict=True
+    ):
+        if near == 0:
             result.append(_NO_FEATURES)
             continue
         left = right = _NO_WALL
-        if side > 0 and side_counts[i]:
-            left = SideWall(wall_distances[i], wall_angles[i], abeams[i])
+        if side > 0 and count:
+            left = SideWall(distance, angle, bool(abeam))
         elif side < 0:
             # The extractor mirrors the right side's wall, "no wall" (angle 0.0) too.
-            right = (
-                SideWall(wall_distances[i], -wall_angles[i], abeams[i])
-                if side_counts[i]
-                else _NO_WALL_RIGHT
-            )
-        result.append(
-            ScanFeatures(
-                front_wall_m=walls_ahead[i],
-                front_robot_m=robots_ahead[i],
-                left=left,
-                right=right,
-                near_returns=nears[i],
-                peer_returns=peer_counts[i],
-            )
-        )
+            right = SideWall(distance, -angle, bool(abeam)) if count else _NO_WALL_RIGHT
+        result.append(ScanFeatures(wall_ahead, robot_ahead, left, right, near, peers))
     return result

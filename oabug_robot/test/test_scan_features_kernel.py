@@ -70,7 +70,7 @@ def _peers(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray | None]:
 
 def _exact(features: ScanFeatures) -> str:
     """Every field, floats to the last bit (repr round-trips and shows -0.0)."""
-    return repr(dataclasses.astuple(features))
+    return repr(features)
 
 
 def _numpy_features(extractor, scans, peers, sides) -> list[str]:
