@@ -143,6 +143,8 @@ class CoverageTracker:
                 self._radius_m**2,
                 self._first_robot,
             )
+            if not len(entering):
+                return new
             rooms = np.flatnonzero(entering >= 0).tolist()
             robots = entering[rooms].tolist()
         else:

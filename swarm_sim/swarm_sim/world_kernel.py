@@ -191,9 +191,11 @@ def rooms_entered_kernel(
         first_robot: (K,) per room, the robot that entered it first (-1: none yet).
 
     Returns:
-        (K,) per room, the robot entering it now (-1: none), -1 for rooms entered before.
+        (K,) per room, the robot entering it now (-1: none), -1 for rooms entered before;
+        all -1 is returned as an empty array (nothing new: the common case).
     """
     entering = np.full(first_robot.shape[0], -1, dtype=np.int64)
+    found = False
     for r in range(rects.shape[0]):
         room = rect_room[r]
         if first_robot[room] >= 0:
@@ -207,5 +209,6 @@ def rooms_entered_kernel(
             dy = max(max(rects[r, 1] - y, y - rects[r, 3]), 0.0)
             if dx * dx + dy * dy < radius2:
                 entering[room] = i
+                found = True
                 break
-    return entering
+    return entering if found else entering[:0]
