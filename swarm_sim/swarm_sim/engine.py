@@ -41,6 +41,7 @@ from swarm_sim.sensors.odometry import OdometryConfig, WheelOdometry
 from swarm_sim.sensors.scent import PumpDepositor, ScentConfig, ScentField
 from swarm_sim.sensors_kernel import yaw_change_kernel
 from swarm_sim.world import BodyConfig
+from swarm_sim.world_kernel import actuators_kernel
 
 __all__ = ['SENSORS', 'EngineConfig', 'SimEngine', 'SiteGeometry', 'StepOutput']
 
@@ -428,8 +429,16 @@ class SimEngine:
         """Advance one physics period and return what is due."""
         cfg = self.config
         dt = cfg.physics_period_s
-        commands = self.active_commands()
-        pumping = self.pumps_running()
+        # active_commands() and pumps_running() in one compiled call.
+        commands, pumping = actuators_kernel(
+            self.time_s,
+            self._command,
+            self._command_time_s,
+            cfg.cmd_vel_timeout_s + 1e-9,
+            self._pump_on,
+            self._pump_time_s,
+            cfg.pump_timeout_s + 1e-9,
+        )
         for hook in self._hooks:
             commands, pumping = hook.actuators(self.time_s, commands, pumping)
         before = self.world.poses
