@@ -41,7 +41,7 @@ from swarm_sim.sensors.odometry import OdometryConfig, WheelOdometry
 from swarm_sim.sensors.scent import PumpDepositor, ScentConfig, ScentField
 from swarm_sim.sensors_kernel import yaw_change_kernel
 from swarm_sim.world import BodyConfig
-from swarm_sim.world_kernel import actuators_kernel
+from swarm_sim.world_kernel import actuators_kernel, body_points_kernel
 
 __all__ = ['SENSORS', 'EngineConfig', 'SimEngine', 'SiteGeometry', 'StepOutput']
 
@@ -448,12 +448,11 @@ class SimEngine:
         poses = self.world.poses
         moved = poses[:, :2] - before[:, :2]
         self.distance_travelled_m += np.hypot(moved[:, 0], moved[:, 1])
-        # The headings serve the nozzles and the gas sensors: computed once, when needed.
-        headings = None
         depositor = self._depositor
         if depositor is not None and depositor.busy(pumping):
-            headings = _headings(poses)
-            depositor.step(pumping, self.nozzle_positions(poses, headings), self.time_s, dt)
+            # nozzle_positions(poses) in compiled code.
+            nozzles = body_points_kernel(poses, -cfg.pump_offset_m)
+            depositor.step(pumping, nozzles, self.time_s, dt)
         out = StepOutput(time_s=self.time_s, poses=poses)
         out.new_room_entries = self.coverage.update(poses, self.time_s)
         sched = self._schedules
@@ -461,9 +460,9 @@ class SimEngine:
             out.scans = self.lidar.measure(poses, self._scan_horizon_m)
         due, elapsed = sched['gas'].due(self.time_s)
         if due and self.gas is not None and self.scent is not None:
-            if headings is None:
-                headings = _headings(poses)
-            c = self.scent.concentration(self.gas_sensor_positions(poses, headings), self.time_s)
+            # gas_sensor_positions(poses) in compiled code.
+            sensors = body_points_kernel(poses, cfg.gas.sensor_offset_m)
+            c = self.scent.concentration(sensors, self.time_s)
             out.gas_raw = self.gas.update(c, elapsed)
         if sched['bearings'].due(self.time_s)[0] and self.bearing_model is not None:
             if self._bearing_cycles:

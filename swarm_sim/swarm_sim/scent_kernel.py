@@ -146,6 +146,7 @@ def puff_sum(
 def pump_release_kernel(
     on_time_s: np.ndarray,
     pump_on: np.ndarray,
+    nozzle_xy: np.ndarray,
     dt_s: float,
     full_s: float,
     rate: float,
@@ -155,11 +156,12 @@ def pump_release_kernel(
     pump stopped, resetting its time.
 
     Returns:
-        The releasing robots, ascending, and their puffs' masses (``rate`` times the
-        pumping time).
+        The places (the robots' nozzles, in robot order) and masses (``rate`` times the
+        pumping time) of the released puffs that ``ScentField.deposit`` keeps: finite
+        places, positive masses.
     """
     n = on_time_s.shape[0]
-    release = np.empty(n, dtype=np.int64)
+    xy = np.empty((n, 2))
     mass = np.empty(n)
     count = 0
     for i in range(n):
@@ -167,8 +169,13 @@ def pump_release_kernel(
             on_time_s[i] += dt_s
         t = on_time_s[i]
         if t >= full_s or (not pump_on[i] and t > 0.0):
-            release[count] = i
-            mass[count] = rate * t
             on_time_s[i] = 0.0
-            count += 1
-    return release[:count], mass[:count]
+            m = rate * t
+            x = nozzle_xy[i, 0]
+            y = nozzle_xy[i, 1]
+            if math.isfinite(x) and math.isfinite(y) and m > 0.0:
+                xy[count, 0] = x
+                xy[count, 1] = y
+                mass[count] = m
+                count += 1
+    return xy[:count], mass[:count]

@@ -237,3 +237,16 @@ def test_the_compiled_watchdogs_give_the_active_commands_and_pumps():
         )
         assert commands.tobytes() == engine.active_commands().tobytes()
         assert pumping.tolist() == engine.pumps_running().tolist()
+
+
+def test_the_compiled_nozzle_and_gas_sensor_places_equal_the_numpy_ones():
+    from swarm_sim.world_kernel import body_points_kernel
+
+    rng = np.random.default_rng(10)
+    engine = make_engine([[1.0, 1.5, 0.0]])
+    poses = np.column_stack([rng.uniform(-20.0, 20.0, (5000, 2)), rng.uniform(-7.0, 7.0, 5000)])
+    poses[:8, 2] = [0.0, -0.0, math.pi, -math.pi, math.pi / 2, 1e-300, 100.0, -1e5]
+    gas = body_points_kernel(poses, engine.config.gas.sensor_offset_m)
+    nozzles = body_points_kernel(poses, -engine.config.pump_offset_m)
+    assert gas.tobytes() == engine.gas_sensor_positions(poses).tobytes()
+    assert nozzles.tobytes() == engine.nozzle_positions(poses).tobytes()

@@ -117,7 +117,10 @@ class ScentField:
         xy = np.atleast_2d(np.asarray(xy, dtype=float))
         mass = np.broadcast_to(np.asarray(mass_ppm_m2, dtype=float), (len(xy),))
         keep = np.isfinite(xy).all(axis=1) & (mass > 0.0)
-        xy, mass = xy[keep], mass[keep]
+        self._append(xy[keep], time_s, mass[keep])
+
+    def _append(self, xy: np.ndarray, time_s: float, mass: np.ndarray) -> None:
+        """Add (K, 2) puff positions [m] and (K,) masses (finite and positive) at ``time_s``."""
         k = len(xy)
         if k == 0:
             return
@@ -255,12 +258,13 @@ class PumpDepositor:
             dt_s: step length [s].
         """
         cfg = self._field.config
-        release, mass = pump_release_kernel(
+        xy, mass = pump_release_kernel(
             self._on_time_s,
             np.asarray(pump_on, dtype=bool),
+            np.asarray(nozzle_xy, dtype=float),
             float(dt_s),
             cfg.deposit_period_s - 1e-9,
             float(cfg.deposit_rate_ppm_m2_per_s),
         )
-        if len(release):
-            self._field.deposit(nozzle_xy[release], time_s, mass)
+        # What deposit() adds (the kernel keeps only finite places and positive masses).
+        self._field._append(xy, time_s, mass)
