@@ -40,7 +40,6 @@ from oabug_robot.scan_features import (
     ScanFeatures,
     SideWall,
 )
-from oabug_robot.settings import PerceptionConfig
 
 _F = TypeVar('_F', bound=Callable[..., object])
 
@@ -462,23 +461,20 @@ def select_kernel(
 
 
 @lru_cache(maxsize=64)
-def _widest_window(config: PerceptionConfig, range_min_m: float) -> float:
-    """An upper bound [rad] of the half width of a peer's window, at the shortest range
-    (``ScanFeatureExtractor``'s tolerance plus the angle a body spans; 1e-9 rad more than
+def _constants(
+    extractor: ScanFeatureExtractor, range_min_m: float, range_max_m: float
+) -> tuple[tuple[float, ...], float]:
+    """The kernels' constants for an extractor and a scan's range limits (cached per
+    extractor object: its configuration is frozen): :func:`features_kernel`'s parameters
+    and an upper bound [rad] of the half width of a peer's window, at the shortest range
+    (the extractor's tolerance plus the angle a body spans; 1e-9 rad more than
     ``math.atan2`` gives, far beyond numpy's difference from it)."""
-    return config.peer_bearing_tolerance_rad + math.atan2(config.robot_radius_m, range_min_m) + 1e-9
-
-
-@lru_cache(maxsize=64)
-def _kernel_parameters(
-    config: PerceptionConfig, feature_range_m: float, range_min_m: float, range_max_m: float
-) -> tuple[float, ...]:
-    cfg = config
-    return tuple(
+    cfg = extractor.config
+    params = tuple(
         float(value)
         for value in (
             range_min_m,
-            min(range_max_m, feature_range_m),
+            min(range_max_m, extractor.feature_range_m),
             cfg.front_half_width_m,
             cfg.follow_capture_m,
             math.cos(cfg.robot_cone_half_angle_rad),
@@ -494,6 +490,8 @@ def _kernel_parameters(
             MIN_FIT_SPREAD_M,
         )
     )
+    widest = cfg.peer_bearing_tolerance_rad + math.atan2(cfg.robot_radius_m, range_min_m) + 1e-9
+    return params, widest
 
 
 def _frame(scan: LaserScanData) -> tuple[float, float, float, float]:
@@ -665,7 +663,7 @@ def _extract(
     angles, cos_t, sin_t = extractor.ray_directions(first, ranges.shape[1])
     cfg = extractor.config
     range_min = max(float(first.range_min_m), 0.0)
-    params = _kernel_parameters(cfg, extractor.feature_range_m, range_min, float(first.range_max_m))
+    params, widest_window = _constants(extractor, range_min, float(first.range_max_m))
     # REP 117: -inf means "too close to measure", i.e. an obstacle at range_min.
     azimuths, distances, start, finite, windows = select_kernel(
         ranges,
@@ -678,12 +676,14 @@ def _extract(
         rotation,
         max_distance,
         angles,
-        _widest_window(cfg, range_min),
+        widest_window,
     )
     # The transcendental functions in numpy, as the extractor computes them (numpy's value
     # of an element does not depend on the array around it).
-    bearing = np.full(azimuths.size, math.nan)
-    if finite.size:
+    if finite.size == azimuths.size:  # every bearing finite (the common case)
+        bearing = np.arctan2(np.sin(azimuths), np.cos(azimuths))
+    else:
+        bearing = np.full(azimuths.size, math.nan)
         finite_azimuths = azimuths[finite]
         bearing[finite] = np.arctan2(np.sin(finite_azimuths), np.cos(finite_azimuths))
     # NaN: no window (a ray this far from every bearing is in none).
