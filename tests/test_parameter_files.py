@@ -51,7 +51,7 @@ _SIM_BRIDGE_ADDED = {
     'start_after_clock_subscribers': 0,
 }
 ADDED = {
-    'oabug': {'min_turn_rate_radps': 0.3},
+    'oabug': {'min_turn_rate_radps': 0.3, 'robot_contact_distance_m': 0.16},
     'sim_bridge': {'physics': 'numpy', **_SIM_BRIDGE_ADDED},
     'msc_pf': {'swarm.search_alone': False, 'msc.turn_margin_db': 2.0},
     'bayes_swarm': {

@@ -240,7 +240,7 @@ def features_kernel(
         params: range_min, limit, front_half_width, follow_capture, cone_cos,
             peer_mask_range, robot_radius, peer_distance_factor, side_lookahead,
             side_window_behind, side_wall_band, abeam_behind, abeam_reach, fit_tolerance,
-            min_spread.
+            min_spread, robot_contact_distance, contact_cos.
         real_out: (K, 4) output per scan: the wall ahead and the robot ahead [m], the
             distance [m] and angle [rad, as seen on the left] of the wanted side's wall
             (read only where its return count is not 0).
@@ -263,6 +263,8 @@ def features_kernel(
         abeam_reach,
         fit_tolerance,
         min_spread,
+        contact,
+        contact_cos,
     ) = params
     body = 2.0 * radius
     num_scans, num_rays = ranges.shape
@@ -338,7 +340,8 @@ def features_kernel(
             y = r * sin_t[j]
             if is_peer[m]:
                 peers += 1
-                if c >= cone_cos and r < front_robot:
+                ahead = c >= cone_cos or (c >= contact_cos and r <= contact)
+                if ahead and r < front_robot:
                     front_robot = r
                 continue
             if x > 0.0 and abs(y) <= front_half_width and x < front_wall:
@@ -488,6 +491,8 @@ def _constants(
             cfg.abeam_reach_m,
             cfg.side_wall_fit_tolerance_m,
             MIN_FIT_SPREAD_M,
+            cfg.robot_contact_distance_m,
+            math.cos(cfg.robot_contact_half_angle_rad),
         )
     )
     widest = cfg.peer_bearing_tolerance_rad + math.atan2(cfg.robot_radius_m, range_min_m) + 1e-9
