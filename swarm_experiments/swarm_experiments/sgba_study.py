@@ -166,9 +166,12 @@ def report_comparison(page: ReportPage) -> None:
         return
     page.add_heading('SGBA beside OA-Bug')
     records = []
-    for (site, robots, departure), group in rows.groupby(
-        ['config.site', 'config.robots', 'config.departure'], sort=False
-    ):
+    site_order = {'small': 0, 'medium': 1, 'big': 2}
+    groups = sorted(
+        rows.groupby(['config.site', 'config.departure', 'config.robots'], sort=False),
+        key=lambda item: (site_order.get(str(item[0][0]), 3), str(item[0][0]), *item[0][1:]),
+    )
+    for (site, departure, robots), group in groups:
         for method in METHODS:
             runs = group[group['config.method'] == method]['metric.coverage_pct']
             if len(runs):
@@ -182,7 +185,9 @@ def report_comparison(page: ReportPage) -> None:
                         'sites': len(runs),
                     }
                 )
-    page.add_table(pd.DataFrame(records), title='Coverage % (mean ± std over sites)')
+    page.add_table(
+        pd.DataFrame(records), title='Coverage % (mean ± std over sites)', export='coverage'
+    )
     frames = []
     for baseline in ('gas_sound', 'gas'):
         subset = rows[rows['config.method'].isin((baseline, *SGBA_METHODS))]
@@ -202,4 +207,5 @@ def report_comparison(page: ReportPage) -> None:
             pd.concat(frames, ignore_index=True),
             title='SGBA minus OA-Bug on the same sites (coverage points)',
             digits=2,
+            export='paired',
         )

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 from swarm_experiments.mission import run_mission
@@ -100,6 +102,11 @@ def test_smoke_runs_both_methods_and_reports_the_paired_comparison(tmp_path):
     text = page.read_text()
     assert '## SGBA beside OA-Bug' in text
     assert 'sgba_scaled - gas_sound' in text
+    # Both tables are exported for the docs' generated results sections.
+    exported = json.loads((page.parent / 'results.json').read_text())['tables']
+    assert {'coverage', 'paired'} <= set(exported)
+    methods = [row[3] for row in exported['coverage']['rows']]
+    assert methods.index('gas_sound') < methods.index('sgba_scaled')  # OA-Bug leads
 
 
 def test_an_sgba_run_records_the_coverage_curve():
