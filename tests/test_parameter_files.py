@@ -59,6 +59,7 @@ ADDED = {
         'cobyla_max_iterations': 1000,
         'penalty_estimate': False,
         'cobyla_library': 'nlopt',
+        'signal_scale': 1.0,
     },
 }
 # Defaults changed on purpose since the recording (name -> new default): the Bayes-Swarm

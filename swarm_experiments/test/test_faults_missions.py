@@ -12,7 +12,7 @@ from swarm_experiments.cli_args import fault_config
 from swarm_experiments.mission import run_mission
 from swarm_experiments.msc_pf_batch import BatchScenario, run_batch
 from swarm_experiments.node_overrides import OverrideError
-from swarm_experiments.oabug_batch import BatchRobot, _deliver, run_oabug_batch
+from swarm_experiments.oabug_batch import BatchRobot, BatchSwarm, _deliver, run_oabug_batch
 from swarm_experiments.reliability import decisions_after_s, parse_fault, still_time_s
 from swarm_experiments.spawn import SpawnSettings, build_mission
 from swarm_experiments.spawn import main as spawn_main
@@ -66,9 +66,7 @@ def _robots_and_engine(settings):
         bearing_cycles=True,
     )
     robots = [BatchRobot(r.parameters, engine.config.lidar) for r in spec.robots]
-    tags = tuple(f'R{i}' for i in range(len(robots)))
-    own = np.array([robot.own_tag_index(tags) for robot in robots], dtype=np.int64)
-    return engine, robots, own
+    return engine, BatchSwarm(robots, tuple(f'R{i}' for i in range(len(robots))))
 
 
 class PushWatch:
@@ -106,7 +104,7 @@ def test_survivors_never_push_into_a_wall_and_lidarless_robots_stop_with_the_pum
     settings = SpawnSettings(
         site='small', robots=10, variant='gas_sound', seed=4, engine=EngineConfig(faults=faults)
     )
-    engine, robots, own = _robots_and_engine(settings)
+    engine, swarm = _robots_and_engine(settings)
     plan = engine.fault_plan
     stale = plan.mask('stale_lidar')
     working = ~(plan.mask('dropout') | stale)
@@ -114,7 +112,7 @@ def test_survivors_never_push_into_a_wall_and_lidarless_robots_stop_with_the_pum
     pumped_before = np.zeros(10, dtype=bool)
     while engine.time_s < 150.0:
         out = engine.step()
-        _deliver(engine, out, robots, own)
+        _deliver(engine, out, swarm)
         pushing.update(engine, out.poses)
         now = engine.time_s
         if now < onset:
@@ -145,11 +143,11 @@ def test_robots_touching_side_by_side_do_not_push_for_ever():
             profile='tuned',
             robot_parameters={'robot_contact_distance_m': contact_m},
         )
-        engine, robots, own = _robots_and_engine(settings)
+        engine, swarm = _robots_and_engine(settings)
         pushing = PushWatch(engine)
         while engine.time_s < 45.0:
             out = engine.step()
-            _deliver(engine, out, robots, own)
+            _deliver(engine, out, swarm)
             pushing.update(engine, out.poses)
         return pushing.longest_s.max()
 
