@@ -287,12 +287,12 @@ def plan_jobs(experiments: list[str], runs: int, baseline_runs: int, large_runs:
     if 'avalanche' in experiments:
         noise = 47.0 / 100.0
         av = 'Avalanche, 6 UAVs'
-        paper_units = {'dimensionless_acquisition': False}
+        dimensionless = {'dimensionless_acquisition': True}
         rows: list[tuple[str, str, dict[str, Any], float, float | None, float | None]] = [
             ('Bayes-Swarm-P', 'bayes_swarm_p', {}, 0.0, None, None),
             ('Bayes-Swarm-O', 'bayes_swarm_o', {}, 0.0, None, None),
             ('Bayes-Swarm-P (alpha = 1)', 'bayes_swarm_p', {'fixed_alpha': 1.0}, 0.0, None, None),
-            ("Bayes-Swarm-P, paper's Eq. 1 units", 'bayes_swarm_p', paper_units, 0.0, None, None),
+            ('Bayes-Swarm-P, dimensionless Eq. 1', 'bayes_swarm_p', dimensionless, 0.0, None, None),
             ('Glowworm', 'glowworm', {}, 0.0, None, None),
             ('Levy walk', 'levy', {}, 0.0, None, None),
             ('noise 0.47, Bayes-Swarm-P', 'bayes_swarm_p', {}, noise, None, None),

@@ -1,22 +1,29 @@
 """In-process against multi-process missions on real DDS: metrics and wall times.
 
-For each algorithm the same short mission runs over N seeds three ways, each run a spawner
-command line in a process of its own:
+For each mission the same run goes over N seeds three ways, each run a spawner command line
+in a process of its own:
 
 - ``builtin``: in process on the built-in runtime (exact sim time: the reference);
 - ``rclpy``: in process on real rclpy (``--runtime rclpy``), through Fast DDS, in real time
   scaled by ``--time-scale``;
 - ``processes``: one process per node (``--processes``), as on robots.
 
-It reports each algorithm's metric as its spawner prints it (OA-Bug: coverage; Bayes-Swarm:
-tau of the finder and how many seeds found the source; MSC + PF: targets captured and the
-CCT where all were) and the wall time of each run (start-up included), mean and standard
-deviation over the seeds. Then it sweeps ``--time-scale`` for 10 OA-Bug robots in processes
-and finds the fastest scale whose mean coverage still matches the built-in reference within
-noise (two standard errors of the difference of the means).
+Missions (``--missions``): ``oabug``, ``bayes_swarm`` and ``msc_pf`` are short runs of each
+algorithm on 3-4 robots; ``oabug_demo`` is ``make demo``'s mission (6 robots, a Small site,
+until every room is covered or the budget is spent) and ``oabug_10`` the same with 10 robots.
+Each mission has its own time scale (``--time-scale`` sets one for all): Bayes-Swarm runs at
+1, because with one process per node the clock runs on while a robot decides.
+
+It reports each mission's metric as its spawner prints it (OA-Bug: coverage and the time
+the last room was first entered; Bayes-Swarm: tau of the finder and how many seeds found the
+source; MSC + PF: targets captured and the CCT where all were) and the wall time of each run
+(start-up included), mean and standard deviation over the seeds, and whether each real-rclpy
+mode matches the built-in reference within noise (two standard errors of the difference of
+the means). Then it sweeps ``--time-scale`` for 10 OA-Bug robots in processes (60 actions)
+and finds the fastest scale whose mean coverage still matches the built-in reference.
 
     nice -n 10 python benchmarks/bench_processes.py                     # everything
-    nice -n 10 python benchmarks/bench_processes.py --algorithms oabug --seeds 3 --no-sweep
+    nice -n 10 python benchmarks/bench_processes.py --missions oabug --seeds 3 --no-sweep
 """
 
 from __future__ import annotations
@@ -52,7 +59,7 @@ class Mission:
 
 MISSIONS = {
     'oabug': Mission('oabug', 'spawn', ('--robots', '4', '--actions', '60'), 2.0),
-    'bayes_swarm': Mission('bayes_swarm', 'spawn_bayes_swarm', ('--robots', '3'), 2.0),
+    'bayes_swarm': Mission('bayes_swarm', 'spawn_bayes_swarm', ('--robots', '3'), 1.0),
     'msc_pf': Mission(
         'msc_pf',
         'spawn_msc_pf',
@@ -68,6 +75,8 @@ MISSIONS = {
         ),
         10.0,
     ),
+    'oabug_demo': Mission('oabug_demo', 'spawn', ('--robots', '6', '--variant', 'gas_sound'), 2.0),
+    'oabug_10': Mission('oabug_10', 'spawn', ('--robots', '10', '--variant', 'gas_sound'), 2.0),
 }
 SWEEP = Mission('oabug', 'spawn', ('--robots', '10', '--actions', '60'), 1.0)
 
@@ -81,11 +90,15 @@ class RunResult:
 
 
 def _metrics(name: str, out: str) -> dict[str, float]:
-    if name == 'oabug':
+    if name.startswith('oabug'):
         m = re.search(r'Coverage: ([\d.]+) % \((\d+)/(\d+) rooms\)', out)
         if m is None:
             raise RuntimeError(f'no coverage line in:\n{out}')
-        return {'coverage_%': float(m.group(1))}
+        metrics = {'coverage_%': float(m.group(1))}
+        if name != 'oabug':
+            last = re.search(r'last new room entered at ([\d.]+) s', out)
+            metrics['last_room_s'] = float(last.group(1)) if last else math.nan
+        return metrics
     if name == 'bayes_swarm':
         if not re.search(r'^case \S+, ', out, re.MULTILINE):
             raise RuntimeError(f'no report in:\n{out}')
@@ -147,17 +160,39 @@ def _env() -> dict[str, str]:
 
 def compare(missions: Sequence[Mission], seeds: int, env: dict[str, str]) -> None:
     """The side-by-side table of the three modes."""
-    print('| algorithm | mode | time scale | metric (mean ± sd over seeds) | wall per run [s] |')
-    print('|---|---|---|---|---|')
+    print(
+        '| mission | mode | time scale | metric (mean ± sd over seeds) | wall per run [s] '
+        '| matches the reference |'
+    )
+    print('|---|---|---|---|---|---|')
     for mission in missions:
+        reference: list[RunResult] = []
         for mode in MODES:
             runs = [_run(mission, mode, seed, mission.time_scale, env) for seed in range(seeds)]
-            metrics = ', '.join(
-                f'{name} {_summary([r.metrics[name] for r in runs])}' for name in runs[0].metrics
-            )
+            if mode == 'builtin':
+                reference = runs
+            names = list(runs[0].metrics)
+            metrics = ', '.join(f'{n} {_summary([r.metrics[n] for r in runs])}' for n in names)
             scale = 'n/a' if mode == 'builtin' else f'{mission.time_scale:g}'
             walls = _summary([r.wall_s for r in runs])
-            print(f'| {mission.name} | {mode} | {scale} | {metrics} | {walls} |', flush=True)
+            verdict = 'reference' if mode == 'builtin' else _verdict(reference, runs, names)
+            print(
+                f'| {mission.name} | {mode} | {scale} | {metrics} | {walls} | {verdict} |',
+                flush=True,
+            )
+
+
+def _verdict(reference: Sequence[RunResult], runs: Sequence[RunResult], names: list[str]) -> str:
+    """Per metric, whether the mean matches the reference's within noise."""
+    parts = []
+    for name in names:
+        ref = [r.metrics[name] for r in reference if math.isfinite(r.metrics[name])]
+        other = [r.metrics[name] for r in runs if math.isfinite(r.metrics[name])]
+        if not ref or not other:
+            parts.append(f'{name} n/a')
+            continue
+        parts.append(f'{name} {"yes" if _matches(ref, other) else "no"}')
+    return ', '.join(parts)
 
 
 def sweep(scales: Sequence[float], seeds: int, env: dict[str, str]) -> None:
@@ -187,7 +222,14 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Command-line entry point."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument('--seeds', type=int, default=10, help='seeds per algorithm and mode')
-    parser.add_argument('--algorithms', nargs='+', choices=tuple(MISSIONS), default=list(MISSIONS))
+    parser.add_argument(
+        '--missions',
+        '--algorithms',
+        nargs='+',
+        choices=tuple(MISSIONS),
+        default=['oabug', 'bayes_swarm', 'msc_pf'],
+        help='missions to compare (default: the three short ones)',
+    )
     parser.add_argument('--sweep-seeds', type=int, default=5, help='seeds per time scale')
     parser.add_argument('--scales', type=float, nargs='+', default=[2.0, 4.0, 8.0, 16.0])
     parser.add_argument('--no-sweep', action='store_true', help='skip the time-scale sweep')
@@ -203,7 +245,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     )
     env = _env()
     start = time.perf_counter()
-    missions = [MISSIONS[name] for name in args.algorithms]
+    missions = [MISSIONS[name] for name in args.missions]
     if args.time_scale is not None:
         missions = [dataclasses.replace(m, time_scale=args.time_scale) for m in missions]
     compare(missions, args.seeds, env)

@@ -8,7 +8,9 @@ cost of its site configuration, the measured variant of its class (random for th
 variants without scent, gas_sound for the two with it) and its robot count by linear
 interpolation between the measured counts; the departure is assumed not to change the
 cost. The runs are then scheduled as ``swarm_study project`` does (Dask's per-task overhead,
-dispatch rate and startup). Example::
+dispatch rate and startup: the figures of ``swarm_experiments.study.projection`` unless
+``--overhead-ms``, ``--dispatch-ms`` and ``--startup-s`` give others, e.g. measured again
+with ``benchmarks/bench_study_engine.py --measure dask``). Example::
 
     python benchmarks/project_oabug_fig4.py --from DIR/oabug-fig4 --cores 2 32 256
 """
@@ -45,6 +47,19 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument('--from', dest='measured', type=Path, required=True)
     parser.add_argument('--cores', type=int, nargs='+', default=[2, 32, 256])
     parser.add_argument('--cpu-scale', type=float, default=1.0)
+    parser.add_argument(
+        '--overhead-ms',
+        type=float,
+        default=1000 * DASK_OVERHEAD_S,
+        help="the engine's core time per task (bench_study_engine.py's core_overhead_per_task_ms)",
+    )
+    parser.add_argument(
+        '--dispatch-ms',
+        type=float,
+        default=1000 * DASK_DISPATCH_S,
+        help="the engine's wall time per task (bench_study_engine.py's overhead_per_task_ms)",
+    )
+    parser.add_argument('--startup-s', type=float, default=DASK_STARTUP_S)
     args = parser.parse_args(argv)
     rows = read_rows(args.measured)
     rows = rows[rows['status'] == 'ok']
@@ -65,9 +80,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         projection = project_wall_time(
             costs,
             cores,
-            per_task_overhead_s=DASK_OVERHEAD_S,
-            dispatch_s=DASK_DISPATCH_S,
-            startup_s=DASK_STARTUP_S,
+            per_task_overhead_s=args.overhead_ms / 1000,
+            dispatch_s=args.dispatch_ms / 1000,
+            startup_s=args.startup_s,
             cpu_scale=args.cpu_scale,
         )
         print(f'{cores} cores: {projection.summary()}')

@@ -51,7 +51,7 @@ _SIM_BRIDGE_ADDED = {
     'start_after_clock_subscribers': 0,
 }
 ADDED = {
-    'oabug': {'min_turn_rate_radps': 0.3},
+    'oabug': {'min_turn_rate_radps': 0.3, 'robot_contact_distance_m': 0.16},
     'sim_bridge': {'physics': 'numpy', **_SIM_BRIDGE_ADDED},
     'msc_pf': {
         'swarm.search_alone': False,
@@ -73,6 +73,7 @@ ADDED = {
         'cobyla_max_iterations': 1000,
         'penalty_estimate': False,
         'cobyla_library': 'nlopt',
+        'signal_scale': 1.0,
     },
 }
 # Defaults changed on purpose since the recording (name -> new default): the Bayes-Swarm

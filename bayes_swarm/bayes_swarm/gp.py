@@ -352,8 +352,10 @@ class ExtendedVariance:
         # k(q, X) transposed is k(X, q) in column-major order, as trsm takes it.
         k = se_kernel(q, self._x, self._hyper).T
         v = dtrsm(1.0, self._chol_f, k, lower=1, overwrite_b=1)
-        var = self._hyper.signal_variance - np.einsum('ij,ij->j', v, v)
-        return np.sqrt(np.maximum(var, 0.0))
+        var = np.einsum('ij,ij->j', v, v)
+        np.subtract(self._hyper.signal_variance, var, out=var)
+        np.maximum(var, 0.0, out=var)
+        return np.sqrt(var, out=var)
 
 
 def _inverse_factor(chol: np.ndarray) -> np.ndarray:

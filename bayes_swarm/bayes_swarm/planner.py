@@ -35,6 +35,7 @@ from bayes_swarm.acquisition import acquisition, omega, planned_path_points, ray
 from bayes_swarm.alpha import AlphaBranch, AlphaDecision, exploitation_weight
 from bayes_swarm.errors import BayesSwarmError, ObservationError
 from bayes_swarm.gp import ExtendedVariance, GaussianProcess, downsample_indices
+from bayes_swarm.lbfgsb import minimize_box
 from bayes_swarm.messages import Decision, DecisionKind, PeerUpdate
 from bayes_swarm.observations import ObservationStore, finite_samples
 from bayes_swarm.penalty import local_penalty
@@ -276,18 +277,34 @@ class BayesSwarmPlanner:
             keep = keep[keep < pts.shape[0] - 1]
         else:
             keep = downsample_indices(pts.shape[0], cfg.n_max)
-        return pts[keep], vals[keep]
+        return pts[keep], vals[keep] / cfg.signal_scale
 
     def _estimated_penalty_constants(self, values: np.ndarray) -> tuple[float, float]:
         """M and L of the penalty from the belief (local penalization, Gonzalez et al. 2016).
 
-        M is the largest observed value; L the largest norm of the GP mean's gradient over
-        the arena grid and the data points (the configured L if that is below 1e-7).
+        M is the largest observation (their estimate of the maximum). L is the largest norm
+        of the GP mean's gradient over the arena: the best of the arena grid and the data
+        points, refined by L-BFGS-B on the analytic gradient of that norm (as GPyOpt
+        estimates it); the configured L if the belief is flat (below 1e-7).
         """
-        points = np.vstack([self._mean_grid, self._gp.training_inputs])
-        _, grad, _ = self._gp.mean_derivatives(points)
-        lipschitz = float(np.max(np.hypot(grad[:, 0], grad[:, 1])))
-        if not (math.isfinite(lipschitz) and lipschitz > 1e-7):
+        gp = self._gp
+        points = np.vstack([self._mean_grid, gp.training_inputs])
+        _, grad, _ = gp.mean_derivatives(points)
+        norms = np.hypot(grad[:, 0], grad[:, 1])
+        best = int(np.argmax(norms))
+        lipschitz = float(norms[best])
+        if math.isfinite(lipschitz) and lipschitz > 1e-7:
+            arena = self._cfg.arena
+            _, value = minimize_box(
+                _negated_gradient_norm,
+                points[best],
+                np.asarray(arena.lower, dtype=float),
+                np.asarray(arena.upper, dtype=float),
+                args=(gp,),
+            )
+            if np.isfinite(value):
+                lipschitz = max(lipschitz, -value)
+        else:
             lipschitz = self._cfg.lipschitz
         return float(np.max(values)), lipschitz
 
@@ -398,15 +415,24 @@ class BayesSwarmPlanner:
         seeds.append(self._rng.uniform(arena.lower, arena.upper))
         if cfg.inner_optimizer == 'newton':
             return ascend_mean(self._gp, np.array(seeds), arena)
-        bounds = list(zip(arena.lower, arena.upper, strict=True))
+        lower = np.asarray(arena.lower, dtype=float)
+        upper = np.asarray(arena.upper, dtype=float)
         best_x, best_f = seeds[0], -math.inf
         for seed in seeds:
-            result = minimize(
-                _negated_mean, seed, args=(self._gp,), jac=True, method='L-BFGS-B', bounds=bounds
-            )
-            if np.isfinite(result.fun) and -float(result.fun) > best_f:
-                best_x, best_f = result.x, -float(result.fun)
+            x, value = minimize_box(_negated_mean, seed, lower, upper, args=(self._gp,))
+            if np.isfinite(value) and -value > best_f:
+                best_x, best_f = x, -value
         return arena.clip(np.asarray(best_x, dtype=float))
+
+
+def _negated_gradient_norm(x: np.ndarray, gp: GaussianProcess) -> tuple[float, np.ndarray]:
+    """-|grad mu(x)| and its gradient -H g / |g| (L-BFGS-B objective of the estimated L)."""
+    _, grad, hess = gp.mean_derivatives(np.asarray(x, dtype=float).reshape(1, 2))
+    g, h = grad[0], hess[0]
+    norm = float(np.hypot(g[0], g[1]))
+    if norm < 1e-300:
+        return -norm, np.zeros(2)
+    return -norm, -(h @ g) / norm
 
 
 def _negated_mean(x: np.ndarray, gp: GaussianProcess) -> tuple[float, np.ndarray]:
@@ -494,11 +520,16 @@ class _OuterProblem:
         self.path_weights = np.full(self.n_steps + 1, 1.0 / self.n_steps)
         self.path_weights[[0, -1]] *= 0.5
         self.path_base = np.zeros(2) if cfg.authors_origin_paths else position
+        self._path_u_column = self.path_u[:, None]
         # The penalty's per-peer constants of value(): z = (L d - M + mu) / (sqrt(2) sigma).
         self.peer_shift = np.asarray(peer_mean, dtype=float) - max_signal
         self.peer_scale = 1.0 / (
             math.sqrt(2.0) * np.maximum(np.asarray(peer_std, dtype=float), cfg.penalty_std_floor)
         )
+        # value() forms -z directly ((L d - M + mu) * (-scale) is -z exactly), in place.
+        self._peer_x = np.ascontiguousarray(peer_waypoints[:, 0], dtype=float)
+        self._peer_y = np.ascontiguousarray(peer_waypoints[:, 1], dtype=float)
+        self._negated_peer_scale = -self.peer_scale
         # The paper's units: Omega with distances in metres, Sigma in signal * m. Dimensionless:
         # Omega with distances in leg lengths V T, Sigma divided by its largest value (the prior
         # std along the longest leg); both then lie in [0, 1] whatever the field's scale.
@@ -526,18 +557,21 @@ class _OuterProblem:
         The same terms in the same units (COBYLA's objective, called tens of times per
         decision); equal to ``values(x)[0]`` up to rounding.
         """
-        px, py = float(self.position[0]), float(self.position[1])
-        ox, oy = float(x[0]) - px, float(x[1]) - py
-        samples = self.path_base + self.path_u[:, None] * np.array([ox, oy])
-        std = self.ext.std(samples)
+        x0, x1 = float(x[0]), float(x[1])
+        ox, oy = x0 - float(self.position[0]), x1 - float(self.position[1])
+        std = self.ext.std(self.path_base + self._path_u_column * np.array([ox, oy]))
         sigma = math.hypot(ox, oy) * float(self.path_weights @ std) * self.sigma_scale
-        ex, ey = float(x[0]) - float(self.expected[0]), float(x[1]) - float(self.expected[1])
+        ex, ey = x0 - float(self.expected[0]), x1 - float(self.expected[1])
         omega_value = 1.0 / (1.0 + (ex * ex + ey * ey) / self.omega_unit_m**2)
         gamma = 1.0
-        if self.peer_waypoints.shape[0]:
-            dist = np.hypot(self.peer_waypoints[:, 0] - x[0], self.peer_waypoints[:, 1] - x[1])
-            z = (self.lipschitz * dist + self.peer_shift) * self.peer_scale
-            gamma = float(np.prod(0.5 * erfc(-z)))
+        if self._peer_x.shape[0]:
+            factors = np.hypot(self._peer_x - x0, self._peer_y - x1)
+            factors *= self.lipschitz
+            factors += self.peer_shift
+            factors *= self._negated_peer_scale  # -z
+            erfc(factors, out=factors)
+            factors *= 0.5
+            gamma = float(np.multiply.reduce(factors))
         return (self.alpha * omega_value + (1.0 - self.alpha) * sigma) * gamma
 
     def values(self, points: np.ndarray) -> np.ndarray:

@@ -12,7 +12,8 @@ profiles are this project's departures, each listed in docs/bayes_swarm.md.
   run does not depend on the seed at all (only the random jumps of Algorithm 1 would).
 * ``estimated-penalty``: the paper's solvers, but the penalty's M and L estimated from the
   robot's belief at every decision as in Gonzalez et al.'s local penalization (M the largest
-  observation, L the largest gradient norm of the GP mean), instead of the fixed values.
+  observation, L the largest gradient norm of the GP mean over the arena), instead of the
+  fixed values.
 """
 
 from __future__ import annotations

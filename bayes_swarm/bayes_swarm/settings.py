@@ -103,19 +103,19 @@ class GpConfig:
 
     The kernel is ``signal_variance * exp(-|x - x'|^2 / (2 length_scale^2))`` plus
     ``noise_std^2`` on the diagonal. Hyperparameters are fitted by maximum marginal likelihood
-    within the bounds; to keep decisions fast they are refitted only when the data set has grown
-    by ``refit_growth_factor`` since the last fit, on at most ``max_fit_points`` samples, with at
-    most ``max_fit_iterations`` likelihood evaluations.
+    within the bounds, at every decision as in the paper (``refit_growth_factor`` 1; a larger
+    factor refits only once the data set has grown by it since the last fit), on at most
+    ``max_fit_points`` samples, with at most ``max_fit_iterations`` likelihood evaluations.
     """
 
-    noise_std: float = parameter(1e-3, 'GP observation noise std (signal units)', gt=0.0)
+    noise_std: float = parameter(1e-3, 'GP observation noise std (signal / signal_scale)', gt=0.0)
     length_scale_bounds_m: tuple[float, float] = (1e-3, 500.0)
     signal_variance_bounds: tuple[float, float] = (1e-5, 1e5)
     initial_length_scale_m: float = 1.0
     initial_signal_variance: float = 1.0
     max_fit_points: int = 80
     max_fit_iterations: int = 30
-    refit_growth_factor: float = 2.0
+    refit_growth_factor: float = 1.0
     max_jitter: float = 1e-2
 
     def __post_init__(self) -> None:
@@ -140,6 +140,10 @@ class BayesSwarmConfig:
     M = 1.2, L = 2, delta theta = 90 deg, f = 1 Hz, N_max = 1000, l_robot = 0.1 m).
     ``robot_index`` is 0-based; the first decision uses r = robot_index + 1 as in Algorithm 1.
     ``fixed_alpha`` replaces Algorithm 2 by a constant (the paper's 'alpha = 1' variant).
+    ``signal_scale`` is the unit of the belief: samples are divided by it before the GP sees
+    them, so M, L (and the GP noise std) are in units of the signal over ``signal_scale``;
+    the avalanche case reads the paper's M = 1.2 and L = 2 for the beacon signal over its
+    known peak (47).
     ``dimensionless_acquisition`` (not in the paper) measures Omega's distances in leg lengths
     V T and divides Sigma by the prior std times V T, so both terms lie in [0, 1]; with the
     paper's units Sigma dwarfs Omega on a field of large values (the avalanche, up to 47) and
@@ -160,6 +164,12 @@ class BayesSwarmConfig:
     max_mission_time_s: float = parameter(100.0, 'T_max of the alpha schedule', unit='s', gt=0.0)
     initial_direction_range_deg: float = parameter(
         90.0, 'Delta theta of the first decision', unit='deg', gt=0.0, le=360.0
+    )
+    signal_scale: float = parameter(
+        1.0,
+        'samples are divided by it before they enter the belief; M, L and noise_std are in '
+        'these units (avalanche: the beacon peak 47)',
+        gt=0.0,
     )
     max_signal: float = parameter(1.2, 'M, the maximum signal strength of the penalty')
     lipschitz: float = parameter(
@@ -225,6 +235,7 @@ class BayesSwarmConfig:
             'robot_size_m',
             'alpha_time_scale',
             'penalty_std_floor',
+            'signal_scale',
         ):
             _positive(name, getattr(self, name))
         _finite('max_signal', self.max_signal)

@@ -207,11 +207,22 @@ def test_non_finite_training_data_is_rejected():
         gp.fit(np.zeros((3, 3)), np.zeros(3))
 
 
+def test_the_default_refits_the_hyperparameters_at_every_fit_as_the_paper():
+    rng = np.random.default_rng(4)
+    x = rng.uniform(0, 3, size=(30, 2))
+    y = np.cos(x[:, 0])
+    gp = GaussianProcess(GpConfig())
+    gp.fit(x[:20], y[:20])
+    first = gp.hyperparameters
+    gp.fit(x[:21], y[:21])
+    assert gp.hyperparameters != first
+
+
 def test_a_refit_follows_a_jump_in_the_signal_scale_before_the_data_doubles():
     rng = np.random.default_rng(4)
     x = rng.uniform(0, 3, size=(30, 2))
     faint = 0.01 * np.cos(x[:, 0])
-    gp = GaussianProcess(GpConfig())
+    gp = GaussianProcess(GpConfig(refit_growth_factor=2.0))
     gp.fit(x[:20], faint[:20])
     first = gp.hyperparameters
     gp.fit(x[:25], faint[:25])

@@ -217,6 +217,34 @@ def test_dimensionless_acquisition_makes_the_decision_independent_of_the_signal_
     assert np.hypot(*(_decision_on_scaled_field(100.0, False) - paper)) > 0.5
 
 
+def _decision_with_signal_scale(field_scale, signal_scale):
+    cfg = BayesSwarmConfig(signal_scale=signal_scale, fixed_alpha=0.9)
+    planner = BayesSwarmPlanner(cfg, 'r0', seed=1)
+    planner.decide([0, 0], 0.0)
+    for end in ([0.26, 0.97], [0.71, 0.71], [0.97, 0.26]):
+        pts = np.linspace([0, 0], end, 11)
+        planner.add_observations(pts, field_scale * case1_field(pts))
+    planner.receive(PeerUpdate('r1', 1, np.array([0.71, 0.71]), np.array([2.2, 1.4])))
+    return planner.decide([2.1, 1.3], 10.0)
+
+
+def test_signal_scale_makes_the_planner_see_the_signal_in_its_units():
+    """A field 47 times stronger with signal_scale 47 is the same belief (M, L, noise in the
+    scaled units), so the same decision; without the scale the penalty and Sigma change it."""
+    reference = _decision_with_signal_scale(1.0, 1.0)
+    scaled = _decision_with_signal_scale(47.0, 47.0)
+    # Equal up to the solvers' tolerances (COBYLA's final step is 1e-4 m).
+    np.testing.assert_allclose(scaled.waypoint_m, reference.waypoint_m, atol=1e-3)
+    np.testing.assert_allclose(scaled.expected_source_m, reference.expected_source_m, atol=1e-4)
+    unscaled = _decision_with_signal_scale(47.0, 1.0)
+    assert np.hypot(*(unscaled.waypoint_m - reference.waypoint_m)) > 0.05
+
+
+def test_signal_scale_must_be_positive():
+    with pytest.raises(ConfigError, match='signal_scale'):
+        BayesSwarmConfig(signal_scale=0.0)
+
+
 def _with_data(cfg, peer_waypoint):
     planner = BayesSwarmPlanner(cfg, 'r0', seed=4)
     planner.decide([0, 0], 0.0)
@@ -243,11 +271,19 @@ def test_a_penalty_ball_over_the_whole_arena_stalls_cobyla_and_the_estimate_free
     estimating = _with_data(replace(fixed, penalty_estimate=True), [1.2, 1.2])
     free = estimating.decide([0.71, 0.71], 50.0)
     assert free.kind is DecisionKind.ACQUISITION
-    assert abs(free.waypoint_m[1] - 0.71) > 0.05
-    values = np.array([0.2, 0.9, 0.4])
-    m, lipschitz = estimating._estimated_penalty_constants(values)
+    assert np.hypot(*(free.waypoint_m - [0.71, 0.71])) > 0.5  # a real leg, not a stall
+    assert abs(free.waypoint_m[1] - 0.71) > 0.02  # not COBYLA's first step either
+    gp = estimating.gp
+    # M: the largest observation (Gonzalez et al.'s estimate).
+    m, lipschitz = estimating._estimated_penalty_constants(np.array([0.2, 0.9, 0.4]))
     assert m == 0.9
-    _, grad, _ = estimating.gp.mean_derivatives(estimating.gp.training_inputs)
+    # L: the largest gradient norm of the GP mean over the arena (a fine grid's maximum,
+    # to its spacing), above the data points' and below the paper's 2 here.
+    g = np.linspace(0.0, 2.4, 241)
+    grid = np.stack(np.meshgrid(g, g), axis=-1).reshape(-1, 2)
+    _, grad, _ = gp.mean_derivatives(grid)
+    assert lipschitz == pytest.approx(float(np.max(np.hypot(grad[:, 0], grad[:, 1]))), rel=1e-3)
+    _, grad, _ = gp.mean_derivatives(gp.training_inputs)
     assert lipschitz >= float(np.max(np.hypot(grad[:, 0], grad[:, 1]))) - 1e-12
     assert lipschitz < 2.0
 

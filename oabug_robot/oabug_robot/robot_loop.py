@@ -15,7 +15,7 @@ the same period; the batch runner asks the :class:`ControlTimer` when a step is 
 
 :func:`extract_features` computes the features of many loops at once (the loops of one
 perception configuration in one call of
-:func:`oabug_robot.scan_features_kernel.extract_many_flat`, equal to each loop's own
+:func:`oabug_robot.scan_features_kernel.extract_held`, equal to each loop's own
 extractor).
 """
 
@@ -37,7 +37,7 @@ from oabug_robot.scan_features import LaserScanData, ScanFeatureExtractor, ScanF
 from oabug_robot.settings import OABugConfig
 from oabug_robot.sound import PeerBearings
 
-__all__ = ['STOP', 'ControlTimer', 'LoopOutput', 'RobotLoop', 'extract_features', 'near_peers']
+__all__ = ['STOP', 'ControlTimer', 'LoopOutput', 'RobotLoop', 'extract_features']
 
 #: The fail-safe command: zero velocity, pump off.
 STOP = Command(linear_mps=0.0, angular_radps=0.0, pump_on=False)
@@ -121,14 +121,22 @@ class RobotLoop(Generic[_ScanT]):
         self._gas_raw: int | None = None
         self._gas_time_s: float | None = None
         self._bearings: PeerBearings | None = None
-        #: The inputs heard at least once (``scan`` counts once it gave features).
-        self.heard: set[str] = set()
 
     def configure(self, settings: OABugNodeConfig) -> None:
         """Take the settings a running node may change (the stale timeout)."""
         self.stale_timeout_s = settings.stale_timeout_s
 
     # Readings: each replaces the one held, stamped with the time it arrived [s].
+
+    @property
+    def heard(self) -> set[str]:
+        """The inputs heard at least once (``scan`` counts once it gave features)."""
+        stamps = (
+            ('scan', self._features_time_s),
+            ('imu', self._imu_time_s),
+            ('gas', self._gas_time_s),
+        )
+        return {name for name, stamp in stamps if stamp is not None}
 
     @property
     def yaw_rad(self) -> float:
@@ -149,13 +157,11 @@ class RobotLoop(Generic[_ScanT]):
         """An IMU yaw arrives (already read from the message's orientation)."""
         self._yaw_rad = yaw_rad
         self._imu_time_s = now_s
-        self.heard.add('imu')
 
     def hold_gas(self, raw: int | None, now_s: float) -> None:
         """A gas reading arrives (None while the sensor warms up: fresh, but no value)."""
         self._gas_raw = raw
         self._gas_time_s = now_s
-        self.heard.add('gas')
 
     def hold_bearings(
         self, azimuths_rad: np.ndarray, distances_m: np.ndarray, now_s: float
@@ -246,7 +252,6 @@ class RobotLoop(Generic[_ScanT]):
         self._features = features
         self._features_time_s = self._scan_time_s
         self._scan = None
-        self.heard.add('scan')
 
     def update_features(self, now_s: float) -> None:
         """Turn the pending scan (if any) into features with the loop's own extractor.
@@ -270,17 +275,10 @@ class RobotLoop(Generic[_ScanT]):
         """One control step at node time ``now_s`` [s], after :meth:`update_features` (or
         :func:`extract_features`): the controller's command, or :data:`STOP` and the stale
         inputs while any input is missing or stale."""
-        features = self._features
-        if features is None or not self._fresh(now_s):
+        command = self._step_controller(now_s)
+        if command is None:
             return LoopOutput(STOP, tuple(self.stale_inputs(now_s)) or ('scan',))
-        snapshot = SensorSnapshot(
-            time_s=now_s,
-            yaw_rad=self._yaw_rad,
-            scan=features,
-            gas_raw=self._gas_raw,
-            bearings=self._bearings,
-        )
-        return LoopOutput(self.fsm.step(snapshot))
+        return LoopOutput(command)
 
     def control(self, now_s: float) -> LoopOutput:
         """:meth:`update_features` (a malformed scan is dropped) then :meth:`step`."""
@@ -289,6 +287,30 @@ class RobotLoop(Generic[_ScanT]):
                 self.update_features(now_s)
         return self.step(now_s)
 
+    def command(self, now_s: float) -> Command:
+        """:meth:`control`'s command alone (what a batch runner applies; the stale inputs
+        are not named)."""
+        if self._scan is not None:
+            with contextlib.suppress(ScanError):
+                self.update_features(now_s)
+        command = self._step_controller(now_s)
+        return STOP if command is None else command
+
+    def _step_controller(self, now_s: float) -> Command | None:
+        """Step the controller on the held readings; None (no step) while an input is
+        missing or stale."""
+        features = self._features
+        if features is None or not self._fresh(now_s):
+            return None
+        snapshot = SensorSnapshot(
+            time_s=now_s,
+            yaw_rad=self._yaw_rad,
+            scan=features,
+            gas_raw=self._gas_raw,
+            bearings=self._bearings,
+        )
+        return self.fsm.step(snapshot)
+
 
 def _identity(scan: LaserScanData) -> LaserScanData:
     return scan
@@ -296,14 +318,16 @@ def _identity(scan: LaserScanData) -> LaserScanData:
 
 def extract_features(loops: Sequence[RobotLoop[Any]], now_s: float) -> None:
     """:meth:`RobotLoop.update_features` of many loops, the loops of one perception group in
-    one compiled call (:func:`oabug_robot.scan_features_kernel.extract_many_flat`, equal to
-    each loop's own extractor). A group whose scans the call cannot take (a
-    :class:`ScanError`) is left to each loop's own extractor in its control step; a loop whose
-    scan cannot be decoded drops it."""
-    from oabug_robot.scan_features_kernel import extract_many_flat
+    one compiled call (:func:`oabug_robot.scan_features_kernel.extract_held`, equal to each
+    loop's own extractor). A group whose scans the call cannot take (a :class:`ScanError`)
+    is left to each loop's own extractor in its control step; a loop whose scan cannot be
+    decoded drops it."""
+    from oabug_robot.scan_features_kernel import extract_held
 
     groups: dict[int, list[tuple[RobotLoop[Any], LaserScanData, int]]] = {}
     for loop in loops:
+        if loop._scan is None:  # nothing new (pending_scan would say None)
+            continue
         try:
             pending = loop.pending_scan()
         except ScanError:
@@ -311,45 +335,14 @@ def extract_features(loops: Sequence[RobotLoop[Any]], now_s: float) -> None:
         if pending is not None:
             groups.setdefault(loop.perception_group, []).append((loop, *pending))
     for members in groups.values():
-        extractor = members[0][0].extractor
-        scans = [scan for _, scan, _ in members]
-        sides = [side for _, _, side in members]
-        bearing_start, azimuths, distances = near_peers(
-            [loop.peer_bearings(now_s) for loop, _, _ in members],
-            extractor.config.peer_bearing_max_distance_m,
-        )
         try:
-            features = extract_many_flat(
-                extractor, scans, bearing_start, azimuths, distances, sides
+            features = extract_held(
+                members[0][0].extractor,
+                [scan for _, scan, _ in members],
+                [loop.peer_bearings(now_s) for loop, _, _ in members],
+                [side for _, _, side in members],
             )
         except ScanError:
             continue
         for (loop, _, _), loop_features in zip(members, features, strict=True):
             loop.take_features(loop_features)
-
-
-def near_peers(
-    held: Sequence[tuple[np.ndarray, np.ndarray, float] | None], max_distance_m: float
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """:meth:`oabug_robot.sound.PeerBearings.near_peers_now` of several loops at once (the
-    same element-wise operations): the slice bounds of each loop's near peers, their
-    bearings at the loops' current yaws [rad] and their distances [m].
-
-    Args:
-        held: per loop, what :meth:`RobotLoop.peer_bearings` returns.
-        max_distance_m: peers farther than this (by their known distance) are left out.
-    """
-    counts = [0 if h is None else len(h[0]) for h in held]
-    bounds = np.zeros(len(held) + 1, dtype=np.int64)
-    np.cumsum(counts, out=bounds[1:])
-    if not bounds[-1]:
-        return bounds, np.zeros(0), np.zeros(0)
-    present = [h for h in held if h is not None]
-    rotation = np.repeat([h[2] for h in present], [len(h[0]) for h in present])
-    azimuths = np.concatenate([h[0] for h in present]) + rotation
-    distances = np.concatenate([h[1] for h in present])
-    near = ~(distances > max_distance_m)  # NaN (unknown) distances are kept
-    if not near.all():
-        bounds = np.concatenate(([0], np.cumsum(near)))[bounds]
-        azimuths, distances = azimuths[near], distances[near]
-    return bounds, azimuths, distances

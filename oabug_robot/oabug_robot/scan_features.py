@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -51,8 +52,7 @@ class LaserScanData:
     range_max_m: float
 
 
-@dataclass(frozen=True)
-class SideWall:
+class SideWall(NamedTuple):
     """The wall beside the robot on one side, from the returns abeam and just behind.
 
     Attributes:
@@ -75,14 +75,17 @@ class SideWall:
         return math.isfinite(self.distance_m)
 
 
-@dataclass(frozen=True)
-class ScanFeatures:
+class ScanFeatures(NamedTuple):
     """Features of one scan in the robot frame (x forward, y left).
+
+    A named tuple rather than a frozen dataclass: a control step builds one per robot and
+    scan, and a tuple is built several times faster.
 
     Attributes:
         front_wall_m: forward distance [m] to the nearest wall return inside the corridor the
             robot sweeps; inf when the corridor is clear up to the feature range.
-        front_robot_m: range [m] of the nearest peer return inside the front cone; inf if none.
+        front_robot_m: range [m] of the nearest peer return inside the front cone, or inside
+            the contact sector within the contact distance; inf if none.
         left: nearest wall return on the left, abeam or behind (not ahead: a wall ahead
             across a door gap must not pull the follower past the door).
         right: the same on the right.
@@ -218,7 +221,11 @@ class ScanFeatureExtractor:
         if is_peer is not None:
             peer_returns = int(np.count_nonzero(is_peer))
             if peer_returns:
-                cone = is_peer & (cos >= math.cos(cfg.robot_cone_half_angle_rad))
+                # Peers in the front cone, and peers touching the body ahead of abeam.
+                ahead = cos >= math.cos(cfg.robot_cone_half_angle_rad)
+                touching = cos >= math.cos(cfg.robot_contact_half_angle_rad)
+                ahead |= touching & (r <= cfg.robot_contact_distance_m)
+                cone = is_peer & ahead
                 if np.count_nonzero(cone):
                     front_robot = float(r[cone].min())
                 is_wall = ~is_peer

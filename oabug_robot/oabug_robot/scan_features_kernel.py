@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
+from functools import lru_cache
 from typing import TypeVar
 
 import numpy as np
@@ -60,10 +61,12 @@ except ImportError:  # a robot install: the same loops run uncompiled (slowly), 
 
 __all__ = [
     'HAVE_NUMBA',
+    'extract_held',
     'extract_many',
     'extract_many_flat',
     'features_kernel',
     'pairwise_sum',
+    'select_kernel',
     'side_wall_fit',
 ]
 
@@ -220,16 +223,8 @@ def features_kernel(
     bearing_distance: np.ndarray,
     sides: np.ndarray,
     params: tuple,
-    front_wall: np.ndarray,
-    front_robot: np.ndarray,
-    near_count: np.ndarray,
-    peer_count: np.ndarray,
-    side_count: np.ndarray,
-    side_x: np.ndarray,
-    side_l: np.ndarray,
-    abeam: np.ndarray,
-    wall_distance: np.ndarray,
-    wall_angle: np.ndarray,
+    real_out: np.ndarray,
+    int_out: np.ndarray,
 ) -> None:  # pragma: no cover - compiled
     """Features of K scans of B rays; the outputs are filled in place.
 
@@ -244,14 +239,13 @@ def features_kernel(
         sides: (K,) the side whose wall is wanted: +1 left, -1 right, 0 none.
         params: range_min, limit, front_half_width, follow_capture, cone_cos,
             peer_mask_range, robot_radius, peer_distance_factor, side_lookahead,
-            side_window_behind, side_wall_band, abeam_behind, abeam_reach.
-        front_wall, front_robot: (K,) outputs [m].
-        near_count, peer_count: (K,) outputs: returns within range, those of peers.
-        side_count: (K,) number of returns of the wanted side's nearest band.
-        side_x, side_l: (K, B) their forward and lateral coordinates [m].
-        abeam: (K,) one of them lies abeam.
-        wall_distance, wall_angle: (K,) the side wall fitted to those returns (distance [m]
-            and angle [rad] as seen on the left; read only where ``side_count`` > 0).
+            side_window_behind, side_wall_band, abeam_behind, abeam_reach, fit_tolerance,
+            min_spread, robot_contact_distance, contact_cos.
+        real_out: (K, 4) output per scan: the wall ahead and the robot ahead [m], the
+            distance [m] and angle [rad, as seen on the left] of the wanted side's wall
+            (read only where its return count is not 0).
+        int_out: (K, 4) output per scan: the returns within range, those of peers, the
+            returns of the wanted side's nearest band, and 1 where one of them lies abeam.
     """
     (
         range_min,
@@ -269,6 +263,8 @@ def features_kernel(
         abeam_reach,
         fit_tolerance,
         min_spread,
+        contact,
+        contact_cos,
     ) = params
     body = 2.0 * radius
     num_scans, num_rays = ranges.shape
@@ -276,13 +272,19 @@ def features_kernel(
     is_peer = np.empty(num_rays, dtype=np.bool_)
     xs = np.empty(num_rays)
     ls = np.empty(num_rays)
+    side_x = np.empty(num_rays)
+    side_l = np.empty(num_rays)
     scratch = np.empty((4, num_rays))
     for k in range(num_scans):
-        front_wall[k] = np.inf
-        front_robot[k] = np.inf
-        peer_count[k] = 0
-        side_count[k] = 0
-        abeam[k] = False
+        front_wall = np.inf
+        front_robot = np.inf
+        peers = 0
+        abeam = 0
+        real_out[k, 2] = np.inf
+        real_out[k, 3] = 0.0
+        int_out[k, 1] = 0
+        int_out[k, 2] = 0
+        int_out[k, 3] = 0
         kept = 0
         any_near = False
         for j in range(num_rays):
@@ -293,8 +295,10 @@ def features_kernel(
                 kept += 1
                 if r <= peer_mask_range:
                     any_near = True
-        near_count[k] = kept
+        int_out[k, 0] = kept
         if kept == 0:
+            real_out[k, 0] = np.inf
+            real_out[k, 1] = np.inf
             continue
         # The peer mask, bearing by bearing.
         if any_near:
@@ -335,12 +339,13 @@ def features_kernel(
             x = r * c
             y = r * sin_t[j]
             if is_peer[m]:
-                peer_count[k] += 1
-                if c >= cone_cos and r < front_robot[k]:
-                    front_robot[k] = r
+                peers += 1
+                ahead = c >= cone_cos or (c >= contact_cos and r <= contact)
+                if ahead and r < front_robot:
+                    front_robot = r
                 continue
-            if x > 0.0 and abs(y) <= front_half_width and x < front_wall[k]:
-                front_wall[k] = x
+            if x > 0.0 and abs(y) <= front_half_width and x < front_wall:
+                front_wall = x
             if side == 0 or not (r <= follow_capture and x <= lookahead and x >= -behind):
                 continue
             if side > 0 and y > 0.0:
@@ -351,6 +356,9 @@ def features_kernel(
                 xs[count] = x
                 ls[count] = -y
                 count += 1
+        real_out[k, 0] = front_wall
+        real_out[k, 1] = front_robot
+        int_out[k, 1] = peers
         if count == 0:
             continue
         # Only the nearest wall: the returns within the band of the closest one.
@@ -361,22 +369,111 @@ def features_kernel(
         kept_side = 0
         for m in range(count):
             if ls[m] <= cut:
-                side_x[k, kept_side] = xs[m]
-                side_l[k, kept_side] = ls[m]
+                side_x[kept_side] = xs[m]
+                side_l[kept_side] = ls[m]
                 if xs[m] >= -abeam_behind and ls[m] <= abeam_reach:
-                    abeam[k] = True
+                    abeam = 1
                 kept_side += 1
-        side_count[k] = kept_side
-        wall_distance[k], wall_angle[k] = side_wall_fit(
-            side_x[k], side_l[k], kept_side, fit_tolerance, min_spread, scratch
+        int_out[k, 2] = kept_side
+        int_out[k, 3] = abeam
+        real_out[k, 2], real_out[k, 3] = side_wall_fit(
+            side_x, side_l, kept_side, fit_tolerance, min_spread, scratch
         )
 
 
-def _kernel_parameters(
+@njit(cache=True)
+def select_kernel(
+    ranges: np.ndarray,
+    range_min: float,
+    limit: float,
+    peer_mask_range: float,
+    held_azimuths: np.ndarray,
+    held_distances: np.ndarray,
+    held_start: np.ndarray,
+    rotation: np.ndarray,
+    max_distance: float,
+    angles: np.ndarray,
+    widest_window: float,
+) -> tuple:  # pragma: no cover - compiled
+    """What the features of K scans need before the transcendental functions: the -inf
+    ranges replaced by ``range_min`` (in place), the peers that may be near and the rays
+    whose peer window is read.
+
+    Args:
+        ranges: (K, B) ranges [m]; -inf entries are set to ``range_min``.
+        range_min, limit: rays with a range in [range_min, limit] are returns.
+        peer_mask_range: only returns up to this range can be a peer's.
+        held_azimuths: (H,) held peer bearings [rad], the scans' in order.
+        held_distances: (H,) their coarse distances [m] (NaN unknown).
+        held_start: (K + 1,) slice bounds of each scan's held bearings.
+        rotation: (K,) per scan, the angle added to its bearings (the robot's rotation since
+            they were heard, ``yaw_at_stamp - yaw`` [rad]); empty: none is added.
+        max_distance: bearings whose distance exceeds this are left out (NaN kept).
+        angles: (B,) the rays' directions in the robot frame, in [-pi, pi) [rad].
+        widest_window: an upper bound of any peer window's half width [rad].
+
+    Returns:
+        The kept bearings [rad] and distances [m], their (K + 1,) slice bounds, the indices
+        of the finite kept bearings, and the flat (K * B) indices of the rays whose peer
+        window may be read: the returns within the peer mask range that lie within
+        ``widest_window`` of a finite kept bearing (the bearing wrapped here with ``%``,
+        within far less than the margin of the wrapped bearing the features use).
+    """
+    num_scans, num_rays = ranges.shape
+    total = held_azimuths.shape[0]
+    azimuths = np.empty(total)
+    distances = np.empty(total)
+    start = np.empty(num_scans + 1, dtype=np.int64)
+    finite = np.empty(total, dtype=np.int64)
+    windows = np.empty(num_scans * num_rays, dtype=np.int64)
+    directions = np.empty(total)
+    reach = widest_window + 1e-6
+    kept = 0
+    num_finite = 0
+    num_windows = 0
+    rotate = rotation.shape[0] > 0
+    for k in range(num_scans):
+        start[k] = kept
+        first_finite = num_finite
+        for b in range(held_start[k], held_start[k + 1]):
+            d = held_distances[b]
+            if d > max_distance:
+                continue
+            a = held_azimuths[b] + rotation[k] if rotate else held_azimuths[b]
+            azimuths[kept] = a
+            distances[kept] = d
+            if math.isfinite(a):
+                finite[num_finite] = kept
+                directions[num_finite] = (a + math.pi) % _TWO_PI - math.pi
+                num_finite += 1
+            kept += 1
+        for j in range(num_rays):
+            r = ranges[k, j]
+            if r == -np.inf:
+                r = range_min
+                ranges[k, j] = r
+            if not (r >= range_min and r <= limit and r <= peer_mask_range):
+                continue
+            for f in range(first_finite, num_finite):
+                if _in_window(angles[j], directions[f], reach):
+                    windows[num_windows] = k * num_rays + j
+                    num_windows += 1
+                    break
+    start[num_scans] = kept
+    return azimuths[:kept], distances[:kept], start, finite[:num_finite], windows[:num_windows]
+
+
+@lru_cache(maxsize=64)
+def _constants(
     extractor: ScanFeatureExtractor, range_min_m: float, range_max_m: float
-) -> tuple[float, ...]:
+) -> tuple[tuple[float, ...], float]:
+    """The kernels' constants for an extractor and a scan's range limits (cached per
+    extractor object: its configuration is frozen): :func:`features_kernel`'s parameters
+    and an upper bound [rad] of the half width of a peer's window, at the shortest range
+    (the extractor's tolerance plus the angle a body spans; 1e-9 rad more than
+    ``math.atan2`` gives, far beyond numpy's difference from it)."""
     cfg = extractor.config
-    return tuple(
+    params = tuple(
         float(value)
         for value in (
             range_min_m,
@@ -394,8 +491,12 @@ def _kernel_parameters(
             cfg.abeam_reach_m,
             cfg.side_wall_fit_tolerance_m,
             MIN_FIT_SPREAD_M,
+            cfg.robot_contact_distance_m,
+            math.cos(cfg.robot_contact_half_angle_rad),
         )
     )
+    widest = cfg.peer_bearing_tolerance_rad + math.atan2(cfg.robot_radius_m, range_min_m) + 1e-9
+    return params, widest
 
 
 def _frame(scan: LaserScanData) -> tuple[float, float, float, float]:
@@ -405,7 +506,7 @@ def _frame(scan: LaserScanData) -> tuple[float, float, float, float]:
 def extract_many(
     extractor: ScanFeatureExtractor,
     scans: Sequence[LaserScanData],
-    peers: Sequence[tuple[np.ndarray, np.ndarray]],
+    peers: Sequence[tuple[np.ndarray, np.ndarray | None]],
     sides: Sequence[int],
 ) -> list[ScanFeatures]:
     """The features ``extractor.extract`` gives for each scan, computed in one call.
@@ -414,7 +515,7 @@ def extract_many(
         extractor: the extractor whose configuration (and ray table) every robot shares.
         scans: K scans with the same angles, limits and number of rays.
         peers: per scan, the peers' bearings [rad] and coarse distances [m] (NaN where
-            unknown), as passed to ``extract``.
+            unknown; None: all unknown), as passed to ``extract``.
         sides: per scan, the side whose wall is wanted (+1 left, -1 right, 0 none): the
             same as ``extract(..., sides=(side,) if side else ())``.
 
@@ -470,97 +571,162 @@ def extract_many_flat(
     if len(azimuths) != bearing_start[-1] or len(distances) != bearing_start[-1]:
         msg = f'{bearing_start[-1]} peers, {len(azimuths)} azimuths, {len(distances)} distances'
         raise ValueError(msg)
+    return _extract(
+        extractor,
+        scans,
+        np.asarray(azimuths, dtype=float),
+        np.asarray(distances, dtype=float),
+        np.asarray(bearing_start, dtype=np.int64),
+        _NO_ROTATION,
+        math.inf,
+        sides,
+    )
+
+
+def extract_held(
+    extractor: ScanFeatureExtractor,
+    scans: Sequence[LaserScanData],
+    held: Sequence[tuple[np.ndarray, np.ndarray, float] | None],
+    sides: Sequence[int],
+) -> list[ScanFeatures]:
+    """What each robot's control loop computes for its scan
+    (:meth:`oabug_robot.robot_loop.RobotLoop.update_features`): ``extractor.extract`` of the
+    scan with the near peers of the held bearings
+    (:meth:`oabug_robot.sound.PeerBearings.near_peers_now`, the same element-wise
+    operations), all scans in one compiled call.
+
+    Args:
+        extractor: as for :func:`extract_many`.
+        scans: K scans, as for :func:`extract_many`.
+        held: per scan, what :meth:`~oabug_robot.robot_loop.RobotLoop.peer_bearings` returns:
+            the held bearings [rad], their distances [m] and the rotation since they were
+            heard [rad], or None.
+        sides: per scan, the side whose wall is wanted (+1 left, -1 right, 0 none).
+
+    Raises:
+        ScanError: the scans have no rays or their angles are not finite.
+        ValueError: the scans differ in angles, limits or number of rays, or the
+            argument lengths differ.
+    """
+    if not len(scans) == len(held) == len(sides):
+        msg = f'{len(scans)} scans, {len(held)} peer sets and {len(sides)} sides'
+        raise ValueError(msg)
+    counts = [0 if h is None else len(h[0]) for h in held]
+    start = np.zeros(len(held) + 1, dtype=np.int64)
+    np.cumsum(counts, out=start[1:])
+    rotation = np.array([0.0 if h is None else h[2] for h in held])
+    if start[-1]:
+        present = [h for h in held if h is not None]
+        azimuths = np.concatenate([h[0] for h in present])
+        distances = np.concatenate([h[1] for h in present])
+    else:
+        azimuths = distances = _NO_ROTATION
+    return _extract(
+        extractor,
+        scans,
+        np.asarray(azimuths, dtype=float),
+        np.asarray(distances, dtype=float),
+        start,
+        rotation,
+        extractor.config.peer_bearing_max_distance_m,
+        sides,
+    )
+
+
+_NO_ROTATION = np.zeros(0)
+_NO_WALL = SideWall()
+_NO_WALL_RIGHT = SideWall(math.inf, -0.0, False)
+_NO_FEATURES = ScanFeatures()
+
+
+def _extract(
+    extractor: ScanFeatureExtractor,
+    scans: Sequence[LaserScanData],
+    held_azimuths: np.ndarray,
+    held_distances: np.ndarray,
+    held_start: np.ndarray,
+    rotation: np.ndarray,
+    max_distance: float,
+    sides: Sequence[int],
+) -> list[ScanFeatures]:
+    """The features of the scans with the peers :func:`select_kernel` keeps of the held
+    bearings (rotated by ``rotation``, per scan, unless it is empty)."""
     if not scans:
         return []
     first = scans[0]
     frame = _frame(first)
     if any(_frame(scan) != frame for scan in scans[1:]):
         raise ValueError('the scans must share their angles and range limits')
-    ranges = np.stack([np.asarray(scan.ranges_m, dtype=float) for scan in scans])
-    if ranges.ndim != 2 or ranges.shape[1] == 0:
-        msg = f'scans must have at least one range, got shape {ranges.shape[1:]}'
+    num_rays = np.shape(first.ranges_m)
+    if len(num_rays) != 1 or num_rays[0] == 0:
+        msg = f'scans must have at least one range, got shape {num_rays}'
         raise ScanError(msg)
+    # Every scan's ranges in one array (the kernel rewrites -inf ranges: a copy).
+    ranges = np.empty((len(scans), num_rays[0]))
+    for i, scan in enumerate(scans):
+        ranges[i] = scan.ranges_m
     angles, cos_t, sin_t = extractor.ray_directions(first, ranges.shape[1])
     cfg = extractor.config
     range_min = max(float(first.range_min_m), 0.0)
+    params, widest_window = _constants(extractor, range_min, float(first.range_max_m))
     # REP 117: -inf means "too close to measure", i.e. an obstacle at range_min.
-    ranges[ranges == -math.inf] = range_min
-    if bearing_start[-1]:
-        azimuths = np.asarray(azimuths, dtype=float)
-        distances = np.asarray(distances, dtype=float)
-        finite = np.isfinite(azimuths)
-        bearing = np.full(azimuths.size, math.nan)
-        bearing[finite] = np.arctan2(np.sin(azimuths[finite]), np.cos(azimuths[finite]))
-        # The kernel reads a ray's window only where it may be a peer's: within the peer
-        # mask range (numpy's arctan2 of an element does not depend on the array around it).
-        half_width = np.full(ranges.shape, math.nan)
-        maskable = ranges <= cfg.peer_mask_range_m
-        half_width[maskable] = cfg.peer_bearing_tolerance_rad + np.arctan2(
-            cfg.robot_radius_m, ranges[maskable]
-        )
+    azimuths, distances, start, finite, windows = select_kernel(
+        ranges,
+        range_min,
+        params[1],
+        cfg.peer_mask_range_m,
+        held_azimuths,
+        held_distances,
+        held_start,
+        rotation,
+        max_distance,
+        angles,
+        widest_window,
+    )
+    # The transcendental functions in numpy, as the extractor computes them (numpy's value
+    # of an element does not depend on the array around it).
+    if finite.size == azimuths.size:  # every bearing finite (the common case)
+        bearing = np.arctan2(np.sin(azimuths), np.cos(azimuths))
     else:
-        bearing = distances = np.zeros(0)
-        half_width = ranges  # not read: no scan has a peer
-    k, num_rays = ranges.shape
-    front_wall = np.empty(k)
-    front_robot = np.empty(k)
-    near_count = np.empty(k, dtype=np.int64)
-    peer_count = np.empty(k, dtype=np.int64)
-    side_count = np.empty(k, dtype=np.int64)
-    side_x = np.empty((k, num_rays))
-    side_l = np.empty((k, num_rays))
-    abeam = np.empty(k, dtype=np.bool_)
-    wall_distance = np.empty(k)
-    wall_angle = np.empty(k)
+        bearing = np.full(azimuths.size, math.nan)
+        finite_azimuths = azimuths[finite]
+        bearing[finite] = np.arctan2(np.sin(finite_azimuths), np.cos(finite_azimuths))
+    # NaN: no window (a ray this far from every bearing is in none).
+    half_width = np.full(ranges.size, math.nan)
+    if windows.size:
+        half_width[windows] = cfg.peer_bearing_tolerance_rad + np.arctan2(
+            cfg.robot_radius_m, ranges.ravel()[windows]
+        )
+    k = len(scans)
+    real_out = np.empty((k, 4))
+    int_out = np.empty((k, 4), dtype=np.int64)
     features_kernel(
         ranges,
-        half_width,
+        half_width.reshape(ranges.shape),
         angles,
         cos_t,
         sin_t,
-        np.asarray(bearing_start, dtype=np.int64),
+        start,
         bearing,
         distances,
         np.asarray(sides, dtype=np.int64),
-        _kernel_parameters(extractor, range_min, float(first.range_max_m)),
-        front_wall,
-        front_robot,
-        near_count,
-        peer_count,
-        side_count,
-        side_x,
-        side_l,
-        abeam,
-        wall_distance,
-        wall_angle,
+        params,
+        real_out,
+        int_out,
     )
     # The outputs as Python numbers once (the same values), not element by element.
-    walls_ahead, robots_ahead = front_wall.tolist(), front_robot.tolist()
-    nears, peer_counts = near_count.tolist(), peer_count.tolist()
-    side_counts, abeams = side_count.tolist(), abeam.tolist()
-    wall_distances, wall_angles = wall_distance.tolist(), wall_angle.tolist()
     result = []
-    for i, side in enumerate(sides):
-        if nears[i] == 0:
-            result.append(ScanFeatures())
+    for side, (wall_ahead, robot_ahead, distance, angle), (near, peers, count, abeam) in zip(
+        sides, real_out.tolist(), int_out.tolist(), strict=True
+    ):
+        if near == 0:
+            result.append(_NO_FEATURES)
             continue
-        left = right = SideWall()
-        if side:
-            wall = SideWall()
-            if side_counts[i]:
-                wall = SideWall(wall_distances[i], wall_angles[i], abeams[i])
-            if side > 0:
-                left = wall
-            else:
-                right = SideWall(wall.distance_m, -wall.angle_rad, wall.abeam)
-        result.append(
-            ScanFeatures(
-                front_wall_m=walls_ahead[i],
-                front_robot_m=robots_ahead[i],
-                left=left,
-                right=right,
-                near_returns=nears[i],
-                peer_returns=peer_counts[i],
-            )
-        )
+        left = right = _NO_WALL
+        if side > 0 and count:
+            left = SideWall(distance, angle, bool(abeam))
+        elif side < 0:
+            # The extractor mirrors the right side's wall, "no wall" (angle 0.0) too.
+            right = SideWall(distance, -angle, bool(abeam)) if count else _NO_WALL_RIGHT
+        result.append(ScanFeatures(wall_ahead, robot_ahead, left, right, near, peers))
     return result

@@ -145,6 +145,16 @@ class PerceptionConfig:
             lidar to the peer's surface.
         robot_cone_half_angle_rad: half angle of the cone in which peers count as hit [rad]
             (the authors' robot: 30 deg).
+        robot_contact_distance_m: a peer return this close within
+            ``robot_contact_half_angle_rad`` of straight ahead, outside the front cone too,
+            is a hit [m]: a peer touching the body ahead of abeam blocks the drive as one
+            ahead does (the authors' grid: any step a robot blocks is a robot hit). At or
+            above the lidar's minimum range (RPLidar A1: 0.15 m), so a peer too close to
+            measure (-inf) counts; 0 turns the rule off.
+        robot_contact_half_angle_rad: half angle of that contact sector [rad]. A touching
+            peer of the same size spans 30 deg either side of its centre's direction, so its
+            returns come within 60 deg of straight ahead exactly when its centre is ahead of
+            abeam, where it blocks the drive.
         peer_bearing_tolerance_rad: angular error allowed between a bearing and the peer's
             lidar returns [rad]; added to the angle the peer's body spans.
         peer_mask_range_m: returns farther than this are never attributed to a peer [m]; a
@@ -181,6 +191,10 @@ class PerceptionConfig:
         0.2, 'peer this close in the front cone is hit', unit='m', ge=0.0
     )
     robot_cone_half_angle_rad: float = math.radians(30.0)
+    robot_contact_distance_m: float = parameter(
+        0.16, 'peer this close ahead of abeam (not only in the cone) is hit', unit='m', ge=0.0
+    )
+    robot_contact_half_angle_rad: float = math.radians(60.0)
     peer_bearing_tolerance_rad: float = math.radians(10.0)
     peer_mask_range_m: float = 1.0
     peer_bearing_max_distance_m: float = 2.0
@@ -215,6 +229,14 @@ class PerceptionConfig:
         _require(
             self.robot_cone_half_angle_rad < math.pi / 2,
             'robot_cone_half_angle_rad must be below 90 deg',
+        )
+        _require(
+            self.robot_contact_half_angle_rad <= math.pi / 2,
+            'robot_contact_half_angle_rad must be at most 90 deg',
+        )
+        _require(
+            self.robot_contact_distance_m <= self.robot_hit_distance_m,
+            'robot_contact_distance_m must not exceed robot_hit_distance_m',
         )
 
 

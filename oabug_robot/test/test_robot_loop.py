@@ -87,3 +87,30 @@ def test_features_of_many_loops_equal_each_loops_own():
         b.update_features(0.1)
         assert a.step(0.2).command == b.step(0.2).command
         assert a.fsm.memory == b.fsm.memory
+
+
+def test_the_batch_command_is_the_control_steps_command():
+    """command() (the batch runner's call) gives control()'s command, STOP while an input
+    is stale, and steps the controller the same way."""
+    rng = np.random.default_rng(4)
+    a, b = loop_of(variant='gas'), loop_of(variant='gas')
+    commands = []
+    for step in range(1, 120):
+        now = 0.1 * step
+        ranges = rng.uniform(0.2, 3.0, RAYS)
+        gas = int(rng.integers(50, 300))
+        for loop in (a, b):
+            if step % 7:  # now and then no IMU reading: the yaw goes stale
+                loop.hold_yaw(0.01 * step, now)
+            if step > 3:
+                loop.hold_gas(gas, now)
+            if step % 2:
+                loop.hold_scan(
+                    LaserScanData(ranges.copy(), -math.pi, 2 * math.pi / RAYS, 0.15, 12.0), now
+                )
+        commands.append(a.command(now))
+        assert commands[-1] == b.control(now).command
+        assert a.fsm.memory == b.fsm.memory
+    # Stopped while the gas was missing, driving later.
+    assert commands[0] == STOP
+    assert any(command.linear_mps > 0.0 for command in commands)

@@ -106,6 +106,39 @@ def test_a_peer_beside_the_followed_wall_is_not_taken_for_the_wall(extractor) ->
     assert unheard.left.distance_m == pytest.approx(0.18, abs=0.01)
 
 
+@pytest.mark.parametrize('kernel', [False, True])
+def test_a_peer_touching_the_body_ahead_of_abeam_is_a_hit(kernel: bool) -> None:
+    from oabug_robot.scan_features_kernel import extract_many
+
+    def features(config: PerceptionConfig, bearing_deg: float) -> float:
+        # A peer (radius 0.1 m) touching the body (centres 0.2 m apart); as the RPLidar A1
+        # reports it, nearer than its 0.15 m minimum range: -inf.
+        direction = math.radians(bearing_deg)
+        x, y = 0.2 * math.cos(direction), 0.2 * math.sin(direction)
+        ranges = add_disc(box_ranges(3.0, 1.5, 3.0, 1.5), x, y, 0.1)
+        ranges = np.where(ranges < 0.15, -np.inf, ranges)
+        scan = LaserScanData(
+            np.asarray(ranges, dtype=np.float32), -math.pi, 2 * math.pi / RAYS, 0.15, 12.0
+        )
+        extractor = ScanFeatureExtractor(config)
+        bearings = np.array([direction])
+        if kernel:
+            (result,) = extract_many(extractor, [scan], [(bearings, None)], [0])
+        else:
+            result = extractor.extract(scan, bearings)
+        return result.front_robot_m
+
+    config = PerceptionConfig()
+    hit = config.robot_hit_distance_m
+    for bearing in (0.0, 70.0, -80.0):  # in the cone, and beside it ahead of abeam
+        assert features(config, bearing) <= hit, bearing
+    for bearing in (100.0, -120.0, 180.0):  # behind abeam: driving on frees the robot
+        assert features(config, bearing) == math.inf, bearing
+    off = PerceptionConfig(robot_contact_distance_m=0.0)
+    assert features(off, 0.0) <= hit
+    assert features(off, 70.0) == math.inf, 'without the rule only the 30 deg cone hits'
+
+
 def test_bearings_with_nan_azimuth_mask_nothing(extractor) -> None:
     ranges = add_disc(box_ranges(3.0, 1.5, 3.0, 1.5), 0.4, 0.0, 0.12)
     features = extractor.extract(scan_of(ranges), np.array([math.nan]))

@@ -15,12 +15,14 @@ from oabug_robot.scan_features import (
     ScanFeatures,
 )
 from oabug_robot.scan_features_kernel import (
+    extract_held,
     extract_many,
     extract_many_flat,
     pairwise_sum,
     side_wall_fit,
 )
 from oabug_robot.settings import PerceptionConfig
+from oabug_robot.sound import PeerBearings
 
 
 def _scan(
@@ -68,7 +70,7 @@ def _peers(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray | None]:
 
 def _exact(features: ScanFeatures) -> str:
     """Every field, floats to the last bit (repr round-trips and shows -0.0)."""
-    return repr(dataclasses.astuple(features))
+    return repr(features)
 
 
 def _numpy_features(extractor, scans, peers, sides) -> list[str]:
@@ -171,6 +173,52 @@ def test_flat_peers_give_the_features_of_the_per_scan_peers() -> None:
         )
         flat = extract_many_flat(extractor, scans, start, azimuths, distances, sides)
         assert [_exact(f) for f in flat] == _numpy_features(extractor, scans, peers, sides)
+
+
+def _held(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, float, float] | None:
+    """Held bearings as a robot loop keeps them (NaN and inf distances, NaN bearings,
+    near and far peers), the yaw they were heard at and the yaw now; None: none held."""
+    if rng.random() < 0.2:
+        return None
+    count = int(rng.integers(0, 9))
+    azimuths = rng.uniform(-4.0, 4.0, count)
+    distances = rng.uniform(0.05, 4.0, count)
+    distances[rng.random(count) < 0.2] = math.nan
+    distances[rng.random(count) < 0.1] = math.inf
+    azimuths[rng.random(count) < 0.1] = math.nan
+    azimuths[rng.random(count) < 0.05] = -0.0
+    stamp_yaw, yaw = rng.uniform(-math.pi, math.pi, 2)
+    if rng.random() < 0.1:
+        yaw = stamp_yaw  # no rotation since: -0.0 bearings stay -0.0
+    return azimuths, distances, float(stamp_yaw), float(yaw)
+
+
+def test_held_bearings_give_each_robots_own_features() -> None:
+    """extract_held (the batch path's call) equals, scan by scan, the extractor on the
+    near peers PeerBearings.near_peers_now selects from the held bearings."""
+    rng = np.random.default_rng(13)
+    extractor = ScanFeatureExtractor(PerceptionConfig())
+    peers_seen = 0
+    for _ in range(60):
+        k = int(rng.integers(1, 12))
+        scans = [_scan(_room_ranges(rng, 360)) for _ in range(k)]
+        held = [_held(rng) for _ in range(k)]
+        sides = [int(s) for s in rng.integers(-1, 2, k)]
+        want = []
+        for scan, h, side in zip(scans, held, sides, strict=True):
+            near: tuple[np.ndarray, np.ndarray | None] = (np.zeros(0), None)
+            if h is not None:
+                near = PeerBearings(h[0], h[1], 0.0, h[2]).near_peers_now(
+                    h[3], extractor.config.peer_bearing_max_distance_m
+                )
+            want.append(_exact(extractor.extract(scan, *near, sides=(side,) if side else ())))
+        loops_held = [None if h is None else (h[0], h[1], h[2] - h[3]) for h in held]
+        got = extract_held(extractor, scans, loops_held, sides)
+        assert [_exact(f) for f in got] == want
+        peers_seen += sum(f.peer_returns for f in got)
+    assert peers_seen > 100
+    with pytest.raises(ValueError, match='sides'):
+        extract_held(extractor, scans, loops_held, [*sides, 1])
 
 
 def test_the_pairwise_sum_adds_in_numpys_order() -> None:

@@ -58,7 +58,10 @@ from swarm_sim.site_geometry import geometry_from_site
 from swarm_experiments.mission import MissionProgress, MissionResult, MissionSpec, StopReason
 from swarm_experiments.spawn import OABugRun, SpawnSettings, run
 
-__all__ = ['BatchRobot', 'run_oabug_batch', 'run_spawn_batch']
+__all__ = ['BatchRobot', 'BatchSwarm', 'run_oabug_batch', 'run_spawn_batch']
+
+# Scan ranges this far beyond every robot's feature range [m] read inf on the batch path.
+_SCAN_HORIZON_MARGIN_M = 1e-3
 
 
 class BatchRobot:
@@ -205,17 +208,19 @@ def run_oabug_batch(
     unused = {'odometry'}
     if not any(robot.needs_gas for robot in robots):
         unused.add('gas')
+    # No feature reads a range beyond the robots' feature range: the engine may read the
+    # farther ones as inf (the margin is far beyond the float32 rounding of a range).
+    horizon_m = max(robot.loop.extractor.feature_range_m for robot in robots)
     engine = SimEngine(
         geometry,
         np.asarray(spec.initial_poses, dtype=float),
         dataclasses.replace(engine_config, sensors=engine_config.sensors - unused),
         bearing_cycles=True,
+        scan_horizon_m=horizon_m + _SCAN_HORIZON_MARGIN_M,
     )
     n = engine.num_robots
     names = tuple(f'r{i}' for i in range(n))
-    tag_ids = tuple(name.upper() for name in names)
-    # Per robot, its own tag's index (-1: none); the node drops that tag's bearings.
-    own_tags = np.array([robot.own_tag_index(tag_ids) for robot in robots], dtype=np.int64)
+    swarm = BatchSwarm(robots, tuple(name.upper() for name in names))
     times = [0.0]
     poses = [engine.world.poses]
     next_sample_s = spec.trajectory_period_s
@@ -245,7 +250,7 @@ def run_oabug_batch(
             if stop is not None and stop(report):
                 reason = StopReason.PREDICATE
                 break
-        _deliver(engine, out, robots, own_tags)
+        _deliver(engine, out, swarm)
 
     # Release the physics backend (a pybullet client; a recorded run's animation is written).
     engine.close()
@@ -263,12 +268,41 @@ def run_oabug_batch(
     )
 
 
-def _deliver(engine: SimEngine, out: Any, robots: list[BatchRobot], own_tags: np.ndarray) -> None:
+class BatchSwarm:
+    """The robots of a batch mission and what handing them their readings needs, worked out
+    once: the loops, each robot's own tag and the control timers.
+
+    Robots whose control timers have the same period fire at the same steps (the same
+    deadlines from the same start), so one timer per period decides for all of them.
+    """
+
+    def __init__(self, robots: Sequence[BatchRobot], tag_ids: Sequence[str]) -> None:
+        """Take the robots (in engine order) and the tag id of every robot (``R0``, ...)."""
+        self.robots = list(robots)
+        self.loops = [robot.loop for robot in self.robots]
+        #: Per robot, its own tag's index (-1: none); the node drops that tag's bearings.
+        self.own_tags = np.array(
+            [robot.own_tag_index(tuple(tag_ids)) for robot in self.robots], dtype=np.int64
+        )
+        by_period: dict[int, list[int]] = {}
+        for i, robot in enumerate(self.robots):
+            by_period.setdefault(robot.timer.period_ns, []).append(i)
+        self._timers = [(self.robots[members[0]].timer, members) for members in by_period.values()]
+
+    def due(self, now_ns: int) -> list[int]:
+        """The robots whose control step runs at ``now_ns``, in index order."""
+        if len(self._timers) == 1:
+            timer, members = self._timers[0]
+            return members if timer.due(now_ns) else []
+        return sorted(i for timer, members in self._timers if timer.due(now_ns) for i in members)
+
+
+def _deliver(engine: SimEngine, out: Any, swarm: BatchSwarm) -> None:
     """Hand one step's readings to the robots and apply the commands of those whose
-    control timer is due (what the executor does between two bridge ticks). ``own_tags``:
-    per robot, the index of its own tag (-1 for none)."""
+    control timer is due (what the executor does between two bridge ticks)."""
     now_ns = seconds_to_ns(out.time_s)  # the nodes' clock: the /clock stamp
     now_s = now_ns * 1e-9
+    robots, loops = swarm.robots, swarm.loops
     if out.scans is not None:
         # The message's float32 values, widened once for every robot's feature extractor.
         ranges_m = out.scans.astype(np.float32).astype(float)
@@ -278,10 +312,10 @@ def _deliver(engine: SimEngine, out: Any, robots: list[BatchRobot], own_tags: np
                 robot.receive_scan(ranges, now_s)
     if out.gas_raw is not None:
         # The int64 readings as Python ints (what receive_gas makes of them), held directly.
-        for robot, raw in zip(robots, out.gas_raw.tolist(), strict=True):
-            robot.loop.hold_gas(raw, now_s)
+        for loop, raw in zip(loops, out.gas_raw.tolist(), strict=True):
+            loop.hold_gas(raw, now_s)
     if out.bearing_cycle is not None:
-        _deliver_bearings(robots, out.bearing_cycle, own_tags, now_s)
+        _deliver_bearings(robots, out.bearing_cycle, swarm.own_tags, now_s)
     if out.imu is not None:
         # The quaternion round trip of every robot's message in one call.
         yaws = out.imu[0]
@@ -292,18 +326,18 @@ def _deliver(engine: SimEngine, out: Any, robots: list[BatchRobot], own_tags: np
                 robot.receive_imu(yaw, now_s)  # no orientation: raises as the node does
             else:
                 robot.loop.hold_yaw(held, now_s)
-    due = [i for i, robot in enumerate(robots) if robot.timer.due(now_ns)]
+    due = swarm.due(now_ns)
+    if not due:
+        return
     # A robot's control step reads only its own readings and controller, so the scan
     # features of every robot due can be computed first, all at once.
-    extract_features([robots[i].loop for i in due], now_s)
-    velocities: list[tuple[float, float]] = []
-    pumps: list[bool] = []
-    for i in due:
-        # BatchRobot.control, without the extra call.
-        command = robots[i].loop.control(now_s).command
-        velocities.append((command.linear_mps, command.angular_radps))
-        pumps.append(command.pump_on)
-    engine.set_commands(due, velocities, pumps)
+    extract_features([loops[i] for i in due], now_s)
+    commands = [loops[i].command(now_s) for i in due]
+    engine.set_commands(
+        due,
+        [(command.linear_mps, command.angular_radps) for command in commands],
+        [command.pump_on for command in commands],
+    )
 
 
 def _deliver_bearings(

@@ -319,6 +319,7 @@ def report_fig4(page: ReportPage) -> None:
             page.add_table(
                 _coverage_table(of_site, site, reference=table_budget),
                 title=f'{site}, profile {profile}: coverage %',
+                export=f'{site}-{profile}',
             )
             if not table_budget:
                 page.add_text(
@@ -333,6 +334,7 @@ def report_fig4(page: ReportPage) -> None:
                     title=f'{site}, profile {profile}: paired differences on the same sites '
                     '(coverage points)',
                     digits=2,
+                    export=f'{site}-{profile}-paired',
                 )
     profiles = _profiles(rows)
     if 'paper' in profiles and len(profiles) > 1:

@@ -1,13 +1,13 @@
 """The SGBA comparison for ``swarm_study``: SGBA beside OA-Bug on the same sites and seeds.
 
-Study ``sgba-vs-oabug``: the OA-Bug paper's Fig. 4 setting (Small sites at the Table II
-budget, 10 robots, centre and edge departure, coverage every 100 actions), with the method
-as an axis: OA-Bug's Gas+Sound and Gas in the as-published profile (``profile=paper``, the
-rows that lead), then SGBA (:mod:`oabug_robot.sgba`) with the authors' parameters
-(``sgba``) and with its distances halved for the sites' doors (``sgba_scaled``). The seed
-is the site index, so every method runs on the same sites and starts and results pair by
-site. Fixed parameters: ``actions`` (None: the Table II budget), ``speed`` [m/s],
-``profile`` (OA-Bug's), and ``sgba.<name>`` for every SGBA node parameter (None: its default).
+Study ``sgba-vs-oabug``: the OA-Bug paper's Fig. 4 setting (Small and Medium sites at the Table
+II budget, 2-10 robots, centre and edge departure, coverage every 100 actions), with the method
+as an axis: OA-Bug's Gas+Sound and Gas in the as-published profile (``profile=paper``, the rows
+that lead), then SGBA (:mod:`oabug_robot.sgba`) with the authors' parameters (``sgba``) and
+with its distances halved for the sites' doors (``sgba_scaled``). The seed is the site index,
+so every method runs on the same sites and starts and results pair by site. Fixed parameters:
+``actions`` (None: the Table II budget), ``speed`` [m/s], ``profile`` (OA-Bug's), and
+``sgba.<name>`` for every SGBA node parameter (None: its default).
 """
 
 from __future__ import annotations
@@ -138,7 +138,7 @@ def studies() -> list[Study]:
             axes={
                 'site': ('small', 'medium'),
                 'method': METHODS,
-                'robots': (10,),
+                'robots': (2, 4, 6, 8, 10),
                 'departure': ('center', 'edge'),
             },
             params=params,
@@ -166,9 +166,12 @@ def report_comparison(page: ReportPage) -> None:
         return
     page.add_heading('SGBA beside OA-Bug')
     records = []
-    for (site, robots, departure), group in rows.groupby(
-        ['config.site', 'config.robots', 'config.departure'], sort=False
-    ):
+    site_order = {'small': 0, 'medium': 1, 'big': 2}
+    groups = sorted(
+        rows.groupby(['config.site', 'config.departure', 'config.robots'], sort=False),
+        key=lambda item: (site_order.get(str(item[0][0]), 3), str(item[0][0]), *item[0][1:]),
+    )
+    for (site, departure, robots), group in groups:
         for method in METHODS:
             runs = group[group['config.method'] == method]['metric.coverage_pct']
             if len(runs):
@@ -182,7 +185,9 @@ def report_comparison(page: ReportPage) -> None:
                         'sites': len(runs),
                     }
                 )
-    page.add_table(pd.DataFrame(records), title='Coverage % (mean ± std over sites)')
+    page.add_table(
+        pd.DataFrame(records), title='Coverage % (mean ± std over sites)', export='coverage'
+    )
     frames = []
     for baseline in ('gas_sound', 'gas'):
         subset = rows[rows['config.method'].isin((baseline, *SGBA_METHODS))]
@@ -202,4 +207,5 @@ def report_comparison(page: ReportPage) -> None:
             pd.concat(frames, ignore_index=True),
             title='SGBA minus OA-Bug on the same sites (coverage points)',
             digits=2,
+            export='paired',
         )

@@ -294,9 +294,10 @@ def node_parameters(case: SignalCase, settings: SpawnSettings, n: int, i: int) -
         'initial_direction_offset_deg': float(offset),
         'fan_index': int(fan_index),
         'fan_size': int(fan_size),
+        'signal_scale': float(case.signal_scale),
         'max_signal': float(case.max_signal),
         'lipschitz': float(case.lipschitz),
-        'noise_std': float(max(1e-3, settings.noise_std)),
+        'noise_std': float(max(1e-3, settings.noise_std / case.signal_scale)),
         'dimensionless_acquisition': case.dimensionless_acquisition,
     }
     params.update(profile_options(settings.profile))
@@ -315,10 +316,10 @@ def batch_mission_spec(
 ) -> Any:
     """The case as a spec of the ROS-free batch simulator (:mod:`swarm_experiments.bayes_batch`).
 
-    The planners get the case's settings (arena, V, T, f_Hz, eps, T_max, delta theta, M, L),
-    never its source; the ``profile``'s options and then ``planner_options`` override
-    BayesSwarmConfig fields. With measurement
-    noise the GP noise term is raised to it unless ``planner_options`` sets ``gp``.
+    The planners get the case's settings (arena, V, T, f_Hz, eps, T_max, delta theta, the
+    signal scale, M, L), never its source; the ``profile``'s options and then
+    ``planner_options`` override BayesSwarmConfig fields. With measurement noise the GP noise
+    term is raised to it (over the signal scale) unless ``planner_options`` sets ``gp``.
     """
     from bayes_swarm.settings import Arena, BayesSwarmConfig, ExhaustiveConfig
 
@@ -330,14 +331,17 @@ def batch_mission_spec(
         detection_radius_m=case.detection_radius_m,
         max_mission_time_s=case.max_mission_time_s,
         initial_direction_range_deg=case.direction_range_deg,
+        signal_scale=case.signal_scale,
         max_signal=case.max_signal,
         lipschitz=case.lipschitz,
         dimensionless_acquisition=case.dimensionless_acquisition,
     )
     options = {**profile_options(profile), **(planner_options or {})}
     if noise_std > 0.0:
+        # The GP's noise is in the belief's units (the signal over signal_scale).
+        scale = float(options.get('signal_scale', planner.signal_scale))
         options.setdefault(
-            'gp', replace(planner.gp, noise_std=max(noise_std, planner.gp.noise_std))
+            'gp', replace(planner.gp, noise_std=max(noise_std / scale, planner.gp.noise_std))
         )
     return BatchMissionSpec(
         field=case.field,

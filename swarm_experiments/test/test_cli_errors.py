@@ -181,6 +181,12 @@ ROWS = [
     _row('study unknown', 'swarm_study', 'run nope --out {work}/out', "no study named 'nope'"),
     _row('study report missing', 'swarm_study', 'report {inputs}/nowhere', 'no such directory'),
     _row('study bad option', 'swarm_study', 'run', 'required: name'),
+    _row(
+        'study --set of the wrong type',
+        'swarm_study',
+        'run oabug-fig4 --set robots=abc --out {work}/out',
+        '--set robots=abc: expected a whole number (like 2)',
+    ),
     _row('bringup index', 'robot_bringup', '--robot-index 5 --robot-count 2', '--robot-index'),
     _row('bringup count', 'robot_bringup', '--robot-count 0', '--robot-count must be >= 1'),
     _row('bringup grace', 'robot_bringup', '--grace x', "invalid float value: 'x'"),

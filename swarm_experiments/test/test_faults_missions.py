@@ -12,8 +12,8 @@ from swarm_experiments.cli_args import fault_config
 from swarm_experiments.mission import run_mission
 from swarm_experiments.msc_pf_batch import BatchScenario, run_batch
 from swarm_experiments.node_overrides import OverrideError
-from swarm_experiments.oabug_batch import BatchRobot, _deliver, run_oabug_batch
-from swarm_experiments.reliability import parse_fault, still_time_s
+from swarm_experiments.oabug_batch import BatchRobot, BatchSwarm, _deliver, run_oabug_batch
+from swarm_experiments.reliability import decisions_after_s, parse_fault, still_time_s
 from swarm_experiments.spawn import SpawnSettings, build_mission
 from swarm_experiments.spawn import main as spawn_main
 from swarm_experiments.spawn_msc_pf import main as msc_main
@@ -66,9 +66,26 @@ def _robots_and_engine(settings):
         bearing_cycles=True,
     )
     robots = [BatchRobot(r.parameters, engine.config.lidar) for r in spec.robots]
-    tags = tuple(f'R{i}' for i in range(len(robots)))
-    own = np.array([robot.own_tag_index(tags) for robot in robots], dtype=np.int64)
-    return engine, robots, own
+    return engine, BatchSwarm(robots, tuple(f'R{i}' for i in range(len(robots))))
+
+
+class PushWatch:
+    """Per robot, the longest time it drove forward without moving 2 cm (pushing)."""
+
+    def __init__(self, engine):
+        self.anchor = engine.world.poses[:, :2].copy()
+        self.since = np.full(engine.num_robots, np.nan)
+        self.longest_s = np.zeros(engine.num_robots)
+
+    def update(self, engine, poses):
+        now = engine.time_s
+        forward = engine.active_commands()[:, 0] > 0.01
+        moved = np.hypot(*(poses[:, :2] - self.anchor).T) > 0.02
+        self.anchor[moved] = poses[moved, :2]
+        restart = moved | ~forward
+        self.since[restart] = np.nan
+        self.since[~restart & np.isnan(self.since)] = now
+        self.longest_s = np.fmax(self.longest_s, now - self.since)
 
 
 @pytest.mark.slow
@@ -87,26 +104,17 @@ def test_survivors_never_push_into_a_wall_and_lidarless_robots_stop_with_the_pum
     settings = SpawnSettings(
         site='small', robots=10, variant='gas_sound', seed=4, engine=EngineConfig(faults=faults)
     )
-    engine, robots, own = _robots_and_engine(settings)
+    engine, swarm = _robots_and_engine(settings)
     plan = engine.fault_plan
     stale = plan.mask('stale_lidar')
     working = ~(plan.mask('dropout') | stale)
-    anchor = engine.world.poses[:, :2].copy()
-    pushing_since = np.full(10, np.nan)  # when a robot began driving forward without moving
-    longest_push = np.zeros(10)
+    pushing = PushWatch(engine)
     pumped_before = np.zeros(10, dtype=bool)
     while engine.time_s < 150.0:
         out = engine.step()
-        _deliver(engine, out, robots, own)
+        _deliver(engine, out, swarm)
+        pushing.update(engine, out.poses)
         now = engine.time_s
-        forward = engine.active_commands()[:, 0] > 0.01
-        moved = np.hypot(*(out.poses[:, :2] - anchor).T) > 0.02
-        anchor[moved] = out.poses[moved, :2]
-        restart = moved | ~forward
-        pushing_since[restart] = np.nan
-        start = ~restart & np.isnan(pushing_since)
-        pushing_since[start] = now
-        longest_push = np.fmax(longest_push, now - pushing_since)
         if now < onset:
             pumped_before |= engine.pumps_running()
         elif now > onset + 1.0:
@@ -115,8 +123,36 @@ def test_survivors_never_push_into_a_wall_and_lidarless_robots_stop_with_the_pum
             assert not engine.active_commands()[stale].any()
     assert pumped_before.any()  # the pumps did run: "off" above is a change
     # No robot drove forward against an obstacle for more than 5 s.
-    assert longest_push[working].max() < 5.0
+    assert pushing.longest_s[working].max() < 5.0
     assert engine.distance_travelled_m[working].min() > 10.0
+
+
+@pytest.mark.slow
+def test_robots_touching_side_by_side_do_not_push_for_ever():
+    # Site 5 from the edge: at 14 s two robots touch, each beside the other's front outside
+    # the 30 deg hit cone. Without the contact rule both drive on into the other, blocked,
+    # for 36 s; with it each takes the touch for a robot hit and turns.
+    def longest_push(contact_m):
+        settings = SpawnSettings(
+            site='small',
+            site_seed=5,
+            seed=5,
+            robots=10,
+            variant='gas_sound',
+            departure='edge',
+            profile='tuned',
+            robot_parameters={'robot_contact_distance_m': contact_m},
+        )
+        engine, swarm = _robots_and_engine(settings)
+        pushing = PushWatch(engine)
+        while engine.time_s < 45.0:
+            out = engine.step()
+            _deliver(engine, out, swarm)
+            pushing.update(engine, out.poses)
+        return pushing.longest_s.max()
+
+    assert longest_push(0.16) < 5.0
+    assert longest_push(0.0) > 20.0  # the rule off: the old dead lock
 
 
 def test_a_bayes_swarm_without_some_robots_still_finds_the_source(case1_spec):
@@ -133,6 +169,10 @@ def test_a_bayes_swarm_without_some_robots_still_finds_the_source(case1_spec):
         path = fewer.trajectories[robot]
         # After the dropout the robot is where it was at 5 s: at most V * 5 s from its start.
         assert np.hypot(*(path[-1] - path[0])) <= case1_spec.planner.velocity_mps * 5.0 + 1e-9
+    # The survivors went on deciding (on the samples they took since) after the dropout.
+    speed = case1_spec.planner.velocity_mps
+    for robot in sorted(set(range(5)) - set(plan.robots['dropout'])):
+        assert decisions_after_s(fewer.trajectories[robot], speed, 5.0) >= 2
     everyone = dataclasses.replace(case1_spec, faults=FaultConfig(dropout_robots=5))
     assert not run_bayes(everyone, 'bayes_swarm_p', 5, seed=3).found
     deaf = dataclasses.replace(case1_spec, faults=FaultConfig(comm_loss_probability=1.0))
@@ -159,6 +199,11 @@ def test_dropped_msc_robots_stand_still_and_capture_nothing():
     assert np.ptp(paths[51:, dropped], axis=0).max() == 0.0
     assert np.ptp(paths[:50, dropped], axis=0).max() > 10.0
     assert np.isfinite(result.cct_s)
+    # The survivors went on driving after the dropout, to the last capture.
+    survivors = sorted(set(range(6)) - set(dropped))
+    steps = np.diff(paths[51:, survivors], axis=0)
+    driven = np.hypot(steps[..., 0], steps[..., 1]).sum(axis=0)
+    assert driven.min() > 50.0
 
 
 def test_msc_link_faults_act_in_the_relay_and_dropped_robots_go_silent():

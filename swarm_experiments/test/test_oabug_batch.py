@@ -6,8 +6,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 from oabug_robot.fsm import Command
-from oabug_robot.robot_loop import near_peers
-from oabug_robot.sound import PeerBearings
 from swarm_experiments.mission import RecordingSpec, StopReason, run_mission
 from swarm_experiments.oabug_batch import (
     BatchRobot,
@@ -107,35 +105,6 @@ def test_without_the_cdr_round_trip_both_paths_still_agree(monkeypatch):
     # Rounding the bearings and scan angles as serialization does changes the run.
     rounded = run_oabug_batch(spec, float32_fields=True)
     assert not np.array_equal(rounded.trajectories, ros.trajectories)
-
-
-def test_near_peers_of_many_robots_equal_each_robots_own_selection():
-    """The batch path's one-call near-peer selection gives, robot by robot, the bearings and
-    distances PeerBearings.near_peers_now gives (bit for bit, NaN and inf included)."""
-    rng = np.random.default_rng(5)
-    for _ in range(200):
-        held, expected = [], []
-        for _ in range(int(rng.integers(1, 11))):
-            if rng.random() < 0.2:
-                held.append(None)
-                expected.append((np.zeros(0), np.zeros(0)))
-                continue
-            count = int(rng.integers(0, 9))
-            azimuths = rng.uniform(-4.0, 4.0, count)
-            distances = rng.uniform(0.0, 4.0, count)
-            distances[rng.random(count) < 0.2] = math.nan
-            distances[rng.random(count) < 0.1] = math.inf
-            azimuths[rng.random(count) < 0.1] = math.nan
-            stamp_yaw, yaw = rng.uniform(-math.pi, math.pi, 2)
-            bearings = PeerBearings(azimuths, distances, 0.0, float(stamp_yaw))
-            held.append((azimuths, distances, float(stamp_yaw) - float(yaw)))
-            expected.append(bearings.near_peers_now(float(yaw), 2.0))
-        bounds, azimuths, distances = near_peers(held, 2.0)
-        for i, (want_azimuths, want_distances) in enumerate(expected):
-            lo, hi = bounds[i], bounds[i + 1]
-            assert azimuths[lo:hi].tobytes() == want_azimuths.tobytes()
-            assert distances[lo:hi].tobytes() == want_distances.tobytes()
-        assert bounds[-1] == len(azimuths) == len(distances)
 
 
 @pytest.mark.parametrize('float32_fields', [True, False])

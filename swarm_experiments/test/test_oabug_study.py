@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import math
 
 import numpy as np
@@ -115,3 +116,7 @@ def test_the_report_has_the_tables_curves_and_paired_statistics(tmp_path):
     assert 'small, profile paper: coverage %' in text
     assert 'gas_sound - gas' in text
     assert (page.parent / 'figures' / 'fig4-small-paper.png').is_file()
+    # The coverage and paired tables are exported for the docs' generated results sections.
+    exported = json.loads((page.parent / 'results.json').read_text())['tables']
+    assert {'small-paper', 'small-paper-paired'} <= set(exported)
+    assert any('gas_sound' in str(row) for row in exported['small-paper']['rows'])

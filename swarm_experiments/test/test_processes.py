@@ -24,6 +24,7 @@ import pytest
 from sim_bridge.bridge_parameters import BRIDGE_PARAMETERS
 from sim_bridge.mission_file import load_mission
 from swarm_experiments.processes import NodeCommand, format_command, parse_command
+from swarm_experiments.reliability import first_move_s, path_length_m
 from swarm_runtime.bag import read_messages
 from swarm_runtime.ros import using_real_rclpy
 
@@ -268,10 +269,22 @@ def test_ctrl_c_stops_every_child_with_the_summary_so_far(tmp_path: Path) -> Non
 
 @real_rclpy
 def test_a_crash_fault_kills_and_restarts_one_robot(tmp_path: Path) -> None:
-    argv = ['--robots', '2', '--actions', '45', '--time-scale', '2', '--fault', 'crash:r1@3+2']
+    # Time scale 1: the restarted node's start-up (a few wall seconds) costs as much sim time.
+    argv = ['--robots', '2', '--actions', '75', '--time-scale', '1', '--fault', 'crash:r1@3+2']
     done = _run('spawn', argv, tmp_path)
     assert done.returncode in (0, 1), done.stderr  # the mission goes on without r1
-    assert 'stopped by budget after 15.0 s sim' in done.stdout
+    assert 'stopped by budget after 25.0 s sim' in done.stdout
     starts = 'OA-Bug gas_sound: robot {} of 2'
     assert (tmp_path / 'r0.log').read_text().count(starts.format(0)) == 1
     assert (tmp_path / 'r1.log').read_text().count(starts.format(1)) == 2  # started again
+    outcome = _outcome(tmp_path)
+    times = np.asarray(outcome['trajectory_times_s'])
+    paths = np.asarray(outcome['trajectories']).reshape(len(times), 2, 3)[..., :2]
+    # Killed at 3 s: r1 stops within the bridge's cmd_vel timeout and stays down ...
+    assert path_length_m(times, paths[:, 1], 0.0, 3.0) > 0.5
+    assert path_length_m(times, paths[:, 1], 4.0, 5.0) == 0.0
+    # ... while r0 drives on; from the restart at 5 s the new node drives r1 again.
+    assert path_length_m(times, paths[:, 0], 3.0, 5.0) > 0.3
+    moving_s = first_move_s(times, paths[:, 1], 5.0)
+    assert moving_s < 20.0, 'the restarted node never drove its robot'
+    assert path_length_m(times, paths[:, 1], moving_s, 25.0) > 1.0

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 from swarm_experiments.mission import run_mission
@@ -62,7 +64,8 @@ def test_the_study_is_registered_with_oabug_rows_first():
     assert study.axes['method'][0] == 'gas_sound'
     assert study.axes['method'][-2:] == ('sgba', 'sgba_scaled')
     assert plan.params['profile'] == 'paper'
-    assert len(plan.specs) == 2 * 4 * 1 * 2 * 20
+    assert study.axes['robots'] == (2, 4, 6, 8, 10), "the paper's Fig. 4 robot counts"
+    assert len(plan.specs) == 2 * 4 * 5 * 2 * 20
     scaled = next(s for s in plan.specs if s.config['method'] == 'sgba_scaled')
     assert _sgba_overrides(scaled.config) == {'geometry_scale': 0.5}
     chosen = make_specs(study, overrides={'sgba.geometry_scale': '0.7'}, smoke=True)
@@ -99,13 +102,24 @@ def test_smoke_runs_both_methods_and_reports_the_paired_comparison(tmp_path):
     text = page.read_text()
     assert '## SGBA beside OA-Bug' in text
     assert 'sgba_scaled - gas_sound' in text
+    # Both tables are exported for the docs' generated results sections.
+    exported = json.loads((page.parent / 'results.json').read_text())['tables']
+    assert {'coverage', 'paired'} <= set(exported)
+    methods = [row[3] for row in exported['coverage']['rows']]
+    assert methods.index('gas_sound') < methods.index('sgba_scaled')  # OA-Bug leads
 
 
 def test_an_sgba_run_records_the_coverage_curve():
     (study,) = studies()
     plan = make_specs(
         study,
-        overrides={'method': '[sgba]', 'site': '[small]', 'departure': '[edge]', 'actions': '200'},
+        overrides={
+            'method': '[sgba]',
+            'site': '[small]',
+            'robots': '[10]',
+            'departure': '[edge]',
+            'actions': '200',
+        },
         runs=1,
     )
     (spec,) = plan.specs

@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Final
 
 import numpy as np
@@ -272,12 +273,19 @@ class _FreePlaces:
         # The way out may be as narrow as the departure point's own clearance.
         own = float(_nearest_wall(self.centre[None, :], self.walls)[0])
         self.way_clearance = min(clearance, own)
-        step = _SEARCH_STEP_FRACTION * robot_radius_m
+        self._reach = reach
+        self._step = _SEARCH_STEP_FRACTION * robot_radius_m
+
+    @cached_property
+    def points(self) -> np.ndarray:
+        """(K, 2) the free candidates [m], on a square grid within the reach (worked out
+        when first asked for: most placements need none)."""
+        reach, step = self._reach, self._step
         offsets = np.arange(-math.ceil(reach / step), math.ceil(reach / step) + 1) * step
         gx, gy = np.meshgrid(offsets, offsets)
         grid = self.centre + np.column_stack([gx.ravel(), gy.ravel()])
         grid = grid[np.hypot(gx.ravel(), gy.ravel()) <= reach]
-        self.points = grid[self.free(grid)]
+        return grid[self.free(grid)]
 
     def free(self, points: np.ndarray) -> np.ndarray:
         """(N,) True where a robot centred there keeps its clearance from every wall and can

@@ -19,7 +19,6 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
-from swarm_common.angles import wrap_angle
 from swarm_common.params import parameter, section
 
 from swarm_sim.errors import ConfigurationError, WorldGeometryError
@@ -40,7 +39,9 @@ from swarm_sim.sensors.imu import GyroYawModel, ImuConfig
 from swarm_sim.sensors.lidar import LidarConfig, LidarModel
 from swarm_sim.sensors.odometry import OdometryConfig, WheelOdometry
 from swarm_sim.sensors.scent import PumpDepositor, ScentConfig, ScentField
+from swarm_sim.sensors_kernel import yaw_change_kernel
 from swarm_sim.world import BodyConfig
+from swarm_sim.world_kernel import actuators_kernel, body_points_kernel
 
 __all__ = ['SENSORS', 'EngineConfig', 'SimEngine', 'SiteGeometry', 'StepOutput']
 
@@ -200,7 +201,10 @@ class StepOutput:
 
 def _headings(poses: np.ndarray) -> np.ndarray:
     """(N, 2) unit vectors cos(yaw), sin(yaw) of (N, 3) poses."""
-    return np.column_stack([np.cos(poses[:, 2]), np.sin(poses[:, 2])])
+    headings = np.empty((len(poses), 2))
+    np.cos(poses[:, 2], out=headings[:, 0])
+    np.sin(poses[:, 2], out=headings[:, 1])
+    return headings
 
 
 class _Schedule:
@@ -237,6 +241,7 @@ class SimEngine:
         config: EngineConfig | None = None,
         *,
         bearing_cycles: bool = False,
+        scan_horizon_m: float | None = None,
     ) -> None:
         """Build the world and its models.
 
@@ -247,8 +252,13 @@ class SimEngine:
             bearing_cycles: hand the bearings over as one :class:`BearingCycle` of flat
                 arrays (``StepOutput.bearing_cycle``) instead of a report per robot (the
                 same values and random draws).
+            scan_horizon_m: when given, scan ranges beyond it read ``inf`` (the others,
+                and every random draw, as without it), and the lidar skips the walls that
+                only farther rays reach (:meth:`LidarModel.measure`). For a consumer that
+                reads no farther range; a bridge publishes the full scans.
         """
         self._bearing_cycles = bearing_cycles
+        self._scan_horizon_m = scan_horizon_m
         self.config = config or EngineConfig()
         cfg = self.config
         self.site = site
@@ -419,8 +429,16 @@ class SimEngine:
         """Advance one physics period and return what is due."""
         cfg = self.config
         dt = cfg.physics_period_s
-        commands = self.active_commands()
-        pumping = self.pumps_running()
+        # active_commands() and pumps_running() in one compiled call.
+        commands, pumping = actuators_kernel(
+            self.time_s,
+            self._command,
+            self._command_time_s,
+            cfg.cmd_vel_timeout_s + 1e-9,
+            self._pump_on,
+            self._pump_time_s,
+            cfg.pump_timeout_s + 1e-9,
+        )
         for hook in self._hooks:
             commands, pumping = hook.actuators(self.time_s, commands, pumping)
         before = self.world.poses
@@ -428,23 +446,23 @@ class SimEngine:
         self._step_index += 1
         self.time_s = self._step_index * dt
         poses = self.world.poses
-        self.distance_travelled_m += np.hypot(*(poses[:, :2] - before[:, :2]).T)
-        # The headings serve the nozzles and the gas sensors: computed once, when needed.
-        headings = None
+        moved = poses[:, :2] - before[:, :2]
+        self.distance_travelled_m += np.hypot(moved[:, 0], moved[:, 1])
         depositor = self._depositor
         if depositor is not None and depositor.busy(pumping):
-            headings = _headings(poses)
-            depositor.step(pumping, self.nozzle_positions(poses, headings), self.time_s, dt)
+            # nozzle_positions(poses) in compiled code.
+            nozzles = body_points_kernel(poses, -cfg.pump_offset_m)
+            depositor.step(pumping, nozzles, self.time_s, dt)
         out = StepOutput(time_s=self.time_s, poses=poses)
         out.new_room_entries = self.coverage.update(poses, self.time_s)
         sched = self._schedules
         if sched['scan'].due(self.time_s)[0] and self.lidar is not None:
-            out.scans = self.lidar.measure(poses)
+            out.scans = self.lidar.measure(poses, self._scan_horizon_m)
         due, elapsed = sched['gas'].due(self.time_s)
         if due and self.gas is not None and self.scent is not None:
-            if headings is None:
-                headings = _headings(poses)
-            c = self.scent.concentration(self.gas_sensor_positions(poses, headings), self.time_s)
+            # gas_sensor_positions(poses) in compiled code.
+            sensors = body_points_kernel(poses, cfg.gas.sensor_offset_m)
+            c = self.scent.concentration(sensors, self.time_s)
             out.gas_raw = self.gas.update(c, elapsed)
         if sched['bearings'].due(self.time_s)[0] and self.bearing_model is not None:
             if self._bearing_cycles:
@@ -453,7 +471,7 @@ class SimEngine:
                 out.bearings = self.bearing_model.measure(poses)
         due, elapsed = sched['imu'].due(self.time_s)
         if due and self.imu is not None:
-            change = np.asarray(wrap_angle(poses[:, 2] - self._imu_last_yaw), dtype=float)
+            change = yaw_change_kernel(poses[:, 2], self._imu_last_yaw)
             self._imu_last_yaw = poses[:, 2].copy()
             out.imu = self.imu.update(change, elapsed)
         due, elapsed = sched['odometry'].due(self.time_s)

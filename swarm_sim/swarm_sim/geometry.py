@@ -18,7 +18,13 @@ import numpy as np
 from swarm_common.angles import wrap_angle
 
 from swarm_sim.errors import WorldGeometryError
-from swarm_sim.raycast_kernel import crossings_kernel, nearest_kernel, scan_kernel
+from swarm_sim.raycast_kernel import (
+    NEAR_MARGIN_M,
+    crossings_kernel,
+    horizon_scan_kernel,
+    nearest_kernel,
+    scan_kernel,
+)
 
 __all__ = [
     'RayCaster',
@@ -151,6 +157,8 @@ def _count_hits_numpy(
 
 
 _FAR = 1e12
+# RayCaster.scan_near: the cell size of the grid of the faces near each cell [m].
+_NEAR_FACE_CELL_M = 0.5
 
 
 class WallGrid:
@@ -175,12 +183,12 @@ class WallGrid:
         ix, iy = np.meshgrid(np.arange(shape[0]), np.arange(shape[1]), indexing='ij')
         centres = lo + (np.column_stack([ix.ravel(), iy.ravel()]) + 0.5) * self.cell_m
         near = point_segment_distance(centres, segments) <= reach_m + self.cell_m * math.sqrt(0.5)
-        width = max(int(near.sum(axis=1).max()), 1)
-        table = np.full((len(centres), width), len(segments), dtype=int)
-        for c in np.flatnonzero(near.any(axis=1)):
-            idx = np.flatnonzero(near[c])
-            table[c, : len(idx)] = idx
-        self._table = table
+        counts = near.sum(axis=1)
+        width = max(int(counts.max()), 1)
+        # Per cell, its walls in index order (a stable sort puts the near ones first), then
+        # the padding index.
+        first = np.argsort(~near, axis=1, kind='stable')[:, :width]
+        self._table = np.where(np.arange(width) < counts[:, None], first, len(segments))
 
     def candidates(self, points: np.ndarray) -> np.ndarray:
         """(K, W) indices of the walls near each of the (K, 2) points; padding is M."""
@@ -373,6 +381,9 @@ class RayCaster:
         # A ray's direction is its bin's fixed direction rotated by the robot's yaw.
         self._cos_offsets = np.cos(self._bin_offsets_rad)
         self._sin_offsets = np.sin(self._bin_offsets_rad)
+        # scan_near: the faces near each grid cell, per cut, and the robots' certificates.
+        self._near_faces: dict[float, tuple[float, float, float, int, int, np.ndarray]] = {}
+        self._certificates = np.full((0, self.num_bins), -1, dtype=np.int64)
 
     @property
     def bin_angles_rad(self) -> np.ndarray:
@@ -426,6 +437,78 @@ class RayCaster:
         )
         best[best > max_range_m] = np.inf
         return best.reshape(n, nb)
+
+    def scan_near(
+        self, poses: np.ndarray, max_range_m: float, cut_m: float
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`scan` where only the ranges up to ``cut_m`` are needed.
+
+        Returns the ranges and, per bin, its kind
+        (:data:`~swarm_sim.raycast_kernel.NO_RETURN`, ``EXACT`` or ``BEYOND_CUT``): a bin
+        is exact (its range equal to :meth:`scan`'s bit for bit) where :meth:`scan` reads at
+        most ``cut_m``, "beyond the cut" where :meth:`scan` reads a finite range beyond it
+        (the range returned is then meaningless), "no return" where :meth:`scan` reads
+        ``inf``. Each robot casts only the walls within ``cut_m`` and decides for its other
+        rays whether they end within ``max_range_m`` by testing the faces along them (see
+        :func:`~swarm_sim.raycast_kernel.horizon_scan_kernel`).
+
+        Args:
+            poses: (N, 3) x [m], y [m], yaw [rad] of every robot.
+            max_range_m: rays longer than this return nothing.
+            cut_m: the ranges wanted exactly [m], ``0 < cut_m < max_range_m``.
+
+        Returns:
+            (N, num_bins) ranges [m] and (N, num_bins) uint8 kinds.
+        """
+        if not 0.0 < cut_m < max_range_m:
+            msg = f'need 0 < cut_m < max_range_m, got {cut_m} and {max_range_m}'
+            raise WorldGeometryError(msg)
+        poses = np.asarray(poses, dtype=float)
+        n = len(poses)
+        nb = self.num_bins
+        best = np.empty(n * nb)
+        kind = np.empty(n * nb, dtype=np.uint8)
+        if n == 0:
+            return best.reshape(0, nb), kind.reshape(0, nb)
+        if len(self._certificates) != n:
+            self._certificates = np.full((n, nb), -1, dtype=np.int64)
+        horizon_scan_kernel(
+            np.ascontiguousarray(poses[:, :2]),
+            np.ascontiguousarray(poses[:, 2]),
+            self._cos_offsets,
+            self._sin_offsets,
+            self._faces,
+            self.angle_min_rad,
+            self.angle_increment_rad,
+            float(max_range_m),
+            self._robot_radius_m,
+            self._robot_radius_m**2,
+            float(cut_m),
+            self._near_face_grid(float(cut_m)),
+            self._certificates,
+            best,
+            kind,
+        )
+        return best.reshape(n, nb), kind.reshape(n, nb)
+
+    def _near_face_grid(self, cut_m: float) -> tuple[float, float, float, int, int, np.ndarray]:
+        """The faces within ``cut_m`` (plus their half thickness and a margin) of each cell
+        of a 0.5 m grid, as :func:`~swarm_sim.raycast_kernel.horizon_scan_kernel` takes them
+        (the padding index is the number of faces)."""
+        grid = self._near_faces.get(cut_m)
+        if grid is None:
+            faces = self._all_segments
+            if len(faces) == 0:
+                table = np.zeros((1, 1), dtype=np.int64)
+                grid = (0.0, 0.0, 1.0, 1, 1, table)
+            else:
+                # A face farther than cut + margin lies beyond cut_m by more than rounding.
+                reach = cut_m + self._half_thickness_m + NEAR_MARGIN_M
+                wall_grid = WallGrid(faces, cell_m=_NEAR_FACE_CELL_M, reach_m=reach)
+                x, y, cell, sx, sy, table, _, _ = wall_grid.kernel_arguments()
+                grid = (x, y, cell, sx, sy, np.ascontiguousarray(table, dtype=np.int64))
+            self._near_faces[cut_m] = grid
+        return grid
 
     def scan_reference(self, poses: np.ndarray, max_range_m: float) -> np.ndarray:
         """:meth:`scan` in numpy, the reference the compiled kernel is tested against (same

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from swarm_sim.errors import WorldGeometryError
-from swarm_sim.world_kernel import rooms_touched_kernel
+from swarm_sim.world_kernel import rooms_entered_kernel, rooms_touched_kernel
 
 __all__ = ['CoverageTracker', 'RoomEntry']
 
@@ -133,12 +133,27 @@ class CoverageTracker:
         """
         if self.complete:
             return []
-        hits = self.inside(positions)
         new: list[RoomEntry] = []
-        for k in np.flatnonzero((self._first_robot < 0) & hits.any(axis=0)):
-            robot = int(np.flatnonzero(hits[:, k])[0])
+        if self._room_index_at is None:
+            # Rectangle rooms only: the compiled test of the rooms not entered yet.
+            entering = rooms_entered_kernel(
+                np.asarray(positions, dtype=float),
+                self._rects,
+                self._rect_room,
+                self._radius_m**2,
+                self._first_robot,
+            )
+            if not len(entering):
+                return new
+            rooms = np.flatnonzero(entering >= 0).tolist()
+            robots = entering[rooms].tolist()
+        else:
+            hits = self.inside(positions)
+            rooms = np.flatnonzero((self._first_robot < 0) & hits.any(axis=0)).tolist()
+            robots = [int(np.flatnonzero(hits[:, k])[0]) for k in rooms]
+        for k, robot in zip(rooms, robots, strict=True):
             self._first_robot[k] = robot
-            entry = RoomEntry(room_index=int(k), robot_index=robot, time_s=float(time_s))
+            entry = RoomEntry(room_index=k, robot_index=robot, time_s=float(time_s))
             self._entries.append(entry)
             new.append(entry)
         return new

@@ -264,6 +264,14 @@ class NumpyPhysics:
             raise ConfigurationError('this physics backend was built without a lidar')
         return self._caster.scan(poses, max_range_m)
 
+    def scan_near(
+        self, poses: np.ndarray, max_range_m: float, cut_m: float
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`swarm_sim.geometry.RayCaster.scan_near`."""
+        if self._caster is None:
+            raise ConfigurationError('this physics backend was built without a lidar')
+        return self._caster.scan_near(poses, max_range_m, cut_m)
+
     def close(self) -> None:
         """Nothing to release."""
 

@@ -17,7 +17,14 @@ from numba import njit
 
 from swarm_sim.raycast_kernel import _wrap
 
-__all__ = ['gas_update_kernel', 'imu_message_yaw_kernel', 'imu_update_kernel']
+__all__ = [
+    'gas_update_kernel',
+    'heard_pairs_kernel',
+    'imu_message_yaw_kernel',
+    'imu_update_kernel',
+    'wrap_sum_kernel',
+    'yaw_change_kernel',
+]
 
 _FLOAT_MAX = np.finfo(np.float64).max
 
@@ -115,3 +122,78 @@ def imu_message_yaw_kernel(yaw_rad: np.ndarray) -> np.ndarray:  # pragma: no cov
             continue
         out[i] = math.atan2(2.0 * (w * z + x * y), w * w + x * x - y * y - z * z)
     return out
+
+
+@njit(cache=True)
+def yaw_change_kernel(
+    yaw_rad: np.ndarray, previous_yaw_rad: np.ndarray
+) -> np.ndarray:  # pragma: no cover - compiled
+    """``swarm_common.angles.wrap_angle(yaw_rad - previous_yaw_rad)`` of (N,) yaws [rad]
+    (the same operations: ``%`` here is numpy's ``mod``)."""
+    out = np.empty(yaw_rad.shape[0])
+    for i in range(yaw_rad.shape[0]):
+        out[i] = _wrap(yaw_rad[i] - previous_yaw_rad[i])
+    return out
+
+
+@njit(cache=True)
+def wrap_sum_kernel(a_rad: np.ndarray, b_rad: np.ndarray) -> np.ndarray:  # pragma: no cover
+    """``swarm_common.angles.wrap_angle(a_rad + b_rad)`` of (N,) angles [rad], with its
+    operations."""
+    out = np.empty(a_rad.shape[0])
+    for i in range(a_rad.shape[0]):
+        out[i] = _wrap(a_rad[i] + b_rad[i])
+    return out
+
+
+@njit(cache=True)
+def heard_pairs_kernel(
+    receiver: np.ndarray,
+    transmitter: np.ndarray,
+    distance_m: np.ndarray,
+    reach_m: np.ndarray,
+    range_m: float,
+    uniform: np.ndarray,
+    dropout_probability: float,
+    sequence: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:  # pragma: no cover - compiled
+    """The sight lines a locator cycle hears, ``BearingModel._cycle``'s selection: within
+    ``range_m`` and the line's reach, and not dropped (a uniform draw at least the dropout
+    probability, when it is not 0).
+
+    Args:
+        receiver, transmitter: (L,) the lines' robots, receivers ascending.
+        distance_m: (L,) their lengths [m].
+        reach_m: (L,) the range left after the walls each crosses [m].
+        range_m: the line-of-sight range [m].
+        uniform: (L,) the dropout draws (read only with a dropout probability).
+        dropout_probability: chance that one report is lost.
+        sequence: (N, N) per receiver and tag, the report counter; the heard ones advance
+            (modulo 65536).
+
+    Returns:
+        The indices of the heard lines, their new sequence numbers, and the (N + 1,) slice
+        bounds of each receiver's among them.
+    """
+    lines = receiver.shape[0]
+    n = sequence.shape[0]
+    heard = np.empty(lines, dtype=np.int64)
+    numbers = np.empty(lines, dtype=np.int64)
+    bounds = np.zeros(n + 1, dtype=np.int64)
+    count = 0
+    for line in range(lines):
+        d = distance_m[line]
+        if not (d <= range_m and d <= reach_m[line]):
+            continue
+        if dropout_probability > 0.0 and not uniform[line] >= dropout_probability:
+            continue
+        i = receiver[line]
+        j = transmitter[line]
+        sequence[i, j] = (sequence[i, j] + 1) % 65536
+        heard[count] = line
+        numbers[count] = sequence[i, j]
+        bounds[i + 1] += 1
+        count += 1
+    for i in range(n):
+        bounds[i + 1] += bounds[i]
+    return heard[:count], numbers[:count], bounds

@@ -21,10 +21,13 @@ Choices where the paper is silent or inconsistent (see docs/bayes_swarm.md):
   noise (std 47 / 100 = 0.47). That needs at least 5.4 m; at 6 m |H| exceeds 0.47 within
   27 m of the beacon in every direction (32 m along the diagonal; 0.66 at the depot), at
   2 m only within 9-11 m. The depot gives the paper's t_idealized = 56.57 s at 0.5 m/s.
-  The penalty uses M = 47 and L = the largest gradient of this field (Sec. 2.5:
-  L = max |grad f|; 6.7 at 6 m, 20 at 2 m). The paper's L = 2 with M = 47 would exclude a
-  ball of radius (M - mu) / L ~ 23 m around every peer's waypoint, i.e. the whole reachable
-  area; it did not matter in the authors' code only because their penalty is inert.
+  The planners see the signal in units of the beacon's known peak (``signal_scale`` 47),
+  for which the paper's M = 1.2 and L = 2 are what Sec. 2.5 asks of them (M >= max f,
+  L >= max |grad f|: 1 and 0.14 /m at 6 m); they are the values the paper gives for Case 1,
+  whose field peaks at 1. Read for |H| itself (M = 47), L = 2 is no Lipschitz constant of
+  the field (its largest gradient is 6.7 at 6 m) and the exclusion ball (M - mu) / L around
+  every peer's waypoint is about 23 m wide, the whole reachable area; that never showed in
+  the authors' code because their penalty is inert.
 """
 
 from __future__ import annotations
@@ -148,6 +151,8 @@ class SignalCase:
         arena_m: (x_min, x_max, y_min, y_max) [m].
         depots_m: (d, 2) start points; robots are dealt to them in turn.
         velocity_mps, horizon_s, detection_radius_m, max_mission_time_s: V, T, eps, T_max.
+        signal_scale: the planners' unit of the signal: they divide samples by it, and M, L
+            are in these units (the avalanche: its peak 47, see the module docstring).
         max_signal, lipschitz: M and L of the local penalty.
         direction_range_deg: delta theta of the first decision.
         observation_rate_hz: f_Hz.
@@ -172,6 +177,7 @@ class SignalCase:
     default_robots: int = 5
     depot_direction_offsets_deg: tuple[float, ...] = (0.0,)
     dimensionless_acquisition: bool = False
+    signal_scale: float = 1.0
 
     def depot_of(self, robot_index: int) -> int:
         """Index of the depot robot ``robot_index`` (0-based) starts from."""
@@ -265,9 +271,10 @@ AVALANCHE_DEPTH_M = 6.0
 def avalanche_case(depth_m: float = AVALANCHE_DEPTH_M) -> SignalCase:
     """The avalanche case with the beacon ``depth_m`` below the sensing plane.
 
-    The peak stays 47; the field's largest gradient, the penalty's L, scales as 1 / depth
-    (6.7 at the default 6 m, 20 at 2 m). The beacon rises above noise of 1 % of its peak
-    within 27 m of it in every direction at 6 m, 23 m at 5 m and 9 m at 2 m.
+    The peak stays 47 and the field's largest gradient scales as 1 / depth (6.7 at the
+    default 6 m, 20 at 2 m), so the paper's L = 2 for |H| / 47 is a valid Lipschitz constant
+    at any depth above about 0.43 m. The beacon rises above noise of 1 % of its peak within 27 m of
+    it in every direction at 6 m, 23 m at 5 m and 9 m at 2 m.
     """
     if not depth_m > 0.0:
         msg = f'depth_m must be > 0, got {depth_m}'
@@ -282,12 +289,12 @@ def avalanche_case(depth_m: float = AVALANCHE_DEPTH_M) -> SignalCase:
         horizon_s=10.0,
         detection_radius_m=0.15,
         max_mission_time_s=100.0,
-        max_signal=47.0,
-        lipschitz=40.0 / depth_m,  # max |grad f|; see the module docstring
+        signal_scale=47.0,  # the beacon's known peak; M and L are read for |H| / 47
+        max_signal=1.2,
+        lipschitz=2.0,
         direction_range_deg=90.0,
         observation_rate_hz=0.5,
         default_robots=6,
-        dimensionless_acquisition=True,
     )
 
 

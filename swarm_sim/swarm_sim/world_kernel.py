@@ -170,3 +170,83 @@ def rooms_touched_kernel(
             if dx * dx + dy * dy < radius2:
                 result[i, rect_room[r]] = True
     return result
+
+
+@njit(cache=True)
+def rooms_entered_kernel(
+    positions: np.ndarray,
+    rects: np.ndarray,
+    rect_room: np.ndarray,
+    radius2: float,
+    first_robot: np.ndarray,
+) -> np.ndarray:  # pragma: no cover - compiled
+    """The rooms first entered now: per room not yet entered (``first_robot`` < 0) that a
+    robot's disc overlaps (:func:`rooms_touched_kernel`'s test), the lowest such robot.
+
+    Args:
+        positions: (N, 2+) robot positions [m].
+        rects: (R, 4) x_min, y_min, x_max, y_max [m].
+        rect_room: (R,) the room of each rectangle.
+        radius2: the disc's squared radius [m^2].
+        first_robot: (K,) per room, the robot that entered it first (-1: none yet).
+
+    Returns:
+        (K,) per room, the robot entering it now (-1: none), -1 for rooms entered before;
+        all -1 is returned as an empty array (nothing new: the common case).
+    """
+    entering = np.full(first_robot.shape[0], -1, dtype=np.int64)
+    found = False
+    for r in range(rects.shape[0]):
+        room = rect_room[r]
+        if first_robot[room] >= 0:
+            continue
+        for i in range(positions.shape[0]):
+            if 0 <= entering[room] <= i:
+                break
+            x = positions[i, 0]
+            y = positions[i, 1]
+            dx = max(max(rects[r, 0] - x, x - rects[r, 2]), 0.0)
+            dy = max(max(rects[r, 1] - y, y - rects[r, 3]), 0.0)
+            if dx * dx + dy * dy < radius2:
+                entering[room] = i
+                found = True
+                break
+    return entering if found else entering[:0]
+
+
+@njit(cache=True)
+def actuators_kernel(
+    time_s: float,
+    command: np.ndarray,
+    command_time_s: np.ndarray,
+    command_timeout_s: float,
+    pump_on: np.ndarray,
+    pump_time_s: np.ndarray,
+    pump_timeout_s: float,
+) -> tuple[np.ndarray, np.ndarray]:  # pragma: no cover - compiled
+    """``SimEngine.active_commands`` and ``SimEngine.pumps_running`` in one call: (N, 2)
+    the commands in force (zero where older than ``command_timeout_s``) and (N,) the pumps
+    running (an "on" older than ``pump_timeout_s`` has timed out). The timeouts include
+    the engine's 1e-9 s margin."""
+    n = command.shape[0]
+    active = np.empty((n, 2))
+    running = np.empty(n, dtype=np.bool_)
+    for i in range(n):
+        fresh = time_s - command_time_s[i] <= command_timeout_s
+        active[i, 0] = command[i, 0] if fresh else 0.0
+        active[i, 1] = command[i, 1] if fresh else 0.0
+        running[i] = pump_on[i] and time_s - pump_time_s[i] <= pump_timeout_s
+    return active, running
+
+
+@njit(cache=True)
+def body_points_kernel(poses: np.ndarray, offset_m: float) -> np.ndarray:  # pragma: no cover
+    """(N, 2) the points ``offset_m`` ahead of each robot's centre (behind when negative):
+    ``SimEngine.gas_sensor_positions``' operations (``nozzle_positions`` with the offset
+    negated: the same values), with the C library's cos and sin (numpy's for float64)."""
+    n = poses.shape[0]
+    out = np.empty((n, 2))
+    for i in range(n):
+        out[i, 0] = poses[i, 0] + offset_m * math.cos(poses[i, 2])
+        out[i, 1] = poses[i, 1] + offset_m * math.sin(poses[i, 2])
+    return out

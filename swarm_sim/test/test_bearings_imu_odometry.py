@@ -4,12 +4,12 @@ import math
 
 import numpy as np
 import pytest
-from swarm_common.angles import yaw_from_quaternion, yaw_to_quaternion
+from swarm_common.angles import wrap_angle, yaw_from_quaternion, yaw_to_quaternion
 from swarm_sim.errors import ConfigurationError
 from swarm_sim.sensors.bearings import BearingConfig, BearingModel
 from swarm_sim.sensors.imu import GyroYawModel, ImuConfig
 from swarm_sim.sensors.odometry import OdometryConfig, WheelOdometry
-from swarm_sim.sensors_kernel import imu_message_yaw_kernel
+from swarm_sim.sensors_kernel import imu_message_yaw_kernel, wrap_sum_kernel, yaw_change_kernel
 
 
 def test_bearing_is_the_peer_direction_in_the_receiver_frame_with_a_few_degrees_of_noise():
@@ -107,14 +107,17 @@ def test_noisy_odometry_drifts_away_from_the_truth():
     assert abs(est[0, 0] - pose[0, 0]) > 1e-3
 
 
-@pytest.mark.parametrize(('robots', 'with_walls'), [(1, True), (2, False), (10, True), (25, True)])
-def test_compiled_sight_lines_give_the_numpy_reports_bit_for_bit(robots, with_walls):
+@pytest.mark.parametrize(
+    ('robots', 'with_walls', 'dropout'),
+    [(1, True, 0.02), (2, False, 0.02), (10, True, 0.02), (25, True, 0.02), (10, True, 0.0)],
+)
+def test_compiled_sight_lines_give_the_numpy_reports_bit_for_bit(robots, with_walls, dropout):
     rng = np.random.default_rng(robots)
     walls = np.zeros((0, 2, 2))
     if with_walls:
         starts = rng.uniform(0.0, 30.0, (60, 2))
         walls = np.stack([starts, starts + rng.uniform(-4.0, 4.0, (60, 2))], axis=1)
-    config = BearingConfig(range_m=25.0, wall_range_factor=0.6)
+    config = BearingConfig(range_m=25.0, wall_range_factor=0.6, dropout_probability=dropout)
     compiled = BearingModel(robots, config, np.random.default_rng(3), walls)
     reference = BearingModel(robots, config, np.random.default_rng(3), walls)
     heard = set()
@@ -188,3 +191,27 @@ def test_compiled_imu_message_yaw_is_the_nodes_quaternion_round_trip_bit_for_bit
         assert math.isnan(imu_message_yaw_kernel(np.array([bad]))[0])
         with pytest.raises(ValueError, match=r'orientation|domain'):
             yaw_from_quaternion(*yaw_to_quaternion(bad))
+
+
+def test_compiled_yaw_change_is_the_wrapped_difference_bit_for_bit():
+    """yaw_change_kernel (the engine's IMU input) and wrap_sum_kernel (the bearings' noise)
+    equal wrap_angle of the difference and the sum, across the +-pi seam, with signed
+    zeros, exact multiples of pi, huge values, NaN and inf."""
+    rng = np.random.default_rng(10)
+    now = np.concatenate(
+        (
+            rng.uniform(-math.pi, math.pi, 3000),
+            [math.pi, -math.pi, 0.0, -0.0, 3 * math.pi, 1e300, math.nan, math.inf, 1e-300],
+        )
+    )
+    before = np.concatenate(
+        (
+            rng.uniform(-math.pi, math.pi, 3000),
+            [-math.pi, math.pi, -0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0],
+        )
+    )
+    with np.errstate(invalid='ignore'):
+        want = wrap_angle(now - before)
+        want_sum = wrap_angle(now + before)
+    assert yaw_change_kernel(now, before).tobytes() == want.tobytes()
+    assert wrap_sum_kernel(now, before).tobytes() == want_sum.tobytes()

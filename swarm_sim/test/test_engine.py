@@ -210,3 +210,43 @@ def test_commands_set_together_equal_commands_set_one_by_one():
     assert together.active_commands().tobytes() == before.tobytes()
     with pytest.raises(ValueError, match='pump states'):
         together.set_commands([0], [(0.3, 0.0)], [])
+
+
+def test_the_compiled_watchdogs_give_the_active_commands_and_pumps():
+    """The step's compiled watchdogs equal active_commands() and pumps_running() on commands
+    and pump states of every age around the timeouts (signed zeros included)."""
+    from swarm_sim.world_kernel import actuators_kernel
+
+    rng = np.random.default_rng(9)
+    engine = make_engine([[1.0 + 0.5 * i, 1.5, 0.0] for i in range(6)])
+    config = engine.config
+    for step in range(200):
+        engine.time_s = 0.1 * step
+        engine._command[:] = rng.choice([0.3, -0.2, 0.0, -0.0], (6, 2))
+        engine._command_time_s[:] = engine.time_s - rng.choice([0.0, 0.4, 0.5, 0.6, np.inf], 6)
+        engine._pump_on[:] = rng.random(6) < 0.5
+        engine._pump_time_s[:] = engine.time_s - rng.choice([0.0, 0.9, 1.0, 1.1, np.inf], 6)
+        commands, pumping = actuators_kernel(
+            engine.time_s,
+            engine._command,
+            engine._command_time_s,
+            config.cmd_vel_timeout_s + 1e-9,
+            engine._pump_on,
+            engine._pump_time_s,
+            config.pump_timeout_s + 1e-9,
+        )
+        assert commands.tobytes() == engine.active_commands().tobytes()
+        assert pumping.tolist() == engine.pumps_running().tolist()
+
+
+def test_the_compiled_nozzle_and_gas_sensor_places_equal_the_numpy_ones():
+    from swarm_sim.world_kernel import body_points_kernel
+
+    rng = np.random.default_rng(10)
+    engine = make_engine([[1.0, 1.5, 0.0]])
+    poses = np.column_stack([rng.uniform(-20.0, 20.0, (5000, 2)), rng.uniform(-7.0, 7.0, 5000)])
+    poses[:8, 2] = [0.0, -0.0, math.pi, -math.pi, math.pi / 2, 1e-300, 100.0, -1e5]
+    gas = body_points_kernel(poses, engine.config.gas.sensor_offset_m)
+    nozzles = body_points_kernel(poses, -engine.config.pump_offset_m)
+    assert gas.tobytes() == engine.gas_sensor_positions(poses).tobytes()
+    assert nozzles.tobytes() == engine.nozzle_positions(poses).tobytes()

@@ -111,14 +111,20 @@ def test_unknown_case_is_rejected_with_the_choices_listed():
 
 
 @pytest.mark.parametrize('depth_m', [2.0, 5.0, 6.0])
-def test_avalanche_lipschitz_constant_is_the_largest_gradient_of_its_field(depth_m):
+def test_the_papers_avalanche_m_and_l_bound_the_signal_over_its_peak(depth_m):
+    """Sec. 2.5 asks M >= max f and L >= max |grad f|: the paper's M = 1.2 and L = 2 hold for
+    |H| / 47 at every depth tried, and L = 2 fails for |H| itself (largest gradient 40 / depth)."""
     case = avalanche_case(depth_m)
     grid = np.linspace(10.0, 30.0, 401)
     gx, gy = np.meshgrid(grid, grid)
     values = case.field(np.column_stack([gx.ravel(), gy.ravel()])).reshape(gx.shape)
     d_dy, d_dx = np.gradient(values, grid, grid)
-    assert np.hypot(d_dx, d_dy).max() == pytest.approx(case.lipschitz, rel=0.05)
+    largest_gradient = np.hypot(d_dx, d_dy).max()
+    assert largest_gradient == pytest.approx(40.0 / depth_m, rel=0.05)
     assert case.field(case.source_m[None])[0] == pytest.approx(47.0)
+    assert (case.max_signal, case.lipschitz, case.signal_scale) == (1.2, 2.0, 47.0)
+    assert values.max() / case.signal_scale <= case.max_signal
+    assert largest_gradient / case.signal_scale <= case.lipschitz < largest_gradient
 
 
 def test_the_default_avalanche_beacon_registers_above_the_papers_noise_across_the_arena():

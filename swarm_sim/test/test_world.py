@@ -142,3 +142,31 @@ def test_the_compiled_room_test_equals_the_numpy_one():
     assert np.array_equal(compiled, tracker.inside_reference(positions))
     assert 20 < np.count_nonzero(compiled) < compiled.size
     assert not compiled[:, 3].any()
+
+
+def test_first_entries_are_those_of_the_numpy_room_test():
+    """CoverageTracker.update (the compiled test of the rooms not entered yet) records, step
+    by step, the rooms first overlapped by the numpy test and the lowest robot in each."""
+    rng = np.random.default_rng(8)
+    lows = rng.uniform(-3.0, 3.0, (12, 2))
+    rects = np.column_stack([lows, lows + rng.uniform(0.1, 1.0, (12, 2))])
+    rooms = [rects[:3], rects[3:4], rects[4:8], np.zeros((0, 4)), rects[8:]]
+    tracker = CoverageTracker(rooms, 0.1)
+    first = np.full(len(rooms), -1)
+    entries = 0
+    for step in range(300):
+        positions = rng.uniform(-4.0, 5.0, (6, 3))
+        new = tracker.update(positions, 0.1 * step)
+        hits = tracker.inside_reference(positions)
+        expected = [
+            (k, int(np.flatnonzero(hits[:, k])[0]))
+            for k in range(len(rooms))
+            if first[k] < 0 and hits[:, k].any()
+        ]
+        assert [(e.room_index, e.robot_index) for e in new] == expected
+        assert all(e.time_s == 0.1 * step for e in new)
+        for k, robot in expected:
+            first[k] = robot
+        entries += len(expected)
+    assert entries == tracker.rooms_covered == len(rooms) - 1  # the empty room never
+    assert tracker.update(np.zeros((6, 3)), 99.0) == []

@@ -213,7 +213,7 @@ def _cmd_report(registry: StudyRegistry, args: argparse.Namespace) -> int:
         directory = page.parent
         rows = read_rows(directory)
         ok = int((rows['status'] == 'ok').sum()) if len(rows) else 0
-        planned = int(read_manifest(directory).get('runs', 0))
+        planned = max(int(read_manifest(directory).get('runs', 0)), len(rows))
         incomplete += ok < planned
         print(f'{page} ({ok} of {planned} runs ok)')
     return EXIT_INCOMPLETE if incomplete else EXIT_OK

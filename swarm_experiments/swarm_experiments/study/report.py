@@ -426,9 +426,10 @@ def _series_plot(page: ReportPage, column: str) -> None:
 def _generic_sections(page: ReportPage) -> None:
     manifest = page.manifest
     all_rows = page.all_rows
-    planned = int(manifest.get('runs', 0))
     ok = len(page.rows)
     failed = int((all_rows['status'] != 'ok').sum()) if 'status' in all_rows else 0
+    # A directory from before manifests kept every call's plan may hold more runs.
+    planned = max(int(manifest.get('runs', 0)), ok + failed)
     page.add_heading(f'Study {page.study}' + (' (smoke)' if manifest.get('smoke') else ''), 1)
     if manifest.get('description'):
         page.add_text(str(manifest['description']))

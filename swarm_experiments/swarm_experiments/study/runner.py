@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import os
-from collections.abc import Callable
+from collections.abc import Callable, Mapping, Set
 from dataclasses import dataclass
 from datetime import UTC, datetime
 from pathlib import Path
@@ -15,7 +15,7 @@ from .results import PartWriter, done_run_ids, read_manifest, study_lock, write_
 from .spec import StudyPlan
 from .version import code_version as current_code_version
 
-__all__ = ['RunSummary', 'run_study']
+__all__ = ['RunSummary', 'merged_manifest', 'run_study']
 
 
 @dataclass(frozen=True)
@@ -83,6 +83,31 @@ class _Progress:
             self._progress.stop()
 
 
+def merged_manifest(old: Mapping[str, Any], plan: StudyPlan, done: Set[str]) -> dict[str, Any]:
+    """The manifest of a study directory after one more ``run`` call: all that was planned.
+
+    A directory collects the runs of every call (each may restrict axes or seeds), so the
+    manifest holds the union: every axis value and seed planned so far, and the ids of
+    every planned run (``planned_run_ids``; ``runs`` is their number). A directory written
+    before the ids were kept counts its stored runs as planned. Fixed parameters are those
+    of the latest call (the rows keep each run's own).
+    """
+    manifest = plan.manifest()
+    old_axes = old.get('axes', {})
+    axes: dict[str, list[Any]] = {}
+    for axis, values in manifest['axes'].items():
+        merged = list(old_axes.get(axis, []))
+        merged += [value for value in values if value not in merged]
+        axes[axis] = merged
+    manifest['axes'] = axes
+    manifest['seeds'] = sorted({*old.get('seeds', []), *manifest['seeds']})
+    planned = set(old.get('planned_run_ids', ())) | set(done)
+    planned.update(spec.run_id for spec in plan.specs)
+    manifest['planned_run_ids'] = sorted(planned)
+    manifest['runs'] = len(planned)
+    return manifest
+
+
 def run_study(
     plan: StudyPlan,
     out_dir: str | os.PathLike[str],
@@ -108,19 +133,18 @@ def run_study(
         raise ResultsError(f'{directory}: cannot create ({exc})') from exc
     version = code_version if code_version is not None else current_code_version()
     with study_lock(directory):
-        manifest = plan.manifest()
         now = datetime.now(UTC).isoformat(timespec='seconds')
-        history: list[dict[str, Any]] = []
+        old: dict[str, Any] = {}
         if (directory / 'study.json').exists():
-            history = list(read_manifest(directory).get('history', []))
+            old = read_manifest(directory)
+        done = done_run_ids(directory)
+        manifest = merged_manifest(old, plan, done)
         call: dict[str, Any] = {'started_utc': now, 'engine': engine.name, 'code_version': version}
         if command is not None:
             call['command'] = command
-        history.append(call)
-        manifest['history'] = history
+        manifest['history'] = [*old.get('history', []), call]
         write_manifest(directory, manifest)
 
-        done = done_run_ids(directory)
         todo = [spec for spec in plan.specs if spec.run_id not in done]
         skipped = len(plan.specs) - len(todo)
         writer = PartWriter(directory, batch_rows=batch_rows, batch_s=batch_s)

@@ -158,20 +158,74 @@ def _set_nested(params: dict[str, Any], dotted: str, text: str) -> None:
         raise UsageError(f'--set {dotted}: the study has no parameter {dotted!r}')
     if isinstance(node[leaf], dict):
         raise UsageError(f'--set {dotted}: is a parameter group; set one of its parameters')
-    node[leaf] = _parse_value(text)
+    node[leaf] = _coerce(dotted, _parse_value(text), text, (node[leaf],))
 
 
-def _axis_values(axis: str, text: str) -> tuple[Any, ...]:
+def _axis_values(axis: str, text: str, declared: Sequence[Any]) -> tuple[Any, ...]:
     parsed = _parse_value(text)
     if isinstance(parsed, list):
-        values = tuple(parsed)
+        values = tuple(_coerce(axis, value, str(value), declared) for value in parsed)
     elif isinstance(parsed, str) and ',' in parsed:
-        values = tuple(_parse_value(part) for part in parsed.split(','))
+        parts = parsed.split(',')
+        values = tuple(_coerce(axis, _parse_value(part), part, declared) for part in parts)
     else:
-        values = (parsed,)
+        values = (_coerce(axis, parsed, text, declared),)
     if not values:
         raise UsageError(f'--set {axis}: give at least one value')
     return values
+
+
+def _kind(value: Any) -> str:
+    if isinstance(value, bool):
+        return 'bool'
+    if isinstance(value, int):
+        return 'int'
+    if isinstance(value, float):
+        return 'float'
+    if isinstance(value, str):
+        return 'str'
+    return 'other'
+
+
+_KIND_NAMES = {
+    'bool': 'true or false',
+    'int': 'a whole number',
+    'float': 'a number',
+    'str': 'a word',
+}
+
+
+def _coerce(name: str, value: Any, text: str, declared: Sequence[Any]) -> Any:
+    """``value`` (parsed from ``text``) as the type of the study's ``declared`` values.
+
+    A parameter or axis whose declared values are all of one scalar type takes only values
+    of that type (an int where a float is declared becomes a float, a number where words are
+    declared stays the text given); ``None`` and parameters declared as ``None`` or of mixed
+    types take anything, for the study's own check to judge.
+
+    Raises:
+        UsageError: the value is not of the declared type.
+    """
+    kinds = {_kind(item) for item in declared if item is not None}
+    if value is None or len(kinds) != 1:
+        return value
+    kind = kinds.pop()
+    got = _kind(value)
+    if kind == 'other' or got == kind:
+        return value
+    if kind == 'float' and got == 'int':
+        return float(value)
+    if kind == 'float' and got == 'str':
+        try:
+            return float(value)  # 'inf', '1e3': numbers YAML 1.1 reads as words
+        except ValueError:
+            pass
+    if kind == 'str' and got in ('int', 'float', 'bool'):
+        return text.strip()
+    example = next(item for item in declared if item is not None)
+    raise UsageError(
+        f'--set {name}={text.strip()}: expected {_KIND_NAMES[kind]} (like {example!r})'
+    )
 
 
 def make_specs(
@@ -199,7 +253,7 @@ def make_specs(
         count = study.smoke.runs
     for key, text in (overrides or {}).items():
         if key in axes:
-            axes[key] = _axis_values(key, text)
+            axes[key] = _axis_values(key, text, study.axes[key])
         else:
             _set_nested(params, key, text)
     if runs is not None:

@@ -17,6 +17,7 @@ from swarm_experiments.study import (
     run_study,
 )
 from swarm_experiments.study.engines import PoolEngine
+from swarm_experiments.study.results import read_manifest
 
 VERSION = 'test-version'
 
@@ -65,6 +66,20 @@ def test_a_second_call_skips_the_stored_runs(tmp_path: Path) -> None:
     again = _serial(plan, tmp_path)
     assert (again.skipped, again.ok, again.complete) == (36, 0, True)
     assert len(read_rows(summary.directory)) == 36
+
+
+def test_the_manifest_holds_what_every_call_planned(tmp_path: Path) -> None:
+    first = make_specs(search_study(), overrides=parse_overrides(['robots=2']), runs=2)
+    _serial(first, tmp_path)
+    second = make_specs(search_study(), overrides=parse_overrides(['robots=4,6']), runs=3)
+    summary = _serial(second, tmp_path)
+    manifest = read_manifest(summary.directory)
+    assert manifest['axes']['robots'] == [2, 4, 6]
+    assert manifest['seeds'] == [0, 1, 2]
+    planned = {spec.run_id for spec in (*first.specs, *second.specs)}
+    assert set(manifest['planned_run_ids']) == planned
+    assert manifest['runs'] == len(planned) == 3 * 2 + 3 * 2 * 3
+    assert [call['engine'] for call in manifest['history']] == ['serial', 'serial']
 
 
 def test_failed_runs_are_stored_and_run_again_on_resume(tmp_path: Path) -> None:

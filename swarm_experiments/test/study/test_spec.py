@@ -96,6 +96,32 @@ def test_unknown_overrides_are_usage_errors(items: list[str], message: str) -> N
         make_specs(search_study(), overrides=parse_overrides(items))
 
 
+@pytest.mark.parametrize(
+    ('items', 'message'),
+    [
+        (['robots=abc'], r'--set robots=abc: expected a whole number \(like 2\)'),
+        (['robots=2,x'], r'--set robots=x: expected a whole number'),
+        (['robots=2.5'], r'--set robots=2.5: expected a whole number'),
+        (['sim.steps=true'], r'--set sim.steps=true: expected a whole number'),
+        (['sim.speed_scale=fast'], r'--set sim.speed_scale=fast: expected a number'),
+        (['variant=[1, [2]]'], r'--set variant=\[2\]: expected a word'),
+    ],
+)
+def test_overrides_of_the_wrong_type_name_the_parameter(items: list[str], message: str) -> None:
+    with pytest.raises(UsageError, match=message):
+        make_specs(search_study(), overrides=parse_overrides(items))
+
+
+def test_overrides_take_the_declared_type() -> None:
+    items = ['sim.speed_scale=2', 'variant=1,gas', 'sleep_s=1e-3']
+    plan = make_specs(search_study(), overrides=parse_overrides(items))
+    config = plan.specs[0].config
+    assert config['sim']['speed_scale'] == 2.0
+    assert isinstance(config['sim']['speed_scale'], float)
+    assert {spec.config['variant'] for spec in plan.specs} == {'1', 'gas'}
+    assert config['sleep_s'] == 0.001
+
+
 def test_parse_overrides_rejects_malformed_and_repeated_items() -> None:
     with pytest.raises(UsageError, match='PARAM=VALUE'):
         parse_overrides(['steps'])

@@ -22,6 +22,7 @@ from swarm_common.params import parameter
 from swarm_sim.errors import ConfigurationError
 from swarm_sim.geometry import as_segments, count_crossings, padded_walls
 from swarm_sim.raycast_kernel import sight_lines_kernel
+from swarm_sim.sensors_kernel import heard_pairs_kernel, wrap_sum_kernel
 
 __all__ = ['BearingConfig', 'BearingCycle', 'BearingModel', 'PeerBearings']
 
@@ -145,6 +146,7 @@ class BearingModel:
         self._sequence = np.zeros((num_robots, num_robots), dtype=np.int64)
         q, s = padded_walls(self._walls)
         self._padded_walls = (q, s, np.arange(len(self._walls), dtype=np.int64))
+        self._reach_table = np.zeros(0)
 
     def effective_range_m(self, walls_crossed: np.ndarray) -> np.ndarray:
         """Range [m] left after crossing the given numbers of walls."""
@@ -162,11 +164,48 @@ class BearingModel:
         return self.measure_cycle(poses).reports()
 
     def measure_cycle(self, poses: np.ndarray) -> BearingCycle:
-        """:meth:`measure` with the reports in flat arrays (the same values and draws)."""
-        rx, tx, delta, dist, walls = sight_lines_kernel(
-            np.ascontiguousarray(poses, dtype=float), self.config.range_m, *self._padded_walls
+        """:meth:`measure` with the reports in flat arrays (the same values and draws as
+        :meth:`measure_reference`): the sight lines and the selection of the heard ones in
+        compiled code, the transcendental functions in numpy."""
+        cfg = self.config
+        poses = np.ascontiguousarray(poses, dtype=float)
+        rx, tx, delta, dist, walls = sight_lines_kernel(poses, cfg.range_m, *self._padded_walls)
+        uniform = dist
+        if cfg.dropout_probability > 0.0:
+            uniform = self._rng.random(len(rx))
+        heard, sequence, bounds = heard_pairs_kernel(
+            rx,
+            tx,
+            dist,
+            self._reach_m(walls),
+            cfg.range_m,
+            uniform,
+            cfg.dropout_probability,
+            self._sequence,
         )
-        return self._cycle(poses, rx, tx, delta, dist, walls)
+        rx, tx, delta, dist = rx[heard], tx[heard], delta[heard], dist[heard]
+        k = len(rx)
+        azimuth = np.arctan2(delta[:, 1], delta[:, 0]) - poses[rx, 2]
+        azimuth = wrap_sum_kernel(azimuth, self._rng.normal(0.0, cfg.azimuth_noise_std_rad, k))
+        elevation = self._rng.normal(0.0, cfg.elevation_noise_std_rad, k)
+        distance = dist * np.exp(self._rng.normal(0.0, cfg.distance_noise_fraction, k))
+        return BearingCycle(
+            receivers=rx,
+            tags=tx,
+            azimuth_rad=azimuth,
+            elevation_rad=elevation,
+            distance_m=distance,
+            sequence=sequence,
+            bounds=bounds.tolist(),
+        )
+
+    def _reach_m(self, walls_crossed: np.ndarray) -> np.ndarray:
+        """:meth:`effective_range_m` by table: the same numpy values for every count of
+        walls (numpy's power of an element does not depend on the array around it)."""
+        top = int(walls_crossed.max(initial=0))
+        if top >= len(self._reach_table):
+            self._reach_table = self.effective_range_m(np.arange(max(top + 1, 16)))
+        return self._reach_table[walls_crossed]
 
     def measure_reference(self, poses: np.ndarray) -> list[PeerBearings]:
         """:meth:`measure` with the sight lines in numpy, the reference of the compiled

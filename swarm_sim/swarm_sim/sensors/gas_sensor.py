@@ -89,6 +89,8 @@ class Mp503Model:
         self.config = config
         self._rng = rng
         self._sensed_ppm = np.zeros(num_robots)
+        # Per sample period [s], the rise and fall gains 1 - exp(-dt / tau).
+        self._gains: dict[float, list[float]] = {}
 
     @property
     def sensed_ppm(self) -> np.ndarray:
@@ -106,9 +108,13 @@ class Mp503Model:
         """
         cfg = self.config
         c = np.asarray(concentration_ppm, dtype=float).reshape(len(self._sensed_ppm))
-        gain_rise, gain_fall = (
-            1.0 - np.exp(-dt_s / np.array([cfg.rise_time_constant_s, cfg.fall_time_constant_s]))
-        ).tolist()
+        gains = self._gains.get(dt_s)
+        if gains is None:
+            # The same every period (numpy's exp, as update_reference computes it).
+            gains = self._gains[dt_s] = (
+                1.0 - np.exp(-dt_s / np.array([cfg.rise_time_constant_s, cfg.fall_time_constant_s]))
+            ).tolist()
+        gain_rise, gain_fall = gains
         noise = _NO_NOISE
         if cfg.noise_std_raw > 0.0:
             noise = self._rng.normal(0.0, cfg.noise_std_raw, len(c))

@@ -11,15 +11,20 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Protocol
+from typing import Protocol, cast
 
 import numpy as np
 from swarm_common.params import parameter
 
 from swarm_sim.errors import ConfigurationError
-from swarm_sim.raycast_kernel import lidar_noise_kernel
+from swarm_sim.raycast_kernel import EXACT, NO_RETURN, horizon_noise_kernel, lidar_noise_kernel
 
-__all__ = ['LidarConfig', 'LidarModel', 'RangeCaster']
+__all__ = ['LidarConfig', 'LidarModel', 'NearRangeCaster', 'RangeCaster']
+
+# A near cast (LidarModel.measure with a horizon) computes the ranges exactly up to the cut
+# from which a ray comes within the horizon only with a noise draw below this many standard
+# deviations (a chance of about 1e-15 per ray; its robot is then cast in full).
+_CUT_NOISE_SIGMAS = 8.0
 
 
 class RangeCaster(Protocol):
@@ -30,6 +35,17 @@ class RangeCaster(Protocol):
 
     def scan(self, poses: np.ndarray, max_range_m: float) -> np.ndarray:
         """(N, num_bins) ranges [m] from (N, 3) poses; ``inf`` beyond ``max_range_m``."""
+        ...
+
+
+class NearRangeCaster(RangeCaster, Protocol):
+    """A caster that can also give only the ranges up to a cut
+    (:meth:`swarm_sim.geometry.RayCaster.scan_near`)."""
+
+    def scan_near(
+        self, poses: np.ndarray, max_range_m: float, cut_m: float
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """(N, num_bins) ranges [m], exact up to ``cut_m``, and the bins' kinds."""
         ...
 
 
@@ -94,22 +110,30 @@ class LidarModel:
         self._caster = caster
         self._rng = rng
 
-    def measure(self, poses: np.ndarray) -> np.ndarray:
+    def measure(self, poses: np.ndarray, horizon_m: float | None = None) -> np.ndarray:
         """Scan from every robot.
 
         Args:
             poses: (N, 3) true x [m], y [m], yaw [rad].
+            horizon_m: when given, ranges beyond it read ``inf``: the readings of the full
+                scan (None) that lie within it, the others ``inf``. A caster that can cast
+                near rays only (:class:`NearRangeCaster`) then skips the far walls; the
+                random draws are the same either way.
 
         Returns:
             (N, num_bins) ranges [m]; bin k at robot-frame angle -pi + k * angle_increment.
         """
         cfg = self.config
+        if horizon_m is not None:
+            cut_m = self._cut_m(horizon_m)
+            if cut_m is not None and hasattr(self._caster, 'scan_near'):
+                return self._measure_near(poses, float(horizon_m), cut_m)
         exact = self._caster.scan(poses, cfg.range_max_m)
         # The same draws as measure_reference, in the same order (``standard_normal`` gives
         # ``normal(0.0, 1.0)``'s values from the same stream, without its per-element scaling).
         normal = self._rng.standard_normal(int(np.count_nonzero(np.isfinite(exact))))
         uniform = self._rng.random(exact.shape) if cfg.dropout_probability > 0.0 else exact
-        return lidar_noise_kernel(
+        noisy = lidar_noise_kernel(
             exact,
             normal,
             uniform,
@@ -118,6 +142,68 @@ class LidarModel:
             cfg.dropout_probability,
             cfg.range_min_m,
             cfg.range_max_m,
+        )
+        if horizon_m is not None:
+            noisy[noisy > horizon_m] = np.inf
+        return noisy
+
+    def _cut_m(self, horizon_m: float) -> float | None:
+        """The cut of a near cast for ``horizon_m`` [m]: from it, a range comes within the
+        horizon only with a noise draw below -:data:`_CUT_NOISE_SIGMAS`. None when a near
+        cast gains nothing (the cut reaches the maximum range, or the noise is too wide)."""
+        cfg = self.config
+        shrink = 1.0 - _CUT_NOISE_SIGMAS * cfg.range_noise_fraction
+        if not (horizon_m > 0.0 and shrink > 0.0):
+            return None
+        # Below range_min a range reads -inf, not inf.
+        floor_m = max(horizon_m, cfg.range_min_m)
+        cut_m = (floor_m + _CUT_NOISE_SIGMAS * cfg.range_noise_min_m) / shrink
+        return cut_m if cut_m < cfg.range_max_m else None
+
+    def _measure_near(self, poses: np.ndarray, horizon_m: float, cut_m: float) -> np.ndarray:
+        """:meth:`measure` with a horizon, from a near cast up to ``cut_m``: the rays
+        beyond the cut draw their noise as in the full scan and read ``inf`` when even their
+        nearest possible noisy range lies beyond the horizon; a robot where that is not so
+        (an extreme draw) is cast in full."""
+        cfg = self.config
+        caster = cast(NearRangeCaster, self._caster)
+        exact, kind = caster.scan_near(poses, cfg.range_max_m, cut_m)
+        normal = self._rng.standard_normal(int(np.count_nonzero(kind)))
+        uniform = self._rng.random(exact.shape) if cfg.dropout_probability > 0.0 else exact
+        redo = np.zeros(len(exact), dtype=bool)
+        noisy = self._near_noise(exact, kind, normal, uniform, horizon_m, cut_m, redo)
+        if redo.any():
+            full = caster.scan(poses, cfg.range_max_m)
+            exact[redo] = full[redo]
+            kind[redo] = np.where(np.isfinite(full[redo]), EXACT, NO_RETURN)
+            noisy = self._near_noise(exact, kind, normal, uniform, horizon_m, cut_m, redo)
+        return noisy
+
+    def _near_noise(
+        self,
+        exact: np.ndarray,
+        kind: np.ndarray,
+        normal: np.ndarray,
+        uniform: np.ndarray,
+        horizon_m: float,
+        cut_m: float,
+        redo: np.ndarray,
+    ) -> np.ndarray:
+        cfg = self.config
+        redo[:] = False
+        return horizon_noise_kernel(
+            exact,
+            kind.ravel(),
+            normal,
+            uniform,
+            cfg.range_noise_fraction,
+            cfg.range_noise_min_m,
+            cfg.dropout_probability,
+            cfg.range_min_m,
+            cfg.range_max_m,
+            horizon_m,
+            cut_m,
+            redo,
         )
 
     def measure_reference(self, poses: np.ndarray) -> np.ndarray:

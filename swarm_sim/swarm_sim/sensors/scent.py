@@ -24,7 +24,13 @@ from swarm_common.params import parameter
 
 from swarm_sim.errors import ConfigurationError
 from swarm_sim.geometry import WallGrid, as_segments
-from swarm_sim.scent_kernel import open_puff_pairs
+from swarm_sim.scent_kernel import (
+    open_puff_pairs,
+    puff_exponents,
+    puff_spread,
+    puff_sum,
+    pump_release_kernel,
+)
 
 __all__ = ['PumpDepositor', 'ScentConfig', 'ScentField']
 
@@ -111,7 +117,10 @@ class ScentField:
         xy = np.atleast_2d(np.asarray(xy, dtype=float))
         mass = np.broadcast_to(np.asarray(mass_ppm_m2, dtype=float), (len(xy),))
         keep = np.isfinite(xy).all(axis=1) & (mass > 0.0)
-        xy, mass = xy[keep], mass[keep]
+        self._append(xy[keep], time_s, mass[keep])
+
+    def _append(self, xy: np.ndarray, time_s: float, mass: np.ndarray) -> None:
+        """Add (K, 2) puff positions [m] and (K,) masses (finite and positive) at ``time_s``."""
         k = len(xy)
         if k == 0:
             return
@@ -156,11 +165,38 @@ class ScentField:
         )
         if len(q_idx) == 0:
             return np.zeros(len(points))
-        value = self._puff_values(p_idx, d2, time_s)
-        return np.bincount(q_idx, weights=value, minlength=len(points))
+        # _puff_values and the sums per sensor, compiled around numpy's exp.
+        cfg = self.config
+        count = len(p_idx)
+        exponents = np.exp(
+            puff_exponents(
+                p_idx,
+                self._time_s,
+                float(time_s),
+                cfg.spread_time_constant_s,
+                cfg.decay_time_constant_s,
+            )
+        )
+        sigma2, gauss = puff_spread(
+            exponents[:count],
+            cfg.initial_spread_m**2,
+            cfg.final_spread_m**2 - cfg.initial_spread_m**2,
+            d2,
+        )
+        return puff_sum(
+            q_idx,
+            p_idx,
+            self._mass,
+            exponents[count:],
+            sigma2,
+            np.exp(gauss),
+            2.0 * math.pi,
+            len(points),
+        )
 
     def _puff_values(self, p_idx: np.ndarray, d2: np.ndarray, time_s: float) -> np.ndarray:
-        """Contributions [ppm] of the puffs ``p_idx`` at squared distances ``d2`` [m^2]."""
+        """Contributions [ppm] of the puffs ``p_idx`` at squared distances ``d2`` [m^2] (the
+        reference's; :meth:`concentration` computes the same in compiled code)."""
         cfg = self.config
         a = time_s - self._time_s[p_idx]
         sigma2 = self.spread_m(a) ** 2
@@ -210,7 +246,7 @@ class PumpDepositor:
     def busy(self, pump_on: np.ndarray) -> bool:
         """False when a :meth:`step` with these pump states would do nothing (no pump runs
         and no puff is pending), so that the caller may skip it."""
-        return bool(np.any(pump_on)) or bool(self._on_time_s.any())
+        return bool(pump_on.any() or self._on_time_s.any())
 
     def step(self, pump_on: np.ndarray, nozzle_xy: np.ndarray, time_s: float, dt_s: float) -> None:
         """Account ``dt_s`` seconds of pumping and deposit the puffs that are complete.
@@ -222,12 +258,13 @@ class PumpDepositor:
             dt_s: step length [s].
         """
         cfg = self._field.config
-        pump_on = np.asarray(pump_on, dtype=bool)
-        self._on_time_s[pump_on] += dt_s
-        full = self._on_time_s >= cfg.deposit_period_s - 1e-9
-        stopped = ~pump_on & (self._on_time_s > 0.0)
-        release = full | stopped
-        if release.any():
-            mass = cfg.deposit_rate_ppm_m2_per_s * self._on_time_s[release]
-            self._field.deposit(nozzle_xy[release], time_s, mass)
-            self._on_time_s[release] = 0.0
+        xy, mass = pump_release_kernel(
+            self._on_time_s,
+            np.asarray(pump_on, dtype=bool),
+            np.asarray(nozzle_xy, dtype=float),
+            float(dt_s),
+            cfg.deposit_period_s - 1e-9,
+            float(cfg.deposit_rate_ppm_m2_per_s),
+        )
+        # What deposit() adds (the kernel keeps only finite places and positive masses).
+        self._field._append(xy, time_s, mass)
