@@ -60,6 +60,7 @@ ADDED = {
         'search.mode': 'history',
         'search.coverage_prior_weight': 1.0,
         'search.sweep_radius_m': 250.0,
+        'search.sector_reach': -1,
         'phases.converged_give_up_m': 0.0,
         'phases.converged_max_age_s': 0.0,
         'phases.far_aim': 'best_particle',
