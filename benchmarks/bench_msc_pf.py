@@ -13,6 +13,9 @@ targets uniform, robots starting in a 30 m disc at the centre, Table I parameter
 * search: the eq. (1) search alone (no targets): when 50 / 90 / 99 / 100 % of the field
   first lies within the detection range (about 292 m) of some robot's path, per seed and
   mean +- std (the search decides most of the CCT);
+* approach: one target at a seeded bearing, 400-900 m from the start: the time from its
+  first hearing to its capture and that over the straight drive at full speed from the
+  nearest robot that heard it (per scheme; ``--set`` applies), median and mean over seeds;
 * pf: time of one particle-filter step of 20 targets x 5041 particles from one observation
   (the update and the convergence test, median over repeats), and of one fused step of 3
   observers; the filters start on their lattice and take fresh noisy samples every repeat.
@@ -60,7 +63,7 @@ CSV_HEADER = (
     'scheme,targets,robots,seed,cct_s,finished,wall_s,mean_capture_s,cpu_s,last_heard_s,'
     'approach_s,approach_ratio\n'
 )
-EXPERIMENTS = ('main', 'robots', 'search', 'pf')
+EXPERIMENTS = ('main', 'robots', 'search', 'approach', 'pf')
 
 
 @dataclass(frozen=True)
@@ -262,6 +265,76 @@ def search_table(results: list[tuple[int, SearchCoverage]], n_robots: int) -> li
         else:
             cells = '- | - | -'
         lines.append(f'| {100 * fraction:g} % | {cells} | {times.size - reached.size} |')
+    return [*lines, '']
+
+
+ApproachJob = tuple[str, int, int, Overrides]
+"""(scheme, robots, seed, controller overrides) of one single-target approach run."""
+
+APPROACH_RANGE_M = (400.0, 900.0)
+"""Distance of the approach experiment's target from the start centre [m]."""
+
+
+def approach_target(seed: int, field_size_m: float = 2000.0) -> np.ndarray:
+    """(1, 2) position of the approach experiment's target for ``seed``."""
+    rng = np.random.default_rng([seed, 11])
+    bearing = rng.uniform(0.0, 2.0 * math.pi)
+    distance = rng.uniform(*APPROACH_RANGE_M)
+    centre = field_size_m / 2.0
+    return np.array(
+        [[centre + distance * math.cos(bearing), centre + distance * math.sin(bearing)]]
+    )
+
+
+def _approach_one(job: ApproachJob) -> tuple[str, int, float, float]:
+    """(scheme, seed, first hearing to capture [s], that over the straight drive); the time
+    is 4000 s when the target was not captured by then."""
+    scheme, n_robots, seed, overrides = job
+    controller = controller_config(overrides)
+    horizon = 4000.0
+    result = run_batch(
+        BatchScenario(
+            scheme=Scheme(scheme),
+            n_robots=n_robots,
+            n_targets=1,
+            seed=seed,
+            max_time_s=horizon,
+            controller=controller,
+            target_positions_m=approach_target(seed, controller.field_size_m),
+        )
+    )
+    heard, captured = float(result.first_heard_s[0]), float(result.capture_times_s[0])
+    took = captured - heard if math.isfinite(captured) else horizon
+    drive = max(float(result.first_heard_range_m[0]), 1.0) / controller.max_speed_m_s
+    print(
+        f'  approach {scheme} seed {seed:2d}: {took:.0f} s, {took / drive:.2f} drives', flush=True
+    )
+    return scheme, seed, took, took / drive
+
+
+def single_target_table(
+    results: list[tuple[str, int, float, float]], n_robots: int, overrides: Overrides
+) -> list[str]:
+    """Markdown table of the approach experiment, one row per scheme."""
+    setting = ', '.join(f'{k}={v}' for k, v in overrides) or 'defaults'
+    lines = [
+        f'Approach to one target {APPROACH_RANGE_M[0]:.0f}-{APPROACH_RANGE_M[1]:.0f} m from '
+        f'the start, {n_robots} robots, settings: {setting}. First hearing to capture [s], '
+        'and that over the straight drive at full speed from the nearest robot that heard it '
+        '(not captured within 4000 s: counted as 4000 s)',
+        '',
+        '| scheme | seeds | median [s] | mean [s] | median / straight drive | per seed [s] |',
+        '|---|---|---|---|---|---|',
+    ]
+    for scheme in dict.fromkeys(r[0] for r in results):
+        mine = sorted((r for r in results if r[0] == scheme), key=lambda r: r[1])
+        took = np.array([r[2] for r in mine])
+        ratio = np.array([r[3] for r in mine])
+        per_seed = ' '.join(f'{t:.0f}' for t in took)
+        lines.append(
+            f'| {scheme} | {len(mine)} | {np.median(took):.0f} | {took.mean():.0f} | '
+            f'{np.median(ratio):.2f} | {per_seed} |'
+        )
     return [*lines, '']
 
 
@@ -603,6 +676,7 @@ def run(
     runs: int = 10,
     sweep_runs: int = 5,
     search_runs: int = 10,
+    approach_runs: int = 8,
     schemes: tuple[str, ...] = SCHEMES,
     max_time_s: float = 20000.0,
     first_seed: int = 0,
@@ -616,7 +690,8 @@ def run(
 
     With ``csv_path``, every outcome is appended to that CSV file as soon as it is known,
     and to ``finished`` if given (what is left of a run stopped by Ctrl-C);
-    ``overrides`` change controller settings of the main, robots and search experiments.
+    ``overrides`` change controller settings of the main, robots, search and approach
+    experiments.
     """
     controller_config(overrides)  # fail before any run on a bad setting
     lines: list[str] = []
@@ -645,6 +720,14 @@ def run(
     if 'search' in experiments:
         search_jobs = [(robots, first_seed + s, max_time_s, overrides) for s in range(search_runs)]
         lines += search_table(list(_map(_search_one, search_jobs, workers)), robots)
+    if 'approach' in experiments:
+        approach_jobs = [
+            (scheme, robots, first_seed + s, overrides)
+            for scheme in schemes
+            for s in range(approach_runs)
+        ]
+        results = list(_map(_approach_one, approach_jobs, workers))
+        lines += single_target_table(results, robots, overrides)
     if 'pf' in experiments:
         for backend in pf_backends:
             lines += pf_table(backend)
@@ -668,6 +751,9 @@ def _main(argv: list[str]) -> int:
     parser.add_argument('--sweep-runs', type=int, default=5)
     parser.add_argument(
         '--search-runs', type=int, default=10, help='seeds of the search experiment'
+    )
+    parser.add_argument(
+        '--approach-runs', type=int, default=8, help='seeds of the approach experiment'
     )
     parser.add_argument('--schemes', nargs='+', choices=SCHEMES, default=list(SCHEMES))
     parser.add_argument('--max-time', type=float, default=20000.0, help='T_max per run [s]')
@@ -695,7 +781,7 @@ def _main(argv: list[str]) -> int:
     )
     args = parser.parse_args(argv)
     overrides = controller_overrides(args.set)
-    for name in ('runs', 'sweep_runs', 'search_runs', 'robots', 'workers'):
+    for name in ('runs', 'sweep_runs', 'search_runs', 'approach_runs', 'robots', 'workers'):
         if getattr(args, name) < 1:
             flag = '--' + name.replace('_', '-')
             raise UsageError(f'{flag} must be >= 1, got {getattr(args, name)}')
@@ -724,6 +810,7 @@ def _main(argv: list[str]) -> int:
             runs=args.runs,
             sweep_runs=args.sweep_runs,
             search_runs=args.search_runs,
+            approach_runs=args.approach_runs,
             schemes=tuple(args.schemes),
             max_time_s=args.max_time,
             first_seed=args.first_seed,

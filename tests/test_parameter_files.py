@@ -53,7 +53,22 @@ _SIM_BRIDGE_ADDED = {
 ADDED = {
     'oabug': {'min_turn_rate_radps': 0.3, 'robot_contact_distance_m': 0.16},
     'sim_bridge': {'physics': 'numpy', **_SIM_BRIDGE_ADDED},
-    'msc_pf': {'swarm.search_alone': False, 'msc.turn_margin_db': 2.0},
+    'msc_pf': {
+        'swarm.search_alone': False,
+        'msc.turn_margin_db': 2.0,
+        # The sector sweep and the PF-driven approach (beyond the paper, off by default).
+        'search.mode': 'history',
+        'search.coverage_prior_weight': 1.0,
+        'search.sweep_radius_m': 250.0,
+        'search.sector_reach': -1,
+        'phases.converged_give_up_m': 0.0,
+        'phases.converged_max_age_s': 0.0,
+        'phases.far_aim': 'best_particle',
+        'phases.max_pursuers': 0,
+        'phases.near_estimate_spread_m': 0.0,
+        'phases.non_detection_window_s': 0.0,
+        'phases.pursue_memory_s': 0.0,
+    },
     'bayes_swarm': {
         'inner_optimizer': 'lbfgsb',
         'cobyla_max_iterations': 1000,

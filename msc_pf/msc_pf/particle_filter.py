@@ -781,10 +781,48 @@ class ParticleFilterBank:
             q += self._miss_table[bins]
         least = float(q.min())
         w = np.exp(least - q)
-        total = float(w.sum())
-        kept = math.exp(-least) * total / self._n
+        kept = math.exp(-least) * float(w.sum()) / self._n
         if not kept > 1e-12:
             return kept
+        self._fold_weights(slot, x, y, w)
+        return kept
+
+    def apply_prior(self, target_id: int, weights: np.ndarray) -> float:
+        """Multiply the belief of ``target_id`` by per-particle ``weights`` (a prior).
+
+        Estimate, spread and largest-weight particle are taken from the weights, then the
+        filter is resampled and roughened as after a sample (:meth:`particles` gives the
+        positions the weights refer to).
+
+        Args:
+            target_id: a tracked target.
+            weights: (N,) non-negative weights of the current particles.
+
+        Returns:
+            The mean weight (the share of the belief the prior keeps). The filter is left
+            unchanged when it is not above 1e-12.
+
+        Raises:
+            KeyError: ``target_id`` is not tracked.
+            ValueError: ``weights`` has the wrong shape or a negative or non-finite value.
+        """
+        slot = self._slot_of[target_id]
+        w = np.asarray(weights, dtype=np.float64)
+        if w.shape != (self._n,) or not bool(np.all(np.isfinite(w))) or bool(np.any(w < 0.0)):
+            msg = f'prior weights must be {self._n} finite non-negative numbers'
+            raise ValueError(msg)
+        kept = float(w.mean())
+        if not kept > 1e-12:
+            return kept
+        self._fold_weights(
+            slot, self._x[slot].astype(np.float64), self._y[slot].astype(np.float64), w
+        )
+        return kept
+
+    def _fold_weights(self, slot: int, x: np.ndarray, y: np.ndarray, w: np.ndarray) -> None:
+        """Estimate, spread and best particle of slot from float64 weights ``w`` of its
+        particles at ``x``, ``y``; then resample and roughen."""
+        total = float(w.sum())
         mx = float(w @ x) / total
         my = float(w @ y) / total
         spread2 = float(w @ ((x - mx) ** 2 + (y - my) ** 2)) / total
@@ -806,7 +844,6 @@ class ParticleFilterBank:
         self._y[slot] = new_y[0]
         self._updated[slot] = True
         self._any_updated = True
-        return kept
 
     def _resampling_draws(self, w: np.ndarray) -> tuple[np.ndarray | None, np.ndarray | None]:
         """The random draws of the resampling of the rows of ``w``: (k, 1) float32 offsets

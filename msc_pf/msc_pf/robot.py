@@ -24,6 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from msc_pf.coverage import SectorSweep
 from msc_pf.errors import ObservationError
 from msc_pf.mobility import (
     avoidance_vector,
@@ -115,6 +116,14 @@ class RobotController:
         self._search = HistorySearch(
             config.search, config.field_size_m, np.random.default_rng(search_seed)
         )
+        self._sweep: SectorSweep | None = None
+        if config.search.mode == 'sector':
+            self._sweep = SectorSweep(
+                config.field_size_m, config.search.cell_size_m, config.search.sweep_radius_m
+            )
+        self._start_m: np.ndarray | None = None
+        self._first_seen: dict[int, tuple[float, float]] = {}
+        self._marked_cell: dict[int, int] = {}
         self._bank: ParticleFilterBank | None = None
         if config.scheme.uses_particle_filter:
             self._bank = ParticleFilterBank(
@@ -263,6 +272,8 @@ class RobotController:
             else:
                 self._search.record_other_visit(peer.visited_cell)
 
+        if self._sweep is not None:
+            self._update_sweep(now_s, position, own_cell, fresh)
         if self._bank is not None:
             events += self._update_filters(now_s, position, own, fresh)
 
@@ -319,6 +330,58 @@ class RobotController:
             while samples and samples[0][0] <= horizon:
                 samples.popleft()
 
+    def _update_sweep(
+        self, now_s: float, position: np.ndarray, own_cell: int, fresh: Sequence[PeerInfo]
+    ) -> None:
+        """Sector search: mark what this robot and its neighbours covered; plan the sector.
+
+        A robot's coverage disc is marked each time it enters a new cell. During the first
+        ``swarm.formation_timeout_s`` the robot notes every peer and where it was first
+        heard; after it, it takes its sector among the searching units it noted.
+        """
+        sweep = self._sweep
+        assert sweep is not None
+        assert self._start_s is not None
+        if self._start_m is None:
+            self._start_m = position.copy()
+        if self._marked_cell.get(self.robot_id) != own_cell:
+            self._marked_cell[self.robot_id] = own_cell
+            sweep.mark(position)
+        planning = now_s - self._start_s < self.config.swarm.formation_timeout_s
+        for peer in fresh:
+            if planning:
+                self._first_seen.setdefault(peer.robot_id, peer.position_m)
+            if self._marked_cell.get(peer.robot_id) != peer.visited_cell:
+                self._marked_cell[peer.robot_id] = peer.visited_cell
+                sweep.mark(peer.position_m)
+        if planning or sweep.planned:
+            return
+        swarm = self.config.swarm
+        if swarm.search_alone or swarm.max_size == 1:
+            units = {self.robot_id, *self._first_seen}
+            mine = self.robot_id
+        else:
+            units = {self.membership.leader_id}
+            units |= {p.leader_id for r, p in self._peers.items() if r in self._first_seen}
+            mine = self.membership.leader_id
+        starts = np.array([self._start_m, *self._first_seen.values()], dtype=np.float64)
+        ranked = sorted(units)
+        sweep.plan(starts.mean(axis=0), len(ranked), ranked.index(mine))
+
+    def _search_vector(
+        self, now_s: float, position: np.ndarray, avoidance: np.ndarray
+    ) -> np.ndarray:
+        """Phase (a): eq. (1), or the sector sweep toward its next uncovered cell."""
+        sweep = self._sweep
+        if sweep is None:
+            return self._search.vector(now_s, position, avoidance)
+        if not sweep.planned:
+            return np.zeros(2)
+        goal = sweep.goal(position)
+        if goal is None:
+            return self._search.vector(now_s, position, avoidance)
+        return unit(goal - position) + self.config.search.alpha_outside * avoidance
+
     def _gradient(self, target: int) -> np.ndarray:
         samples = self._samples.get(target)
         if not samples:
@@ -348,6 +411,7 @@ class RobotController:
             if batch and math.isfinite(where[0]) and math.isfinite(where[1]):
                 ids = sorted(batch)
                 observations.append((where, ids, [batch[t] for t in ids]))
+        before = set(self._bank.tracked_ids)
         if self.config.particle_filter.fusion == 'joint':
             groups = [observations]
         else:
@@ -357,9 +421,62 @@ class RobotController:
                 continue
             for target in self._bank.update_joint(group):
                 events.append(f'filter of target {target} degenerated: re-initialised')
+                before.discard(target)
+        self._apply_coverage_prior(before)
+        self._fold_in_non_detections(now_s, position, own, fresh)
         self._fold_in_unheard(now_s, position, fresh)
         self._bank.end_step()
         return events
+
+    def _fold_in_non_detections(
+        self,
+        now_s: float,
+        position: np.ndarray,
+        own: Mapping[int, float],
+        fresh: Sequence[PeerInfo],
+    ) -> None:
+        """``phases.non_detection_window_s``: fold this step's non-detections into every
+        recently sampled filter (the robot's and its neighbours' who did not hear it).
+
+        Observers farther from the estimate than 1.3 detection ranges plus two spreads are
+        left out: their non-detection says nothing about the filter's particles.
+        """
+        window = self.config.phases.non_detection_window_s
+        bank = self._bank
+        if window <= 0.0 or bank is None:
+            return
+        reach = 1.3 * self.config.radio.detection_range_m
+        for target in bank.tracked_ids:
+            if target in self._captured:
+                continue
+            if now_s - self._last_sampled_s.get(target, -math.inf) > window:
+                continue
+            points = [] if target in own else [(float(position[0]), float(position[1]))]
+            for peer in fresh:
+                if target in peer.captured_ids or any(t == target for t, _ in peer.readings):
+                    continue
+                points.append(peer.position_m)
+            if not points:
+                continue
+            estimate = bank.estimate(target)
+            observers = np.array(points, dtype=np.float64)
+            far = np.hypot(*(observers - estimate.position_m[None, :]).T)
+            observers = observers[far < reach + 2.0 * estimate.spread_m]
+            if len(observers):
+                bank.update_unheard(target, observers)
+
+    def _apply_coverage_prior(self, before: set[int]) -> None:
+        """Sector search: weigh the particles of filters started this step (those not in
+        ``before``) down where the robot knows the field searched."""
+        weight = self.config.search.coverage_prior_weight
+        bank, sweep = self._bank, self._sweep
+        if bank is None or sweep is None or weight >= 1.0:
+            return
+        for target in bank.tracked_ids:
+            if target in before:
+                continue
+            covered = sweep.covered_at(bank.particles(target))
+            bank.apply_prior(target, np.where(covered, weight, 1.0))
 
     def _fold_in_unheard(
         self,
@@ -417,14 +534,29 @@ class RobotController:
                 if p.target_id == target and math.isfinite(p.target_rssi_dbm)
             ]
             n_closer = count_closer_heading_to(mean, others)
+            if 0 < self.config.phases.max_pursuers <= n_closer or self._beyond_reach(target):
+                continue
             value = evaluation_value(
                 mean, n_closer, msc.dispersion_degree, msc.dispersion_threshold
             )
             if value > best_value:
                 best, best_value = target, value
-        if best == NO_TARGET and self._keeps_converged(self.target_id):
+        if best == NO_TARGET and (
+            self._keeps_converged(self.target_id) or self._keeps_pursuing(self.target_id, now_s)
+        ):
             return self.target_id
         return best
+
+    def _beyond_reach(self, target: int) -> bool:
+        """Sector search: ``target``'s estimate lies beyond ``search.sector_reach`` sectors
+        of the own one, which is not covered yet (the robot leaves it to others)."""
+        reach = self.config.search.sector_reach
+        sweep, bank = self._sweep, self._bank
+        if reach < 0 or sweep is None or bank is None or not bank.is_tracked(target):
+            return False
+        if sweep.sector_offset(bank.estimate(target).position_m) <= reach:
+            return False
+        return not sweep.own_sector_covered()
 
     def _keeps_converged(self, target: int) -> bool:
         """True when a lost ``target`` is still pursued on its converged estimate."""
@@ -434,6 +566,20 @@ class RobotController:
             and target != NO_TARGET
             and target not in self._captured
             and self._bank.is_converged(target)
+        )
+
+    def _keeps_pursuing(self, target: int, now_s: float) -> bool:
+        """True when ``target``, not heard now, got a sample within pursue_memory_s."""
+        memory = self.config.phases.pursue_memory_s
+        return (
+            memory > 0.0
+            and self.config.scheme.uses_far_formation
+            and self._bank is not None
+            and target != NO_TARGET
+            and target not in self._captured
+            and self._bank.is_tracked(target)
+            and now_s - self._last_sampled_s.get(target, -math.inf) <= memory
+            and not self._beyond_reach(target)
         )
 
     def _evaluation(self, target: int, now_s: float) -> float:
@@ -458,14 +604,23 @@ class RobotController:
             self.phase = Phase.SEARCH
         if not self.config.scheme.uses_stored_estimates or self._bank is None:
             return
+        phases = self.config.phases
+        max_age = phases.converged_max_age_s
         candidates = [
             Candidate(e.target_id, e.position_m, self.smoothed_rssi(e.target_id, now_s))
             for e in self._bank.estimates()
-            if e.converged and e.target_id not in self._captured
+            if e.converged
+            and e.target_id not in self._captured
+            and not self._beyond_reach(e.target_id)
+            and (
+                max_age <= 0.0
+                or self._last_sampled_s.get(e.target_id, -math.inf) >= now_s - max_age
+            )
         ]
         neighbours = np.array([p.position_m for p in self._peers.values()]).reshape(-1, 2)
-        phases = self.config.phases
-        choice = select_retarget(candidates, position, neighbours, self.config.radio, phases)
+        choice = select_retarget(
+            candidates, position, neighbours, self.config.radio, phases, phases.max_pursuers
+        )
         kind = 'its estimate'
         if choice is None and phases.retarget_unconverged:
             oldest = now_s - phases.recorded_max_age_s
@@ -474,9 +629,12 @@ class RobotController:
                 for e in self._bank.estimates()
                 if not e.converged
                 and e.target_id not in self._captured
+                and not self._beyond_reach(e.target_id)
                 and self._last_sampled_s.get(e.target_id, -math.inf) >= oldest
             ]
-            choice = select_retarget(recorded, position, neighbours, self.config.radio, phases)
+            choice = select_retarget(
+                recorded, position, neighbours, self.config.radio, phases, phases.max_pursuers
+            )
             kind = 'its unconverged filter'
         if choice is not None:
             self._committed = choice
@@ -537,7 +695,13 @@ class RobotController:
         bank = self._bank
         if scheme.uses_direct_approach and bank is not None and bank.is_converged(target):
             goal = bank.estimate(target).position_m
-            near = float(np.hypot(*(goal - position))) < phases.task_area_m
+            distance = float(np.hypot(*(goal - position)))
+            near = distance < phases.task_area_m
+            if mean is None and distance < phases.converged_give_up_m:
+                # Silent this close to a converged estimate: captured by robots out of
+                # range, or a wrong estimate.
+                self._abandon(target, heard=False)
+                return Phase.SEARCH
             if near:
                 # At the estimate but the target is not louder than gamma2: the estimate is
                 # wrong (or the target was captured by robots out of range). A converged flag
@@ -620,15 +784,27 @@ class RobotController:
         cfg = self.config
         alpha = cfg.search.alpha_outside
         if self.phase == Phase.SEARCH:
-            return self._search.vector(now_s, position, avoidance), False
+            return self._search_vector(now_s, position, avoidance), False
         if self.phase == Phase.FAR_LOCALISATION:
             assert self._bank is not None
-            best = self._bank.estimate(self.target_id).best_particle_m
-            return far_field_leader_vector(position, best, avoidance, alpha), False
+            estimate = self._bank.estimate(self.target_id)
+            aim = estimate.best_particle_m
+            if cfg.phases.far_aim == 'estimate':
+                aim = estimate.position_m
+            return far_field_leader_vector(position, aim, avoidance, alpha), False
         if self.phase == Phase.DIRECT_APPROACH:
             if float(np.hypot(*(self._goal - position))) < cfg.phases.task_area_m:
                 alpha = cfg.search.alpha_inside
             return direct_approach_vector(position, self._goal, avoidance, alpha), True
+        near_spread = cfg.phases.near_estimate_spread_m
+        bank = self._bank
+        if near_spread > 0.0 and bank is not None and bank.is_tracked(self.target_id):
+            estimate = bank.estimate(self.target_id)
+            if estimate.spread_m < near_spread:
+                goal = estimate.position_m
+                if float(np.hypot(*(goal - position))) < cfg.phases.task_area_m:
+                    alpha = cfg.search.alpha_inside
+                return direct_approach_vector(position, goal, avoidance, alpha), True
         return self._msc_leader_vector(now_s, position, avoidance), False
 
     def _msc_leader_vector(

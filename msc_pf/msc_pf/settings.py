@@ -33,6 +33,8 @@ INITIAL_PRIORS = ('detection_square', 'field')
 FUSION_MODES = ('joint', 'sequential')
 RESAMPLING_SCHEMES = ('systematic', 'multinomial')
 PF_BACKENDS = ('auto', 'numpy', 'numba')
+SEARCH_MODES = ('history', 'sector')
+FAR_AIMS = ('best_particle', 'estimate')
 
 
 def _require(condition: bool, message: str) -> None:
@@ -253,6 +255,48 @@ class SearchConfig:
     wall_weight: float | None = parameter(
         None, 'weight of the field-edge repulsion; unset (.nan) uses k_s.'
     )
+    mode: str = parameter(
+        'history',
+        (
+            "how searching robots move: 'history' is eq. (1); 'sector' (beyond the paper) "
+            'splits the field into angular sectors around the start, one per searching unit '
+            '(robot, or swarm leader), and heads for the nearest cell of the own sector not '
+            "yet within ``sweep_radius_m`` of a path the robot knows (own, or neighbours' "
+            'reported positions), then for the nearest such cell anywhere, then eq. (1).'
+        ),
+        choices=SEARCH_MODES,
+    )
+    coverage_prior_weight: float = parameter(
+        1.0,
+        (
+            "'sector' search, PF schemes: when a filter starts, its particles in cells the "
+            'robot knows searched (see ``sweep_radius_m``) get this weight, because a target '
+            'there would have been heard before; 1 = no such prior. It cuts the ring of '
+            'distances of a first sample to its unsearched side.'
+        ),
+        ge=0.0,
+        le=1.0,
+    )
+    sector_reach: int = parameter(
+        -1,
+        (
+            "'sector' search, PF schemes: until its own sector is covered, a robot takes "
+            'only targets whose estimate lies within this many sectors of its own (0: its '
+            'own sector only) and leaves the others to the robots sweeping there; -1 = any '
+            'target. Targets near the start are heard by every robot at once.'
+        ),
+        ge=-1,
+    )
+    sweep_radius_m: float = parameter(
+        250.0,
+        (
+            "'sector' search: a cell counts as searched once a robot came this close. Inside "
+            'the ~292 m detection range, so that a target there has been heard with near '
+            'certainty (mean RSSI 2 dB above gamma_D at 250 m).'
+        ),
+        unit='m',
+        gt=0.0,
+    )
 
     def __post_init__(self) -> None:
         _require_finite(self)
@@ -260,6 +304,11 @@ class SearchConfig:
         _require(self.history_radius_m > 0.0, 'history_radius_m must be positive')
         _require(self.random_period_s >= 0.0, 'random_period_s must be non-negative')
         _require(self.wall_margin_m >= 0.0, 'wall_margin_m must be non-negative')
+        _require(self.mode in SEARCH_MODES, f'search mode not in {SEARCH_MODES}')
+        _require(self.sweep_radius_m > 0.0, 'sweep_radius_m must be positive')
+        _require(
+            0.0 <= self.coverage_prior_weight <= 1.0, 'coverage_prior_weight must be in [0, 1]'
+        )
 
     @property
     def effective_wall_weight(self) -> float:
@@ -459,6 +508,29 @@ class PhaseConfig:
         unit='m',
         gt=0.0,
     )
+    converged_give_up_m: float = parameter(
+        0.0,
+        (
+            'beyond the paper, PF schemes: a robot that drives at a converged estimate and '
+            'does not hear the target within this distance of it drops the estimate (a '
+            'target heard from 300 m is heard for sure at 200 m; silent means captured by '
+            'robots out of range, or a wrong estimate); 0 = drive on to the task area (the '
+            'paper).'
+        ),
+        unit='m',
+        ge=0.0,
+    )
+    converged_max_age_s: float = parameter(
+        0.0,
+        (
+            'beyond the paper, proposed scheme: after a capture only converged estimates '
+            "that got a sample (own or a neighbour's) within this time are candidates, as "
+            '``recorded_max_age_s`` for unconverged ones; 0 = every converged estimate (the '
+            'paper).'
+        ),
+        unit='s',
+        ge=0.0,
+    )
     unheard_updates: bool = parameter(
         False,
         (
@@ -471,6 +543,19 @@ class PhaseConfig:
             "only the samples heard; this is the same observation model's other half. Off "
             'by default: it did not lower the mean CCT (docs/notes/msc_pf.md).'
         ),
+    )
+    non_detection_window_s: float = parameter(
+        0.0,
+        (
+            'beyond the paper, PF schemes: every control step, each filter that got a sample '
+            'within this time also folds in the non-detections of that step: the robot and '
+            'every neighbour heard this step that did not hear the target (each particle '
+            'weighted by the chance a target there would have stayed below gamma_D). With '
+            '``particle_filter.censored_likelihood`` off this is the full observation model '
+            '(samples heard and steps not heard); 0 = off (only samples heard).'
+        ),
+        unit='s',
+        ge=0.0,
     )
     unheard_exhausted_share: float = parameter(
         0.01,
@@ -498,6 +583,52 @@ class PhaseConfig:
     goal_progress_min_m: float = parameter(
         15.0, 'the least approach to the goal over that window.', unit='m', gt=0.0
     )
+    pursue_memory_s: float = parameter(
+        0.0,
+        (
+            'beyond the paper, proposed scheme: a robot keeps its selected target while its '
+            "filter got a sample (own or a neighbour's) within this time, approaching the "
+            'largest-weight particle (b-1) or the converged estimate (eq. 8) through signal '
+            'gaps; 0 = only while heard (msc.detection_memory_s). At the detection edge '
+            'single samples come and go, and a robot that searched again at every gap '
+            'circled the target at 300 m.'
+        ),
+        unit='s',
+        ge=0.0,
+    )
+    far_aim: str = parameter(
+        'best_particle',
+        (
+            "where the (b-1) leader heads: 'best_particle' is the paper's largest-weight "
+            "particle; 'estimate' (beyond the paper) the weighted mean of eq. (5). The "
+            'largest-weight particle of a wide filter jumps between the modes of the ring of '
+            'distances, and a lone robot chasing it turns back and forth; the mean moves '
+            'smoothly once the other side of the ring is ruled out (coverage prior, '
+            'non-detections).'
+        ),
+        choices=FAR_AIMS,
+    )
+    near_estimate_spread_m: float = parameter(
+        0.0,
+        (
+            'beyond the paper, PF schemes: in the MSC phases (RSSI above gamma1, and the '
+            'final approach above gamma2) a leader whose filter of the target has a spread '
+            'below this drives at the estimate with eq. (8) instead of MSC; 0 = MSC (the '
+            'paper). Near the target the filter is good to a few metres, while MSC steps '
+            'follow the noisy RSSI around the 5 m task area.'
+        ),
+        unit='m',
+        ge=0.0,
+    )
+    max_pursuers: int = parameter(
+        0,
+        (
+            'beyond the paper: a robot does not take a target it hears when at least this '
+            'many neighbours heading to it hear it louder (it searches on, or takes another '
+            'target); 0 = no limit (the paper: the MSC dispersion penalty only).'
+        ),
+        ge=0,
+    )
 
     def __post_init__(self) -> None:
         _require_finite(self)
@@ -508,6 +639,7 @@ class PhaseConfig:
         _require(self.hysteresis_db >= 0.0, 'hysteresis_db must be non-negative')
         _require(self.retarget_penalty < 0.0, 'retarget_penalty R must be negative')
         _require(self.task_area_m > 0.0, 'task_area_m must be positive')
+        _require(self.far_aim in FAR_AIMS, f'far_aim not in {FAR_AIMS}')
         _require(self.work_timeout_s > 0.0, 'work_timeout_s must be positive')
         _require(self.unheard_give_up_m > 0.0, 'unheard_give_up_m must be positive')
         _require(self.recorded_max_age_s >= 0.0, 'recorded_max_age_s must be non-negative')

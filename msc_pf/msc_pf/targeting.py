@@ -69,12 +69,19 @@ def select_retarget(
     neighbour_positions_m: np.ndarray,
     radio: RadioConfig,
     config: PhaseConfig,
+    max_closer: int = 0,
 ) -> int | None:
-    """ID of the candidate with the largest value (lower ID on ties); None without candidates."""
+    """ID of the candidate with the largest value (lower ID on ties); None without candidates.
+
+    With ``max_closer`` > 0, candidates that at least that many neighbours are closer to
+    are left to them (beyond the paper: ``phases.max_pursuers``).
+    """
     best_id: int | None = None
     best_value = -np.inf
     for candidate in sorted(candidates, key=lambda c: c.target_id):
         n_r = count_closer_to(position_m, candidate.estimate_m, neighbour_positions_m)
+        if 0 < max_closer <= n_r:
+            continue
         value = candidate_value(candidate, position_m, n_r, radio, config)
         if value > best_value:
             best_id, best_value = candidate.target_id, value

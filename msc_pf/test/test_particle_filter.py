@@ -477,3 +477,32 @@ def test_non_detection_far_away_changes_nothing_and_covering_the_belief_is_repor
     particles = small.particles(3)
     assert small.update_unheard(3, np.array([[1000.0, 1000.0]])) < 1e-12
     np.testing.assert_array_equal(small.particles(3), particles)  # left unchanged
+
+
+def test_a_prior_moves_the_belief_to_where_it_weighs_more():
+    bank = make_bank(seed=3)
+    bank.track(5, (1000.0, 1000.0))
+    particles = bank.particles(5)
+    east = particles[:, 0] > 1000.0
+    kept = bank.apply_prior(5, np.where(east, 1.0, 0.05))
+    assert kept == pytest.approx(0.5 * 1.0 + 0.5 * 0.05, abs=0.02)
+    after = bank.particles(5)
+    assert np.mean(after[:, 0] > 1000.0) > 0.9
+    estimate = bank.estimate(5)
+    assert estimate.position_m[0] > 1100.0
+    assert estimate.best_particle_m[0] > 1000.0
+
+
+def test_a_prior_must_weigh_every_particle_and_a_zero_prior_changes_nothing():
+    bank = make_bank(seed=3)
+    bank.track(5, (1000.0, 1000.0))
+    n = bank.particles(5).shape[0]
+    with pytest.raises(ValueError, match='prior weights'):
+        bank.apply_prior(5, np.ones(n - 1))
+    with pytest.raises(ValueError, match='prior weights'):
+        bank.apply_prior(5, np.full(n, -1.0))
+    with pytest.raises(KeyError):
+        bank.apply_prior(6, np.ones(n))
+    before = bank.particles(5)
+    assert bank.apply_prior(5, np.zeros(n)) == 0.0
+    np.testing.assert_array_equal(bank.particles(5), before)

@@ -375,3 +375,17 @@ def test_the_turning_pbest_rule_climbs_to_a_target_through_the_noise(seed):
     assert closest < 6.0
     # The specification's pbest rule dithers in the noise and gets nowhere near.
     assert climb('pbest', seed)[0] > 50.0
+
+
+def test_a_silent_converged_estimate_is_dropped_at_the_give_up_distance():
+    # Target 2 is localised from the neighbours' samples only; the robot then drives at it
+    # (beyond the paper: phases.converged_give_up_m).
+    phases = PhaseConfig(work_timeout_s=100.0, converged_give_up_m=100.0)
+    robot, out = run_capture_scenario('proposed', phases=phases)
+    assert out.status.phase is Phase.DIRECT_APPROACH
+    goal = robot.filters.estimate(2).position_m
+    out = robot.step(41.0, goal + np.array([0.0, 120.0]), {})
+    assert out.status.phase is Phase.DIRECT_APPROACH
+    out = robot.step(42.0, goal + np.array([0.0, 90.0]), {})
+    assert out.status.phase is Phase.SEARCH
+    assert not robot.filters.is_tracked(2)

@@ -157,3 +157,19 @@ def test_paired_differences_use_only_the_seeds_both_schemes_ran(bench):
     table = bench.paired_table(rows, ('proposed', 'msc'))
     assert '| 10 | 0 +- 1528 (2/3) |' in table
     assert bench.paired_table(rows, ('msc',)) == []
+
+
+def test_the_approach_target_lies_400_to_900_m_from_the_start_by_seed(bench):
+    spots = [bench.approach_target(seed) for seed in range(20)]
+    distances = [float(np.hypot(*(spot[0] - 1000.0))) for spot in spots]
+    assert all(400.0 <= d <= 900.0 for d in distances)
+    assert len({round(d, 6) for d in distances}) == 20
+    np.testing.assert_array_equal(bench.approach_target(3), spots[3])
+
+
+def test_the_approach_table_gives_medians_per_scheme(bench):
+    results = [('proposed', 0, 300.0, 1.0), ('proposed', 1, 500.0, 2.0), ('msc', 0, 900.0, 3.0)]
+    lines = bench.single_target_table(results, 15, (('phases.max_pursuers', 1),))
+    assert 'phases.max_pursuers=1' in lines[0]
+    assert '| proposed | 2 | 400 | 400 | 1.50 | 300 500 |' in lines
+    assert '| msc | 1 | 900 | 900 | 3.00 | 900 |' in lines
