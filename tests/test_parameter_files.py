@@ -51,7 +51,11 @@ _SIM_BRIDGE_ADDED = {
     'start_after_clock_subscribers': 0,
 }
 ADDED = {
-    'oabug': {'min_turn_rate_radps': 0.3, 'robot_contact_distance_m': 0.16},
+    'oabug': {
+        'min_turn_rate_radps': 0.3,
+        'robot_contact_distance_m': 0.16,
+        'robot_contact_in_path': True,
+    },
     'sim_bridge': {'physics': 'numpy', **_SIM_BRIDGE_ADDED},
     'msc_pf': {
         'swarm.search_alone': False,

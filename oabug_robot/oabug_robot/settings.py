@@ -155,6 +155,10 @@ class PerceptionConfig:
             peer of the same size spans 30 deg either side of its centre's direction, so its
             returns come within 60 deg of straight ahead exactly when its centre is ahead of
             abeam, where it blocks the drive.
+        robot_contact_in_path: the contact rule counts only peer returns inside the
+            corridor the body sweeps (``front_half_width_m`` either side), i.e. a peer the
+            next step would push; a peer beside the path, passed with a gap (two followers
+            of opposite walls of a 2-cell corridor are 0.23 m apart), is no hit.
         peer_bearing_tolerance_rad: angular error allowed between a bearing and the peer's
             lidar returns [rad]; added to the angle the peer's body spans.
         peer_mask_range_m: returns farther than this are never attributed to a peer [m]; a
@@ -195,6 +199,10 @@ class PerceptionConfig:
         0.16, 'peer this close ahead of abeam (not only in the cone) is hit', unit='m', ge=0.0
     )
     robot_contact_half_angle_rad: float = math.radians(60.0)
+    robot_contact_in_path: bool = parameter(
+        True,
+        'the contact rule counts only peers inside the corridor the body sweeps, not beside it',
+    )
     peer_bearing_tolerance_rad: float = math.radians(10.0)
     peer_mask_range_m: float = 1.0
     peer_bearing_max_distance_m: float = 2.0
