@@ -55,6 +55,7 @@ ADDED = {
         'min_turn_rate_radps': 0.3,
         'robot_contact_distance_m': 0.16,
         'robot_contact_in_path': True,
+        'inner_corner_arc_radius_m': 0.15,
     },
     'sim_bridge': {'physics': 'numpy', **_SIM_BRIDGE_ADDED},
     'msc_pf': {

@@ -132,7 +132,8 @@ def test_robots_touching_side_by_side_do_not_push_for_ever():
     # Site 5 from the edge: at 14 s two robots touch, each beside the other's front outside
     # the 30 deg hit cone. Without the contact rule both drive on into the other, blocked,
     # for 36 s; with it each takes the touch for a robot hit and turns, whether it counts
-    # the whole contact sector or only the body's path.
+    # the whole contact sector or only the body's path. (The scenario arises with inner
+    # corners turned on the spot, the earlier default.)
     def longest_push(contact_m, in_path=True):
         settings = SpawnSettings(
             site='small',
@@ -145,6 +146,7 @@ def test_robots_touching_side_by_side_do_not_push_for_ever():
             robot_parameters={
                 'robot_contact_distance_m': contact_m,
                 'robot_contact_in_path': in_path,
+                'inner_corner_arc_radius_m': 0.0,
             },
         )
         engine, swarm = _robots_and_engine(settings)
