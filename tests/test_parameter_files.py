@@ -51,7 +51,12 @@ _SIM_BRIDGE_ADDED = {
     'start_after_clock_subscribers': 0,
 }
 ADDED = {
-    'oabug': {'min_turn_rate_radps': 0.3, 'robot_contact_distance_m': 0.16},
+    'oabug': {
+        'min_turn_rate_radps': 0.3,
+        'robot_contact_distance_m': 0.16,
+        'robot_contact_in_path': True,
+        'inner_corner_arc_radius_m': 0.15,
+    },
     'sim_bridge': {'physics': 'numpy', **_SIM_BRIDGE_ADDED},
     'msc_pf': {
         'swarm.search_alone': False,

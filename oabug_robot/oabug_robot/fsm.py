@@ -35,7 +35,14 @@ import numpy as np
 
 from oabug_robot.corners import CornerDetector
 from oabug_robot.heading import angle_difference, preferred_direction, wrap_angle
-from oabug_robot.motion import Twist2D, follow_wall, go_straight, turn_in_place, wrap_corner
+from oabug_robot.motion import (
+    Twist2D,
+    follow_wall,
+    go_straight,
+    inner_corner_ahead,
+    turn_in_place,
+    wrap_corner,
+)
 from oabug_robot.pump import PumpScheduler
 from oabug_robot.scan_features import ScanFeatures
 from oabug_robot.settings import (
@@ -228,7 +235,7 @@ class OABugFsm:
                 mem.driven_since_wrap_m = 0.0
             else:
                 return wrap_corner(mem.wall_side, cfg.motion)
-        elif front_blocked:
+        elif front_blocked or inner_corner_ahead(scan.front_wall_m, cfg.motion):
             # Turning away from an inner corner swings the old wall out of the abeam strip
             # before the new one comes in: that is no outer corner.
             self._corners.reset()
@@ -247,11 +254,19 @@ class OABugFsm:
             if mem.mode is Mode.WRAP:  # type: ignore[comparison-overlap]  # set by _wrap
                 return wrap_corner(mem.wall_side, cfg.motion)
         wall = scan.side(mem.wall_side)
-        if mem.mode is Mode.FOLLOW and self._wall_lost(wall.found, front_blocked, yaw_change):
+        corner_ahead = front_blocked or inner_corner_ahead(scan.front_wall_m, cfg.motion)
+        if mem.mode is Mode.FOLLOW and self._wall_lost(wall.found, corner_ahead, yaw_change):
             self._leave_wall(mem.preferred_direction_rad, Event.LEAVE_WALL)
             error = angle_difference(mem.target_yaw_rad, snap.yaw_rad)
             return turn_in_place(error, cfg.motion)
-        return follow_wall(mem.wall_side, wall, front_blocked, cfg.motion)
+        return follow_wall(
+            mem.wall_side,
+            wall,
+            front_blocked,
+            cfg.motion,
+            front_wall_m=scan.front_wall_m,
+            body_radius_m=cfg.perception.robot_radius_m,
+        )
 
     def _wall_lost(self, wall_found: bool, front_blocked: bool, yaw_change_rad: float) -> bool:
         """True once the follower has arced ``lost_wall_arc_rad`` towards its side unseen.

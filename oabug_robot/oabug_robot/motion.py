@@ -11,7 +11,15 @@ from dataclasses import dataclass
 from oabug_robot.scan_features import SideWall
 from oabug_robot.settings import MotionConfig
 
-__all__ = ['STOP', 'Twist2D', 'follow_wall', 'go_straight', 'turn_in_place', 'wrap_corner']
+__all__ = [
+    'STOP',
+    'Twist2D',
+    'follow_wall',
+    'go_straight',
+    'inner_corner_ahead',
+    'turn_in_place',
+    'wrap_corner',
+]
 
 
 @dataclass(frozen=True)
@@ -51,18 +59,38 @@ def go_straight(error_rad: float, cfg: MotionConfig) -> Twist2D:
     )
 
 
-def follow_wall(side: int, wall: SideWall, front_blocked: bool, cfg: MotionConfig) -> Twist2D:
+def follow_wall(
+    side: int,
+    wall: SideWall,
+    front_blocked: bool,
+    cfg: MotionConfig,
+    *,
+    front_wall_m: float = math.inf,
+    body_radius_m: float = 0.0,
+) -> Twist2D:
     """Keep the wall on ``side`` (+1 left, -1 right) parallel at ``cfg.wall_distance_m``.
 
-    Turns on the spot away from a wall that blocks the way (inner corner) and, with no wall
-    beside it, arcs towards its side until one is back.
+    An inner corner (a wall ahead) is taken on the move: once the wall ahead is within
+    :func:`inner_corner_ahead`'s distance the follower turns away from its side at the
+    largest yaw rate while driving on, on an arc of radius ``cfg.inner_corner_arc_radius_m``
+    that tightens as the wall comes closer and becomes a turn on the spot where the wall
+    would touch the body. Without the arc (radius 0) it turns on the spot once the wall
+    blocks the way. With no wall beside it, it arcs towards its side until one is back.
 
     Args:
         side: the followed side.
         wall: the wall beside the robot on that side.
         front_blocked: a wall is within hit distance ahead.
         cfg: speeds and gains.
+        front_wall_m: forward distance to the nearest wall ahead [m].
+        body_radius_m: the body's radius, where the wall ahead would touch it [m].
     """
+    if inner_corner_ahead(front_wall_m, cfg):
+        start_m = cfg.wall_distance_m + cfg.inner_corner_arc_radius_m
+        room = (front_wall_m - body_radius_m) / max(start_m - body_radius_m, 1e-9)
+        speed = cfg.turn_rate_radps * cfg.inner_corner_arc_radius_m
+        speed = min(cfg.forward_speed_mps, speed) * min(1.0, max(0.0, room))
+        return Twist2D(speed, -side * cfg.turn_rate_radps)
     if front_blocked:
         return Twist2D(0.0, -side * cfg.turn_rate_radps)
     if not wall.found:
@@ -75,6 +103,17 @@ def follow_wall(side: int, wall: SideWall, front_blocked: bool, cfg: MotionConfi
     )
     fraction = max(_MIN_FOLLOW_FRACTION, math.cos(min(abs(wall.angle_rad), math.pi / 2)))
     return Twist2D(cfg.forward_speed_mps * fraction, _clamp(rate, cfg.turn_rate_radps))
+
+
+def inner_corner_ahead(front_wall_m: float, cfg: MotionConfig) -> bool:
+    """Whether a follower should start arcing away from the wall ``front_wall_m`` ahead.
+
+    A 90 deg arc of radius r ends r further on, so it starts r beyond the wall distance and
+    ends parallel to the new wall at the wall distance; 0 disables the arc (the follower
+    drives on until the wall blocks the way and turns on the spot).
+    """
+    radius = cfg.inner_corner_arc_radius_m
+    return radius > 0.0 and front_wall_m <= cfg.wall_distance_m + radius
 
 
 def wrap_corner(side: int, cfg: MotionConfig) -> Twist2D:

@@ -224,7 +224,10 @@ class ScanFeatureExtractor:
                 # Peers in the front cone, and peers touching the body ahead of abeam.
                 ahead = cos >= math.cos(cfg.robot_cone_half_angle_rad)
                 touching = cos >= math.cos(cfg.robot_contact_half_angle_rad)
-                ahead |= touching & (r <= cfg.robot_contact_distance_m)
+                touching &= r <= cfg.robot_contact_distance_m
+                if cfg.robot_contact_in_path:
+                    touching &= np.abs(y) <= cfg.front_half_width_m
+                ahead |= touching
                 cone = is_peer & ahead
                 if np.count_nonzero(cone):
                     front_robot = float(r[cone].min())

@@ -240,7 +240,8 @@ def features_kernel(
         params: range_min, limit, front_half_width, follow_capture, cone_cos,
             peer_mask_range, robot_radius, peer_distance_factor, side_lookahead,
             side_window_behind, side_wall_band, abeam_behind, abeam_reach, fit_tolerance,
-            min_spread, robot_contact_distance, contact_cos.
+            min_spread, robot_contact_distance, contact_cos, contact_in_path (1.0: the
+            contact rule counts only returns within front_half_width of the path).
         real_out: (K, 4) output per scan: the wall ahead and the robot ahead [m], the
             distance [m] and angle [rad, as seen on the left] of the wanted side's wall
             (read only where its return count is not 0).
@@ -265,6 +266,7 @@ def features_kernel(
         min_spread,
         contact,
         contact_cos,
+        contact_in_path,
     ) = params
     body = 2.0 * radius
     num_scans, num_rays = ranges.shape
@@ -340,7 +342,11 @@ def features_kernel(
             y = r * sin_t[j]
             if is_peer[m]:
                 peers += 1
-                ahead = c >= cone_cos or (c >= contact_cos and r <= contact)
+                ahead = c >= cone_cos or (
+                    c >= contact_cos
+                    and r <= contact
+                    and (contact_in_path == 0.0 or abs(y) <= front_half_width)
+                )
                 if ahead and r < front_robot:
                     front_robot = r
                 continue
@@ -493,6 +499,7 @@ def _constants(
             MIN_FIT_SPREAD_M,
             cfg.robot_contact_distance_m,
             math.cos(cfg.robot_contact_half_angle_rad),
+            1.0 if cfg.robot_contact_in_path else 0.0,
         )
     )
     widest = cfg.peer_bearing_tolerance_rad + math.atan2(cfg.robot_radius_m, range_min_m) + 1e-9

@@ -155,6 +155,10 @@ class PerceptionConfig:
             peer of the same size spans 30 deg either side of its centre's direction, so its
             returns come within 60 deg of straight ahead exactly when its centre is ahead of
             abeam, where it blocks the drive.
+        robot_contact_in_path: the contact rule counts only peer returns inside the
+            corridor the body sweeps (``front_half_width_m`` either side), i.e. a peer the
+            next step would push; a peer beside the path, passed with a gap (two followers
+            of opposite walls of a 2-cell corridor are 0.23 m apart), is no hit.
         peer_bearing_tolerance_rad: angular error allowed between a bearing and the peer's
             lidar returns [rad]; added to the angle the peer's body spans.
         peer_mask_range_m: returns farther than this are never attributed to a peer [m]; a
@@ -195,6 +199,10 @@ class PerceptionConfig:
         0.16, 'peer this close ahead of abeam (not only in the cone) is hit', unit='m', ge=0.0
     )
     robot_contact_half_angle_rad: float = math.radians(60.0)
+    robot_contact_in_path: bool = parameter(
+        True,
+        'the contact rule counts only peers inside the corridor the body sweeps, not beside it',
+    )
     peer_bearing_tolerance_rad: float = math.radians(10.0)
     peer_mask_range_m: float = 1.0
     peer_bearing_max_distance_m: float = 2.0
@@ -257,6 +265,12 @@ class MotionConfig:
             middle of that range and the closest a lidar with the RPLidar A1's 0.15 m minimum
             range still measures (nearer returns read -inf, i.e. at the minimum range).
             Chosen against 0.16, 0.18 and 0.2 m (docs/notes/oabug_measurements.md).
+        inner_corner_arc_radius_m: a follower meeting a wall ahead (an inner corner) turns
+            away from it on an arc of this radius while driving on, from this far beyond
+            ``wall_distance_m``, instead of stopping at the wall and turning on the spot
+            (the grid's 90 deg turn, on the move); the arc tightens as the wall comes
+            closer and becomes a turn on the spot where the wall would touch the body.
+            0 turns on the spot [m].
         wall_distance_gain_radps_per_m: yaw rate per metre of wall-distance error [rad/(s m)].
         wall_angle_gain_per_s: yaw rate per radian of wall-direction error [1/s].
         random_step_m: the Random variant redraws its heading with probability
@@ -281,6 +295,15 @@ class MotionConfig:
     wall_distance_m: float = parameter(
         0.15, 'distance kept from the followed wall', unit='m', gt=0.0
     )
+    inner_corner_arc_radius_m: float = parameter(
+        0.15,
+        (
+            'a follower takes an inner corner as an arc of this radius, starting when the '
+            'wall ahead is this much beyond wall_distance_m (0: stop and turn on the spot)'
+        ),
+        unit='m',
+        ge=0.0,
+    )
     wall_distance_gain_radps_per_m: float = 6.0
     wall_angle_gain_per_s: float = 2.5
     random_step_m: float = parameter(
@@ -293,7 +316,10 @@ class MotionConfig:
         for f in fields(self):
             value = getattr(self, f.name)
             _require(math.isfinite(value), f'{f.name} must be finite, got {value!r}')
-            _require(value > 0.0, f'{f.name} must be > 0, got {value!r}')
+            if f.name == 'inner_corner_arc_radius_m':
+                _require(value >= 0.0, f'{f.name} must be >= 0, got {value!r}')
+            else:
+                _require(value > 0.0, f'{f.name} must be > 0, got {value!r}')
         _require(
             self.min_turn_rate_radps <= self.turn_rate_radps,
             'min_turn_rate_radps must not exceed turn_rate_radps',

@@ -10,6 +10,7 @@ from oabug_robot.fsm import Event, FsmState, Mode, OABugFsm, SensorSnapshot
 from oabug_robot.heading import angle_difference
 from oabug_robot.scan_features import ScanFeatures, SideWall
 from oabug_robot.settings import (
+    MotionConfig,
     OABugConfig,
     PerceptionConfig,
     SoundMemory,
@@ -134,8 +135,8 @@ def test_fixed_turn_right_keeps_the_wall_on_the_left_and_turns_clockwise(variant
     script.step(free())
     command = script.step(wall_ahead())
     assert fsm.memory.wall_side == 1
-    assert command.linear_mps == 0.0
-    assert command.angular_radps < 0.0
+    assert command.linear_mps < fsm.config.motion.forward_speed_mps
+    assert command.angular_radps == -fsm.config.motion.turn_rate_radps
 
 
 def test_fixed_turn_left_keeps_the_wall_on_the_right() -> None:
@@ -252,6 +253,58 @@ def test_a_peer_is_not_hit_while_turning_in_place() -> None:
     script.step(robot_ahead())
     script.step(robot_ahead())
     assert fsm.memory.counts[Event.HIT_ROBOT] == 1
+
+
+ARC = MotionConfig(inner_corner_arc_radius_m=0.15)
+
+
+def corner_ahead_m(distance_m: float) -> ScanFeatures:
+    return ScanFeatures(front_wall_m=distance_m, left=SideWall(0.15, 0.0, abeam=True))
+
+
+def follower(motion: MotionConfig) -> tuple[OABugFsm, Script]:
+    """A Gas robot following the wall on its left, heading south."""
+    fsm = make(Variant.GAS, robot_count=1, motion=motion)
+    script = Script(fsm)
+    reach_wall(script)
+    script.step(side_wall(1), yaw_rad=-math.pi / 2)
+    script.follow_straight(1)
+    return fsm, script
+
+
+def test_an_inner_corner_is_taken_as_an_arc_on_the_move() -> None:
+    fsm, script = follower(ARC)
+    motion = fsm.config.motion
+    start_m = motion.wall_distance_m + motion.inner_corner_arc_radius_m
+    command = script.step(corner_ahead_m(start_m + 0.05))
+    assert command.linear_mps == pytest.approx(motion.forward_speed_mps)
+    assert abs(command.angular_radps) < motion.turn_rate_radps, 'still plain following'
+    command = script.step(corner_ahead_m(start_m - 0.01))
+    assert command.angular_radps == -motion.turn_rate_radps, 'turning right at full rate'
+    arc_m = command.linear_mps / abs(command.angular_radps)
+    assert 0.0 < arc_m <= motion.inner_corner_arc_radius_m
+    closer = script.step(corner_ahead_m(0.15))
+    assert 0.0 < closer.linear_mps < command.linear_mps, 'the arc tightens near the wall'
+    touching = script.step(corner_ahead_m(fsm.config.perception.robot_radius_m))
+    assert touching.linear_mps == 0.0, 'on the spot where the wall would touch the body'
+    assert fsm.memory.state is FsmState.FOLLOWING_WALL
+
+
+def test_without_the_arc_an_inner_corner_is_turned_on_the_spot() -> None:
+    fsm, script = follower(MotionConfig(inner_corner_arc_radius_m=0.0))
+    command = script.step(corner_ahead_m(0.28))
+    assert abs(command.angular_radps) < fsm.config.motion.turn_rate_radps
+    command = script.step(corner_ahead_m(0.2))
+    assert command.linear_mps == 0.0
+    assert command.angular_radps == -fsm.config.motion.turn_rate_radps
+
+
+def test_the_side_wall_swinging_away_in_an_inner_corner_arc_is_no_outer_corner() -> None:
+    fsm, script = follower(ARC)
+    script.step(ScanFeatures(front_wall_m=0.28, left=SideWall(0.2, 0.3, abeam=False)))
+    script.step(ScanFeatures(front_wall_m=0.5, left=SideWall(0.3, 0.6, abeam=False)))
+    assert Event.OUTER_CORNER not in fsm.memory.counts
+    assert Event.REVISIT not in fsm.memory.counts
 
 
 @pytest.mark.parametrize('variant', [Variant.MINIMUM, Variant.SOUND])
@@ -378,7 +431,6 @@ def test_an_inner_corner_after_a_revisit_returns_to_following_wall(variant: Vari
     assert fsm.memory.event is Event.HIT_WALL
     assert not fsm.memory.leave_at_next_corner
     assert fsm.memory.wall_side == 1, 'it keeps the wall it follows'
-    assert command.linear_mps == 0.0
     assert command.angular_radps < 0.0, 'turning right, away from the wall ahead'
     script.step(side_wall(1), yaw_rad=-math.pi / 2)
     script.follow_straight(1)

@@ -17,6 +17,13 @@ def test_the_paper_profile_is_table_one_read_literally():
     assert config.robot_hit_repeat_s == 0.0
 
 
+def test_both_profiles_take_inner_corners_on_an_arc_and_count_contacts_in_the_path():
+    for name in PROFILES:
+        config = OABUG_PARAMETERS.build(profile_parameters(name)).controller
+        assert config.motion.inner_corner_arc_radius_m == 0.15, name
+        assert config.perception.robot_contact_in_path, name
+
+
 def test_the_tuned_profile_is_the_defaults_and_its_departures_are_listed():
     defaults = OABUG_PARAMETERS.defaults()
     assert profile_parameters('tuned') == {}

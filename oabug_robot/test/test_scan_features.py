@@ -139,6 +139,36 @@ def test_a_peer_touching_the_body_ahead_of_abeam_is_a_hit(kernel: bool) -> None:
     assert features(off, 70.0) == math.inf, 'without the rule only the 30 deg cone hits'
 
 
+@pytest.mark.parametrize('kernel', [False, True])
+def test_in_path_the_contact_rule_ignores_a_peer_beside_the_path(kernel: bool) -> None:
+    """A peer passed with a 5 cm gap (centre 0.12 m ahead, 0.22 m to the left: its nearest
+    returns at 58-60 deg, 0.15-0.16 m) is within the contact sector and distance, but the
+    body's path misses it; a peer touching the body ahead of abeam is in the path."""
+    from oabug_robot.scan_features_kernel import extract_many
+
+    def front_robot_m(config: PerceptionConfig, x: float, y: float) -> float:
+        ranges = add_disc(box_ranges(3.0, 1.5, 3.0, 1.5), x, y, 0.1)
+        extractor = ScanFeatureExtractor(config)
+        bearings = np.array([math.atan2(y, x)])
+        if kernel:
+            (result,) = extract_many(extractor, [scan_of(ranges)], [(bearings, None)], [0])
+        else:
+            result = extractor.extract(scan_of(ranges), bearings)
+        return result.front_robot_m
+
+    sector = PerceptionConfig(robot_contact_in_path=False)
+    in_path = PerceptionConfig()
+    assert in_path.robot_contact_in_path, 'the default'
+    hit = sector.robot_hit_distance_m
+    assert front_robot_m(sector, 0.12, 0.22) <= sector.robot_contact_distance_m
+    assert front_robot_m(in_path, 0.12, 0.22) == math.inf
+    assert front_robot_m(in_path, 0.12, -0.22) == math.inf
+    for bearing_deg in (0.0, 40.0, -55.0, 70.0):  # touching, ahead of abeam
+        direction = math.radians(bearing_deg)
+        x, y = 0.2 * math.cos(direction), 0.2 * math.sin(direction)
+        assert front_robot_m(in_path, x, y) <= hit, bearing_deg
+
+
 def test_bearings_with_nan_azimuth_mask_nothing(extractor) -> None:
     ranges = add_disc(box_ranges(3.0, 1.5, 3.0, 1.5), 0.4, 0.0, 0.12)
     features = extractor.extract(scan_of(ranges), np.array([math.nan]))

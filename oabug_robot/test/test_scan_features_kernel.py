@@ -86,6 +86,7 @@ def _numpy_features(extractor, scans, peers, sides) -> list[str]:
         (360, PerceptionConfig()),
         (90, PerceptionConfig()),
         (360, PerceptionConfig(lidar_yaw_offset_rad=0.3, feature_range_m=2.0)),
+        (360, PerceptionConfig(robot_contact_in_path=False)),
     ],
 )
 def test_the_kernel_gives_the_numpy_features_on_random_scans(rays, config) -> None:

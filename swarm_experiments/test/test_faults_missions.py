@@ -131,8 +131,10 @@ def test_survivors_never_push_into_a_wall_and_lidarless_robots_stop_with_the_pum
 def test_robots_touching_side_by_side_do_not_push_for_ever():
     # Site 5 from the edge: at 14 s two robots touch, each beside the other's front outside
     # the 30 deg hit cone. Without the contact rule both drive on into the other, blocked,
-    # for 36 s; with it each takes the touch for a robot hit and turns.
-    def longest_push(contact_m):
+    # for 36 s; with it each takes the touch for a robot hit and turns, whether it counts
+    # the whole contact sector or only the body's path. (The scenario arises with inner
+    # corners turned on the spot, the earlier default.)
+    def longest_push(contact_m, in_path=True):
         settings = SpawnSettings(
             site='small',
             site_seed=5,
@@ -141,7 +143,11 @@ def test_robots_touching_side_by_side_do_not_push_for_ever():
             variant='gas_sound',
             departure='edge',
             profile='tuned',
-            robot_parameters={'robot_contact_distance_m': contact_m},
+            robot_parameters={
+                'robot_contact_distance_m': contact_m,
+                'robot_contact_in_path': in_path,
+                'inner_corner_arc_radius_m': 0.0,
+            },
         )
         engine, swarm = _robots_and_engine(settings)
         pushing = PushWatch(engine)
@@ -152,6 +158,7 @@ def test_robots_touching_side_by_side_do_not_push_for_ever():
         return pushing.longest_s.max()
 
     assert longest_push(0.16) < 5.0
+    assert longest_push(0.16, in_path=False) < 5.0
     assert longest_push(0.0) > 20.0  # the rule off: the old dead lock
 
 
