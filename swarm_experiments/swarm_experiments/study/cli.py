@@ -48,6 +48,11 @@ def _add_plan_options(parser: argparse.ArgumentParser) -> None:
     count = parser.add_mutually_exclusive_group()
     count.add_argument('--runs', type=int, help='seeds per configuration')
     count.add_argument('--sites', type=int, help='sites per configuration (site studies)')
+    first = parser.add_mutually_exclusive_group()
+    first.add_argument('--first-seed', type=int, help="first seed instead of the study's own")
+    first.add_argument(
+        '--first-site', type=int, help='first site index instead of 0 (site studies)'
+    )
     parser.add_argument(
         '--set',
         dest='overrides',
@@ -127,8 +132,17 @@ def _plan(registry: StudyRegistry, args: argparse.Namespace) -> StudyPlan:
     study = registry.get(args.name)
     if args.sites is not None and study.seed_label != 'site':
         raise UsageError(f'study {study.name} has seeds, not sites: use --runs')
+    if args.first_site is not None and study.seed_label != 'site':
+        raise UsageError(f'study {study.name} has seeds, not sites: use --first-seed')
     runs = args.sites if args.sites is not None else args.runs
-    return make_specs(study, runs=runs, overrides=parse_overrides(args.overrides), smoke=args.smoke)
+    first = args.first_site if args.first_site is not None else args.first_seed
+    return make_specs(
+        study,
+        runs=runs,
+        overrides=parse_overrides(args.overrides),
+        smoke=args.smoke,
+        first_seed=first,
+    )
 
 
 def _cmd_list(registry: StudyRegistry) -> int:

@@ -234,10 +234,12 @@ def make_specs(
     runs: int | None = None,
     overrides: Mapping[str, str] | None = None,
     smoke: bool = False,
+    first_seed: int | None = None,
 ) -> StudyPlan:
     """Expand ``study`` into its run specs, in axis order then seed order.
 
-    ``runs`` replaces the seeds per configuration; ``overrides`` (``PARAM -> VALUE`` text,
+    ``runs`` replaces the seeds per configuration and ``first_seed`` the study's first seed
+    (e.g. held-out sites 300, 301, ...); ``overrides`` (``PARAM -> VALUE`` text,
     values read as YAML) set fixed parameters (dotted names reach nested ones) or restrict an
     axis to the given comma-separated values; ``smoke`` applies the study's :class:`Smoke`
     first.
@@ -260,8 +262,12 @@ def make_specs(
         if runs < 1:
             raise UsageError(f'the number of runs must be >= 1, not {runs}')
         count = runs
+    if first_seed is None:
+        first_seed = study.first_seed
+    elif first_seed < 0:
+        raise UsageError(f'the first seed must be >= 0, not {first_seed}')
     _jsonable(params, 'params')
-    seeds = tuple(range(study.first_seed, study.first_seed + count))
+    seeds = tuple(range(first_seed, first_seed + count))
     names = tuple(axes)
     specs = []
     for values in itertools.product(*(axes[name] for name in names)):

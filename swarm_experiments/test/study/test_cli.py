@@ -13,6 +13,7 @@ from study_fixtures import studies
 from study_helpers import comparable
 from swarm_experiments.study import StudyRegistry, read_rows
 from swarm_experiments.study.cli import main
+from swarm_experiments.study.results import read_manifest
 
 
 @pytest.fixture
@@ -73,6 +74,17 @@ def test_sites_and_set_shape_the_study(registry: StudyRegistry, tmp_path: Path) 
     assert set(rows['seed']) == {0, 1}
 
 
+def test_first_site_moves_the_sites_to_held_out_indices(
+    registry: StudyRegistry, tmp_path: Path
+) -> None:
+    argv = ['run', 'synthetic-search', '--sites', '2', '--first-site', '300', '--set', 'robots=4']
+    assert _run(registry, *argv, '--engine', 'serial', '--out', str(tmp_path), '--quiet') == 0
+    rows = read_rows(tmp_path / 'synthetic-search')
+    assert set(rows['seed']) == {300, 301}
+    manifest = read_manifest(tmp_path / 'synthetic-search')
+    assert manifest['seeds'] == [300, 301]
+
+
 def test_failed_runs_exit_1_and_the_report_lists_them(
     registry: StudyRegistry, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -104,6 +116,8 @@ def test_failed_runs_exit_1_and_the_report_lists_them(
         (['run', 'synthetic-search', '--set', 'oops'], 'expected PARAM=VALUE'),
         (['run', 'synthetic-search', '--runs', '0'], '>= 1'),
         (['run', 'synthetic-search', '--runs', '2', '--sites', '2'], 'not allowed with'),
+        (['run', 'synthetic-search', '--first-site', '-1'], 'first seed must be >= 0'),
+        (['run', 'synthetic-search', '--first-site', '1', '--first-seed', '1'], 'not allowed'),
         (['run', 'synthetic-search', '--engine', 'spark'], 'invalid choice'),
         (['run', 'synthetic-search', '--workers', '0'], '--workers must be >= 1'),
         (['report', '/nonexistent/dir'], 'no such directory'),
