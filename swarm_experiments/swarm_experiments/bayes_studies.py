@@ -341,6 +341,7 @@ def _reference_section_authors(page: ReportPage) -> None:
     page.add_table(
         _mean_std(rows, ['config.case', 'config.source', 'config.solvers']),
         title='tau per case, source placement and solvers',
+        export='tau',
     )
     page.add_text(
         'Paper, COBYLA / L-BFGS-B (Tables 6 and 7, 55 runs): Case 1 0.44 +- 0.10, Case 2 '

@@ -142,3 +142,34 @@ def test_random_source_rows_stay_apart_and_out_of_the_paper_comparison(tmp_path)
     paper = {row[1]: row for row in page.exports['paper']['rows'] if row[0] == 'case2'}
     assert float(paper['p'][2]) == 0.51  # the paper's field only
     assert len(page.exports['paired']['rows']) == 2  # one per source placement
+
+
+def test_the_optimizers_report_exports_tau_per_solver_and_the_paired_table(tmp_path):
+    import pandas as pd
+    from swarm_experiments.study import ReportPage
+
+    from swarm_experiments import bayes_studies
+
+    records = [
+        {
+            'status': 'ok',
+            'seed': seed,
+            'config.case': 'case1',
+            'config.source': 'paper',
+            'config.solvers': solvers,
+            'metric.found': True,
+            'metric.tau': tau + 0.01 * seed,
+            'metric.tau_censored': tau + 0.01 * seed,
+        }
+        for seed in range(4)
+        for solvers, tau in (('cobyla/lbfgsb', 0.3), ('pso/lbfgsb', 0.4))
+    ]
+    page = ReportPage(tmp_path, {'study': 'bayes-table1-2-optimizers'}, pd.DataFrame(records))
+    bayes_studies._report_optimizers(page)
+    tau = {
+        row[2]: dict(zip(page.exports['tau']['columns'], row, strict=True))
+        for row in page.exports['tau']['rows']
+    }
+    assert set(tau) == {'cobyla/lbfgsb', 'pso/lbfgsb'}
+    assert float(tau['pso/lbfgsb']['mean']) > float(tau['cobyla/lbfgsb']['mean'])
+    assert len(page.exports['paired']['rows']) == 1  # PSO against the paper's solvers
