@@ -55,6 +55,7 @@ __all__ = [
     'ParameterInfo',
     'ParameterSpec',
     'SpecError',
+    'kind_of_value',
     'parameter',
     'render_value',
     'section',
@@ -235,7 +236,9 @@ def _render_string(text: str) -> str:
     return "'" + text.replace("'", "''") + "'"
 
 
-def _kind_of_value(value: Any) -> str:
+def kind_of_value(value: Any) -> str:
+    """The parameter kind of a Python value ('bool', 'int', 'float', 'str', 'int[]', ...), or
+    its type's name for anything else."""
     if isinstance(value, bool):
         return 'bool'
     if isinstance(value, int):
@@ -245,7 +248,7 @@ def _kind_of_value(value: Any) -> str:
     if isinstance(value, str):
         return 'str'
     if isinstance(value, list | tuple):
-        kinds = {_kind_of_value(item) for item in value}
+        kinds = {kind_of_value(item) for item in value}
         if len(kinds) == 1:
             return kinds.pop() + '[]'
         return 'list'
@@ -253,7 +256,7 @@ def _kind_of_value(value: Any) -> str:
 
 
 def _describe_value(value: Any) -> str:
-    kind = _kind_of_value(value)
+    kind = kind_of_value(value)
     words = {
         'bool': 'a boolean',
         'int': 'an integer',

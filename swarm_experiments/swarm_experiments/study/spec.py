@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import yaml
+from swarm_common.params import kind_of_value
 
 from .definition import Study
 from .errors import StudyDefinitionError, UsageError
@@ -175,18 +176,6 @@ def _axis_values(axis: str, text: str, declared: Sequence[Any]) -> tuple[Any, ..
     return values
 
 
-def _kind(value: Any) -> str:
-    if isinstance(value, bool):
-        return 'bool'
-    if isinstance(value, int):
-        return 'int'
-    if isinstance(value, float):
-        return 'float'
-    if isinstance(value, str):
-        return 'str'
-    return 'other'
-
-
 _KIND_NAMES = {
     'bool': 'true or false',
     'int': 'a whole number',
@@ -206,12 +195,12 @@ def _coerce(name: str, value: Any, text: str, declared: Sequence[Any]) -> Any:
     Raises:
         UsageError: the value is not of the declared type.
     """
-    kinds = {_kind(item) for item in declared if item is not None}
+    kinds = {kind_of_value(item) for item in declared if item is not None}
     if value is None or len(kinds) != 1:
         return value
     kind = kinds.pop()
-    got = _kind(value)
-    if kind == 'other' or got == kind:
+    got = kind_of_value(value)
+    if kind not in _KIND_NAMES or got == kind:
         return value
     if kind == 'float' and got == 'int':
         return float(value)
