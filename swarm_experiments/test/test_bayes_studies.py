@@ -45,6 +45,23 @@ def test_a_run_returns_tau_and_a_censored_tau_that_pairs_failures():
     )
 
 
+def test_glowworm_gets_its_own_time_limit_factor_and_the_avalanche_study_sets_it():
+    # The swarm needs about 155 s to climb to the beacon from the 5 m dispersal fan: it
+    # fails within the paper's T_max of 100 s and finds it with a longer limit.
+    config = {'case': 'avalanche', 'algorithm': 'glowworm'}
+    paper_limit = run_bayes(_spec(config, 0))
+    assert not paper_limit['found']
+    assert paper_limit['tau_censored'] == pytest.approx((100.0 - 56.5685) / 56.5685, rel=1e-4)
+    extended = run_bayes(_spec({**config, 'glowworm_t_max_factor': 3.0}, 0))
+    assert extended['found']
+    assert 100.0 < extended['found_time_s'] < 300.0
+    # The Levy / sweep factor does not reach Glowworm, nor Glowworm's the others.
+    unchanged = run_bayes(_spec({**config, 'baseline_t_max_factor': 3.0}, 0))
+    assert not unchanged['found']
+    avalanche = {study.name: study for study in studies()}['bayes-table8-avalanche']
+    assert avalanche.params['glowworm_t_max_factor'] * 100.0 > 583.0  # the paper's 9.30
+
+
 def test_random_sources_follow_the_seed_and_stay_inside_the_arena():
     a = run_bayes(_spec({'case': 'case1', 'robots': 2, 'source': 'random', 't_max_s': 1.0}, 5))
     b = run_bayes(_spec({'case': 'case1', 'robots': 2, 'source': 'random', 't_max_s': 1.0}, 6))
