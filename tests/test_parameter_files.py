@@ -78,6 +78,7 @@ ADDED = {
         'inner_optimizer': 'lbfgsb',
         'cobyla_max_iterations': 1000,
         'penalty_estimate': False,
+        'penalty_log_space': False,
         'cobyla_library': 'nlopt',
         'signal_scale': 1.0,
     },

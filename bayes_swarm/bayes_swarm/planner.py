@@ -29,7 +29,7 @@ import time
 import numpy as np
 from scipy.linalg import LinAlgError
 from scipy.optimize import minimize
-from scipy.special import erfc
+from scipy.special import erfc, log_ndtr
 
 from bayes_swarm.acquisition import acquisition, omega, planned_path_points, ray_integrals
 from bayes_swarm.alpha import AlphaBranch, AlphaDecision, exploitation_weight
@@ -38,13 +38,17 @@ from bayes_swarm.gp import ExtendedVariance, GaussianProcess, downsample_indices
 from bayes_swarm.lbfgsb import minimize_box
 from bayes_swarm.messages import Decision, DecisionKind, PeerUpdate
 from bayes_swarm.observations import ObservationStore, finite_samples
-from bayes_swarm.penalty import local_penalty
+from bayes_swarm.penalty import local_penalty, log_local_penalty
 from bayes_swarm.settings import Arena, BayesSwarmConfig
 from bayes_swarm.trust_region import projected_newton_step
 
 __all__ = ['BayesSwarmPlanner', 'ascend_mean', 'first_waypoint']
 
 _MEAN_GRID_SIZE = 16
+# Added to the raw acquisition before its log (``penalty_log_space``): it is 0 only on a
+# leg of length 0 with alpha = 0, which must stay finite (GPyOpt adds 1e-50).
+_LOG_FLOOR = 1e-300
+_SQRT2 = math.sqrt(2.0)
 _MAX_RAY_STEPS = 25
 _REFINE_LEVELS = 2
 # (radius, heading) multiples of the pattern search's 3 x 3 stencil, centre excluded.
@@ -503,6 +507,7 @@ class _OuterProblem:
         lipschitz: float,
     ) -> None:
         self.cfg = cfg
+        self.log_space = cfg.penalty_log_space
         self.lipschitz = lipschitz
         self.position = position
         self.expected = expected
@@ -551,6 +556,27 @@ class _OuterProblem:
             std_floor=self.cfg.penalty_std_floor,
         )
 
+    def log_gamma(self, points: np.ndarray) -> np.ndarray:
+        return log_local_penalty(
+            points,
+            self.peer_waypoints,
+            self.peer_mean,
+            self.peer_std,
+            max_signal=self.max_signal,
+            lipschitz=self.lipschitz,
+            std_floor=self.cfg.penalty_std_floor,
+        )
+
+    def _combine(
+        self, omega_values: np.ndarray, sigma_values: np.ndarray, points: np.ndarray
+    ) -> np.ndarray:
+        """The maximised objective (q,) from Eq. 1's terms at (q, 2) ``points``: Eq. 1 itself,
+        or with ``penalty_log_space`` its log, log(raw acquisition) + log Gamma."""
+        if not self.log_space:
+            return acquisition(self.alpha, omega_values, sigma_values, self.gamma(points))
+        raw = acquisition(self.alpha, omega_values, sigma_values, np.ones_like(omega_values))
+        return np.log(raw + _LOG_FLOOR) + self.log_gamma(points)
+
     def value(self, x: np.ndarray) -> float:
         """Acquisition at one reachable (2,) point: :meth:`values` without its batch set-up.
 
@@ -563,6 +589,17 @@ class _OuterProblem:
         sigma = math.hypot(ox, oy) * float(self.path_weights @ std) * self.sigma_scale
         ex, ey = x0 - float(self.expected[0]), x1 - float(self.expected[1])
         omega_value = 1.0 / (1.0 + (ex * ex + ey * ey) / self.omega_unit_m**2)
+        raw = self.alpha * omega_value + (1.0 - self.alpha) * sigma
+        if self.log_space:
+            result = math.log(raw + _LOG_FLOOR)
+            if self._peer_x.shape[0]:
+                factors = np.hypot(self._peer_x - x0, self._peer_y - x1)
+                factors *= self.lipschitz
+                factors += self.peer_shift
+                factors *= self._negated_peer_scale  # -z
+                factors *= -_SQRT2
+                result += float(np.sum(log_ndtr(factors)))
+            return result
         gamma = 1.0
         if self._peer_x.shape[0]:
             factors = np.hypot(self._peer_x - x0, self._peer_y - x1)
@@ -572,7 +609,7 @@ class _OuterProblem:
             erfc(factors, out=factors)
             factors *= 0.5
             gamma = float(np.multiply.reduce(factors))
-        return (self.alpha * omega_value + (1.0 - self.alpha) * sigma) * gamma
+        return raw * gamma
 
     def values(self, points: np.ndarray) -> np.ndarray:
         """Acquisition (q,) at arbitrary (q, 2) reachable points (paths sampled uniformly)."""
@@ -585,9 +622,7 @@ class _OuterProblem:
         length = np.hypot(offsets[:, 0], offsets[:, 1])
         sigma = length * np.trapezoid(std, u, axis=1)
         sigma *= self.sigma_scale
-        return acquisition(
-            self.alpha, omega(pts, self.expected, self.omega_unit_m), sigma, self.gamma(pts)
-        )
+        return self._combine(omega(pts, self.expected, self.omega_unit_m), sigma, pts)
 
     def grid(self) -> tuple[np.ndarray, np.ndarray]:
         """Candidates (c, 2) on the polar grid of the reachable disk and their values (c,)."""
@@ -605,11 +640,8 @@ class _OuterProblem:
             from_origin=cfg.authors_origin_paths,
         )
         pts = candidates.reshape(-1, 2)
-        values = acquisition(
-            self.alpha,
-            omega(pts, self.expected, self.omega_unit_m),
-            self.sigma_scale * sigma.reshape(-1),
-            self.gamma(pts),
+        values = self._combine(
+            omega(pts, self.expected, self.omega_unit_m), self.sigma_scale * sigma.reshape(-1), pts
         )
         values[~cfg.arena.contains(pts)] = -np.inf
         return pts, values

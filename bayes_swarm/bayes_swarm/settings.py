@@ -179,6 +179,10 @@ class BayesSwarmConfig:
     penalty_estimate: bool = parameter(
         False, 'L and M of the penalty estimated from the belief GP each decision (not in paper)'
     )
+    penalty_log_space: bool = parameter(
+        False,
+        'maximise log(acquisition) + sum log(penalty factors), as GPyOpt (not in the paper)',
+    )
     robot_size_m: float = parameter(0.1, 'l_robot of Algorithm 2', unit='m', gt=0.0)
     n_max: int = parameter(1000, 'N_max: observations kept for the GP after downsampling', ge=1)
     alpha_time_scale: float = parameter(

@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 from bayes_swarm.alpha import AlphaBranch, exploitation_weight, scheduled_alpha
-from bayes_swarm.penalty import local_penalty
+from bayes_swarm.penalty import local_penalty, log_local_penalty
 
 PEER = np.array([[1.0, 1.0]])
 
@@ -50,6 +50,27 @@ def test_penalty_multiplies_over_peers_and_is_one_without_peers():
     )[0]
     assert double == pytest.approx(single**2)
     assert local_penalty(pts, np.zeros((0, 2)), [], [], max_signal=1.2, lipschitz=2.0)[0] == 1.0
+
+
+def test_log_penalty_is_the_log_of_the_penalty_and_stays_finite_where_it_underflows():
+    pts = np.array([[1.0 + d, 1.0] for d in np.linspace(0.0, 1.5, 16)])
+    peers = np.array([[1.0, 1.0], [1.3, 0.8]])
+    args = (pts, peers, np.array([0.4, 0.1]), np.array([0.05, 0.2]))
+    kwargs = {'max_signal': 1.2, 'lipschitz': 2.0}
+    gamma = local_penalty(*args, **kwargs)
+    log_gamma = log_local_penalty(*args, **kwargs)
+    resolved = gamma > 1e-200
+    np.testing.assert_allclose(log_gamma[resolved], np.log(gamma[resolved]), rtol=1e-10, atol=1e-14)
+    # Forty-seven peers deep inside their balls: the product underflows to 0, its log does
+    # not, and it still ranks the points (further from the peers is less penalized).
+    crowd = np.repeat(PEER, 47, axis=0)
+    inside = np.array([[1.0, 1.0], [1.05, 1.0], [1.1, 1.0]])
+    crowd_args = (inside, crowd, np.full(47, 0.0), np.full(47, 1e-3))
+    assert np.all(local_penalty(*crowd_args, **kwargs) == 0.0)
+    logs = log_local_penalty(*crowd_args, **kwargs)
+    assert np.all(np.isfinite(logs))
+    assert np.all(np.diff(logs) > 0)
+    assert log_local_penalty(pts[:1], np.zeros((0, 2)), [], [], **kwargs)[0] == 0.0
 
 
 def test_negated_maximum_as_m_makes_the_penalty_inert():

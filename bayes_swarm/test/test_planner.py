@@ -268,6 +268,13 @@ def test_a_penalty_ball_over_the_whole_arena_stalls_cobyla_and_the_estimate_free
     else:
         assert np.hypot(*(decision.waypoint_m - [0.71, 0.71])) == pytest.approx(1.0, abs=1e-6)
         assert decision.waypoint_m[1] == pytest.approx(0.71, abs=1e-6)  # the first step
+    # In log space (GPyOpt's form) the same ball no longer flattens the objective: log Gamma
+    # falls towards the peer's waypoint, so COBYLA leaves it and a real leg follows.
+    in_logs = _with_data(replace(fixed, penalty_log_space=True), [1.2, 1.2])
+    escaped = in_logs.decide([0.71, 0.71], 50.0)
+    assert escaped.kind is DecisionKind.ACQUISITION
+    assert np.hypot(*(escaped.waypoint_m - [0.71, 0.71])) > 0.5
+    assert np.hypot(*(escaped.waypoint_m - [1.2, 1.2])) > np.hypot(0.49, 0.49)
     estimating = _with_data(replace(fixed, penalty_estimate=True), [1.2, 1.2])
     free = estimating.decide([0.71, 0.71], 50.0)
     assert free.kind is DecisionKind.ACQUISITION
@@ -310,8 +317,13 @@ def test_an_unknown_cobyla_library_is_rejected():
 
 @pytest.mark.parametrize(
     'options',
-    [{}, {'authors_origin_paths': True}, {'dimensionless_acquisition': True}],
-    ids=['paper', 'origin-paths', 'dimensionless'],
+    [
+        {},
+        {'authors_origin_paths': True},
+        {'dimensionless_acquisition': True},
+        {'penalty_log_space': True},
+    ],
+    ids=['paper', 'origin-paths', 'dimensionless', 'log-space'],
 )
 def test_the_single_point_acquisition_equals_the_batch_one(options):
     """COBYLA's objective (value) is the batch acquisition (values) at one point."""
