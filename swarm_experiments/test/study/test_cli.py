@@ -250,9 +250,13 @@ def _cli(tmp_path: Path, *argv: str) -> subprocess.Popen[str]:
 @pytest.mark.slow
 def test_ctrl_c_keeps_the_finished_runs_and_the_same_command_resumes(tmp_path: Path) -> None:
     out = tmp_path / 'out'
+    # 0.4 s a run keeps the study going for about 5 s on two workers, so the Ctrl-C below
+    # lands mid-study even when a loaded machine starves this test's polling for seconds.
     argv = [
         'run',
         'synthetic-slow',
+        '--set',
+        'sleep_s=0.4',
         '--engine',
         'pool',
         '--workers',
@@ -283,6 +287,8 @@ def test_ctrl_c_keeps_the_finished_runs_and_the_same_command_resumes(tmp_path: P
         tmp_path,
         'run',
         'synthetic-slow',
+        '--set',
+        'sleep_s=0.4',
         '--engine',
         'serial',
         '--out',
