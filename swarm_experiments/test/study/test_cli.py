@@ -230,6 +230,13 @@ def test_project_reads_measured_rows_and_prints_the_wall_time(
     assert 'no measured run for 3 configurations: variant=gas, robots=8' in capsys.readouterr().err
 
 
+def _default_sigint() -> None:
+    # A shell without job control starts background jobs with SIGINT ignored, and a Python
+    # started with SIGINT ignored never raises KeyboardInterrupt: give the child the
+    # disposition a terminal's Ctrl-C meets, whatever launched the test run.
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def _cli(tmp_path: Path, *argv: str) -> subprocess.Popen[str]:
     return subprocess.Popen(
         [
@@ -244,6 +251,7 @@ def _cli(tmp_path: Path, *argv: str) -> subprocess.Popen[str]:
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
+        preexec_fn=_default_sigint,
     )
 
 
