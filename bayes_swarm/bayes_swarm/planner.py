@@ -590,26 +590,18 @@ class _OuterProblem:
         ex, ey = x0 - float(self.expected[0]), x1 - float(self.expected[1])
         omega_value = 1.0 / (1.0 + (ex * ex + ey * ey) / self.omega_unit_m**2)
         raw = self.alpha * omega_value + (1.0 - self.alpha) * sigma
+        if not self._peer_x.shape[0]:
+            return math.log(raw + _LOG_FLOOR) if self.log_space else raw
+        factors = np.hypot(self._peer_x - x0, self._peer_y - x1)
+        factors *= self.lipschitz
+        factors += self.peer_shift
+        factors *= self._negated_peer_scale  # -z of every peer
         if self.log_space:
-            result = math.log(raw + _LOG_FLOOR)
-            if self._peer_x.shape[0]:
-                factors = np.hypot(self._peer_x - x0, self._peer_y - x1)
-                factors *= self.lipschitz
-                factors += self.peer_shift
-                factors *= self._negated_peer_scale  # -z
-                factors *= -_SQRT2
-                result += float(np.sum(log_ndtr(factors)))
-            return result
-        gamma = 1.0
-        if self._peer_x.shape[0]:
-            factors = np.hypot(self._peer_x - x0, self._peer_y - x1)
-            factors *= self.lipschitz
-            factors += self.peer_shift
-            factors *= self._negated_peer_scale  # -z
-            erfc(factors, out=factors)
-            factors *= 0.5
-            gamma = float(np.multiply.reduce(factors))
-        return raw * gamma
+            factors *= -_SQRT2  # log gamma = log Phi(sqrt(2) z)
+            return math.log(raw + _LOG_FLOOR) + float(np.sum(log_ndtr(factors)))
+        erfc(factors, out=factors)
+        factors *= 0.5
+        return raw * float(np.multiply.reduce(factors))
 
     def values(self, points: np.ndarray) -> np.ndarray:
         """Acquisition (q,) at arbitrary (q, 2) reachable points (paths sampled uniformly)."""
