@@ -425,15 +425,66 @@ def _report_scaling(page: ReportPage) -> None:
     rows = page.rows
     if rows.empty:
         return
+    by = ['config.solvers', 'config.robots']
     page.add_table(
-        _mean_std(rows, ['config.solvers', 'config.robots']),
+        _mean_std(rows, by),
         title='tau per swarm size and solvers (Fig. 4)',
+        export='tau',
     )
     page.add_text(
         'Paper Fig. 4 (read from the figure, COBYLA / L-BFGS-B): tau falls steeply up to 20 '
         'robots, then stays flat; the median decision time grows with the swarm, about '
         '0.1-1 s on a 4-core Xeon.'
     )
+    cost = (
+        rows.groupby(_with_varied(rows, by), sort=False)
+        .agg(
+            decision_cpu_ms=('metric.finder_decision_cpu_ms', 'median'),
+            mission_cpu_s=('metric.mission_cpu_s', 'mean'),
+            decisions=('metric.decisions', 'mean'),
+        )
+        .reset_index()
+    )
+    page.add_table(
+        cost,
+        title="cost per swarm size: the finder's median decision CPU time (median over runs), "
+        'mission CPU and decisions (means over runs)',
+        export='cost',
+    )
+    _scaling_figure(page, rows)
+    _paired_section(
+        page,
+        'config.solvers',
+        'cobyla/lbfgsb',
+        ['config.robots'],
+        "PSO / L-BFGS-B against the paper's COBYLA / L-BFGS-B, paired by seed",
+    )
+
+
+def _scaling_figure(page: ReportPage, rows: Any) -> None:
+    """tau and decision CPU against swarm size, one line per solver pair (as Fig. 4)."""
+    from matplotlib.figure import Figure
+
+    figure = Figure(figsize=(9.0, 3.6))
+    tau_ax, cpu_ax = figure.subplots(1, 2)
+    for solvers, of_solvers in rows.groupby('config.solvers', sort=False):
+        found = of_solvers[of_solvers['metric.found'].astype(bool)]
+        tau = found.groupby('config.robots')['metric.tau'].agg(['mean', 'std'])
+        tau_ax.errorbar(
+            tau.index, tau['mean'], yerr=tau['std'], marker='o', capsize=3, label=str(solvers)
+        )
+        cpu = of_solvers.groupby('config.robots')['metric.finder_decision_cpu_ms'].median()
+        cpu_ax.plot(cpu.index, cpu.values, marker='o', label=str(solvers))
+    tau_ax.set_xlabel('robots')
+    tau_ax.set_ylabel('tau (mean ± std, found runs)')
+    cpu_ax.set_xlabel('robots')
+    cpu_ax.set_ylabel('median decision CPU [ms]')
+    cpu_ax.set_yscale('log')
+    for ax in (tau_ax, cpu_ax):
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize='small')
+    figure.suptitle('Bayes-Swarm Fig. 4: Case 2, random sources, swarm size', fontsize='small')
+    page.add_figure(figure, 'fig4-scaling', caption='tau and decision CPU against swarm size')
 
 
 # ---------------------------------------------------------------------------- studies

@@ -190,3 +190,42 @@ def test_the_optimizers_report_exports_tau_per_solver_and_the_paired_table(tmp_p
     assert set(tau) == {'cobyla/lbfgsb', 'pso/lbfgsb'}
     assert float(tau['pso/lbfgsb']['mean']) > float(tau['cobyla/lbfgsb']['mean'])
     assert len(page.exports['paired']['rows']) == 1  # PSO against the paper's solvers
+
+
+def test_the_scaling_report_exports_tau_cost_and_pso_against_cobyla_per_size(tmp_path):
+    import pandas as pd
+    from swarm_experiments.study import ReportPage
+
+    from swarm_experiments import bayes_studies
+
+    records = [
+        {
+            'status': 'ok',
+            'seed': seed,
+            'config.solvers': solvers,
+            'config.robots': robots,
+            'metric.found': True,
+            'metric.tau': tau / robots + 0.01 * seed,
+            'metric.tau_censored': tau / robots + 0.01 * seed,
+            'metric.finder_decision_cpu_ms': cpu_ms * robots,
+            'metric.mission_cpu_s': 0.1 * robots,
+            'metric.decisions': 2 * robots,
+        }
+        for seed in range(4)
+        for robots in (5, 10)
+        for solvers, tau, cpu_ms in (('cobyla/lbfgsb', 3.0, 1.0), ('pso/lbfgsb', 4.0, 10.0))
+    ]
+    page = ReportPage(tmp_path, {'study': 'bayes-fig4-scaling'}, pd.DataFrame(records))
+    bayes_studies._report_scaling(page)
+    tau = page.exports['tau']
+    assert len(tau['rows']) == 4
+    columns = page.exports['cost']['columns']
+    cost = {
+        (str(row[0]), int(row[1])): dict(zip(columns, row, strict=True))
+        for row in page.exports['cost']['rows']
+    }
+    assert float(cost[('pso/lbfgsb', 10)]['decision_cpu_ms']) == pytest.approx(100.0)
+    assert float(cost[('cobyla/lbfgsb', 5)]['decision_cpu_ms']) == pytest.approx(5.0)
+    # PSO is paired with the paper's solvers once per swarm size.
+    assert len(page.exports['paired']['rows']) == 2
+    assert (tmp_path / 'figures' / 'fig4-scaling.png').is_file()
