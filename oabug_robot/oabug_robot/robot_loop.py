@@ -302,14 +302,10 @@ class RobotLoop(Generic[_ScanT]):
         features = self._features
         if features is None or not self._fresh(now_s):
             return None
-        snapshot = SensorSnapshot(
-            time_s=now_s,
-            yaw_rad=self._yaw_rad,
-            scan=features,
-            gas_raw=self._gas_raw,
-            bearings=self._bearings,
+        # time_s, yaw_rad, scan, gas_raw, bearings
+        return self.fsm.step(
+            SensorSnapshot(now_s, self._yaw_rad, features, self._gas_raw, self._bearings)
         )
-        return self.fsm.step(snapshot)
 
 
 def _identity(scan: LaserScanData) -> LaserScanData:
