@@ -143,6 +143,12 @@ class BatchRobot:
         return tag_ids.index(self.own_tag) if self.own_tag in tag_ids else -1
 
     @property
+    def scan_frame(self) -> tuple[float, float, float, float]:
+        """The scan message's angle_min, angle_increment, range_min and range_max as the
+        robot receives them (the same for every robot of a mission: one lidar model)."""
+        return self._scan_frame
+
+    @property
     def field_type(self) -> type:
         """The type of the messages' float32 fields as received: np.float32 or np.float64."""
         return self._field_type
@@ -288,6 +294,9 @@ class BatchSwarm:
         for i, robot in enumerate(self.robots):
             by_period.setdefault(robot.timer.period_ns, []).append(i)
         self._timers = [(self.robots[members[0]].timer, members) for members in by_period.values()]
+        frames = {robot.scan_frame for robot in self.robots}
+        #: The scan frame every robot receives, None when they differ.
+        self.scan_frame = frames.pop() if len(frames) == 1 else None
 
     def due(self, now_ns: int) -> list[int]:
         """The robots whose control step runs at ``now_ns``, in index order."""
@@ -307,9 +316,15 @@ def _deliver(engine: SimEngine, out: Any, swarm: BatchSwarm) -> None:
         # The message's float32 values, widened once for every robot's feature extractor.
         ranges_m = out.scans.astype(np.float32).astype(float)
         withheld = out.withheld.get('scan')
-        for i, (robot, ranges) in enumerate(zip(robots, ranges_m, strict=True)):
-            if withheld is None or not withheld[i]:
-                robot.receive_scan(ranges, now_s)
+        frame = swarm.scan_frame
+        if withheld is None and frame is not None:
+            # receive_scan of every robot, the scan built here (one call less per robot).
+            for loop, ranges in zip(loops, ranges_m, strict=True):
+                loop.hold_scan(LaserScanData(ranges, *frame), now_s)
+        else:
+            for i, (robot, ranges) in enumerate(zip(robots, ranges_m, strict=True)):
+                if withheld is None or not withheld[i]:
+                    robot.receive_scan(ranges, now_s)
     if out.gas_raw is not None:
         # The int64 readings as Python ints (what receive_gas makes of them), held directly.
         for loop, raw in zip(loops, out.gas_raw.tolist(), strict=True):
