@@ -190,21 +190,6 @@ class RobotLoop(Generic[_ScanT]):
             name for name, stamp in required if stamp is None or not 0.0 <= now_s - stamp <= timeout
         ]
 
-    def _fresh(self, now_s: float) -> bool:
-        """``not self.stale_inputs(now_s)``, without building the list (every step asks)."""
-        timeout = self.stale_timeout_s
-        stamp = self._features_time_s
-        if stamp is None or not 0.0 <= now_s - stamp <= timeout:
-            return False
-        stamp = self._imu_time_s
-        if stamp is None or not 0.0 <= now_s - stamp <= timeout:
-            return False
-        if self.needs_gas:
-            stamp = self._gas_time_s
-            if stamp is None or not 0.0 <= now_s - stamp <= timeout:
-                return False
-        return True
-
     def _near_peers(self, now_s: float) -> tuple[np.ndarray, np.ndarray]:
         bearings = self._bearings
         if bearings is None or now_s - bearings.stamp_s > self.config.bearing_timeout_s:
@@ -300,8 +285,20 @@ class RobotLoop(Generic[_ScanT]):
         """Step the controller on the held readings; None (no step) while an input is
         missing or stale."""
         features = self._features
-        if features is None or not self._fresh(now_s):
+        if features is None:
             return None
+        # ``not self.stale_inputs(now_s)``, without building the list (every step asks).
+        timeout = self.stale_timeout_s
+        stamp = self._features_time_s
+        if stamp is None or not 0.0 <= now_s - stamp <= timeout:
+            return None
+        stamp = self._imu_time_s
+        if stamp is None or not 0.0 <= now_s - stamp <= timeout:
+            return None
+        if self.needs_gas:
+            stamp = self._gas_time_s
+            if stamp is None or not 0.0 <= now_s - stamp <= timeout:
+                return None
         # time_s, yaw_rad, scan, gas_raw, bearings
         return self.fsm.step(
             SensorSnapshot(now_s, self._yaw_rad, features, self._gas_raw, self._bearings)

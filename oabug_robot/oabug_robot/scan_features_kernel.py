@@ -421,10 +421,11 @@ def select_kernel(
 
     Returns:
         The kept bearings [rad] and distances [m], their (K + 1,) slice bounds, the indices
-        of the finite kept bearings, and the flat (K * B) indices of the rays whose peer
+        of the finite kept bearings, the flat (K * B) indices of the rays whose peer
         window may be read: the returns within the peer mask range that lie within
         ``widest_window`` of a finite kept bearing (the bearing wrapped here with ``%``,
-        within far less than the margin of the wrapped bearing the features use).
+        within far less than the margin of the wrapped bearing the features use), and
+        those rays' ranges [m].
     """
     num_scans, num_rays = ranges.shape
     total = held_azimuths.shape[0]
@@ -433,6 +434,7 @@ def select_kernel(
     start = np.empty(num_scans + 1, dtype=np.int64)
     finite = np.empty(total, dtype=np.int64)
     windows = np.empty(num_scans * num_rays, dtype=np.int64)
+    window_ranges = np.empty(num_scans * num_rays)
     directions = np.empty(total)
     reach = widest_window + 1e-6
     kept = 0
@@ -464,10 +466,18 @@ def select_kernel(
             for f in range(first_finite, num_finite):
                 if _in_window(angles[j], directions[f], reach):
                     windows[num_windows] = k * num_rays + j
+                    window_ranges[num_windows] = r
                     num_windows += 1
                     break
     start[num_scans] = kept
-    return azimuths[:kept], distances[:kept], start, finite[:num_finite], windows[:num_windows]
+    return (
+        azimuths[:kept],
+        distances[:kept],
+        start,
+        finite[:num_finite],
+        windows[:num_windows],
+        window_ranges[:num_windows],
+    )
 
 
 @lru_cache(maxsize=64)
@@ -667,8 +677,9 @@ def _extract(
         return []
     first = scans[0]
     frame = _frame(first)
-    if any(scan[1:] != frame for scan in scans[1:]):  # _frame(scan), inline
-        raise ValueError('the scans must share their angles and range limits')
+    for scan in scans[1:]:
+        if scan[1:] != frame:  # _frame(scan), inline
+            raise ValueError('the scans must share their angles and range limits')
     num_rays = np.shape(first.ranges_m)
     if len(num_rays) != 1 or num_rays[0] == 0:
         msg = f'scans must have at least one range, got shape {num_rays}'
@@ -682,7 +693,7 @@ def _extract(
     range_min = max(float(first.range_min_m), 0.0)
     params, widest_window = _constants(extractor, range_min, float(first.range_max_m))
     # REP 117: -inf means "too close to measure", i.e. an obstacle at range_min.
-    azimuths, distances, start, finite, windows = select_kernel(
+    azimuths, distances, start, finite, windows, window_ranges = select_kernel(
         ranges,
         range_min,
         params[1],
@@ -707,7 +718,7 @@ def _extract(
     half_width = np.full(ranges.size, math.nan)
     if windows.size:
         half_width[windows] = cfg.peer_bearing_tolerance_rad + np.arctan2(
-            cfg.robot_radius_m, ranges.ravel()[windows]
+            cfg.robot_radius_m, window_ranges
         )
     k = len(scans)
     real_out = np.empty((k, 4))
