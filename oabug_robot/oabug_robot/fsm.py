@@ -90,6 +90,9 @@ class Event(Enum):
     RANDOM_TURN = 8
 
 
+# tuple.__new__(cls, fields) builds a named tuple from all its fields without the Python-level
+# __new__ of the class (what its ``_make`` does); the per-step tuples are built so.
+_tuple_new = tuple.__new__
 # The members every step compares with, as module constants (cheaper to look up).
 _NO_EVENT = Event.NONE
 _TURN, _STRAIGHT, _FOLLOW, _WRAP = Mode.TURN, Mode.STRAIGHT, Mode.FOLLOW, Mode.WRAP
@@ -224,7 +227,8 @@ class OABugFsm:
             linear, angular = self._step_bug(snapshot, dt)
         mem.last_linear_mps = linear
         pump = uses_scent and self._pump.update(time_s, linear)
-        return Command(float(linear), float(angular), bool(pump))
+        # Command(float(linear), float(angular), bool(pump)), without the class's __new__.
+        return _tuple_new(Command, (float(linear), float(angular), bool(pump)))
 
     def _step_bug(self, snap: SensorSnapshot, dt_s: float) -> Twist2D:
         # The configuration values are the ones __init__ looked up (every step reads them).

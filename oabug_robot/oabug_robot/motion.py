@@ -114,7 +114,10 @@ def follow_wall(
         fraction = _MIN_FOLLOW_FRACTION
     limit = cfg.turn_rate_radps
     rate = rate if rate < limit else limit  # _clamp(rate, limit)
-    return Twist2D(cfg.forward_speed_mps * fraction, rate if rate > -limit else -limit)
+    # Twist2D(...), without the class's Python-level __new__ (what its _make does).
+    return tuple.__new__(
+        Twist2D, (cfg.forward_speed_mps * fraction, rate if rate > -limit else -limit)
+    )
 
 
 def inner_corner_ahead(front_wall_m: float, cfg: MotionConfig) -> bool:

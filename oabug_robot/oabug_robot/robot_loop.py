@@ -299,9 +299,12 @@ class RobotLoop(Generic[_ScanT]):
             stamp = self._gas_time_s
             if stamp is None or not 0.0 <= now_s - stamp <= timeout:
                 return None
-        # time_s, yaw_rad, scan, gas_raw, bearings
+        # SensorSnapshot(time_s, yaw_rad, scan, gas_raw, bearings), without the class's
+        # Python-level __new__ (what its _make does).
         return self.fsm.step(
-            SensorSnapshot(now_s, self._yaw_rad, features, self._gas_raw, self._bearings)
+            tuple.__new__(
+                SensorSnapshot, (now_s, self._yaw_rad, features, self._gas_raw, self._bearings)
+            )
         )
 
 

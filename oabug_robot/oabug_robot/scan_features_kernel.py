@@ -656,6 +656,9 @@ def extract_held(
 
 
 _NO_ROTATION = np.zeros(0)
+# tuple.__new__(cls, fields) builds a named tuple from all its fields without the Python-level
+# __new__ of the class (what its ``_make`` does).
+_tuple_new = tuple.__new__
 _NO_WALL = SideWall()
 _NO_WALL_RIGHT = SideWall(math.inf, -0.0, False)
 _NO_FEATURES = ScanFeatures()
@@ -737,7 +740,8 @@ def _extract(
         real_out,
         int_out,
     )
-    # The outputs as Python numbers once (the same values), not element by element.
+    # The outputs as Python numbers once (the same values), not element by element; the
+    # named tuples built from their complete field tuples (``_make`` without its checks).
     result = []
     for side, (wall_ahead, robot_ahead, distance, angle), (near, peers, count, abeam) in zip(
         sides, real_out.tolist(), int_out.tolist(), strict=True
@@ -747,9 +751,11 @@ def _extract(
             continue
         left = right = _NO_WALL
         if side > 0 and count:
-            left = SideWall(distance, angle, bool(abeam))
+            left = _tuple_new(SideWall, (distance, angle, bool(abeam)))
         elif side < 0:
             # The extractor mirrors the right side's wall, "no wall" (angle 0.0) too.
-            right = SideWall(distance, -angle, bool(abeam)) if count else _NO_WALL_RIGHT
-        result.append(ScanFeatures(wall_ahead, robot_ahead, left, right, near, peers))
+            right = (
+                _tuple_new(SideWall, (distance, -angle, bool(abeam))) if count else _NO_WALL_RIGHT
+            )
+        result.append(_tuple_new(ScanFeatures, (wall_ahead, robot_ahead, left, right, near, peers)))
     return result
