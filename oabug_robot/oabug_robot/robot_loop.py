@@ -170,9 +170,8 @@ class RobotLoop(Generic[_ScanT]):
         frame [rad] and distances [m, NaN unknown], stamped with the yaw held now (0 before
         the first IMU reading)."""
         yaw = self._yaw_rad if math.isfinite(self._yaw_rad) else 0.0
-        self._bearings = PeerBearings(
-            azimuths_rad=azimuths_rad, distances_m=distances_m, stamp_s=now_s, yaw_at_stamp_rad=yaw
-        )
+        # PeerBearings(azimuths_rad, distances_m, stamp_s, yaw_at_stamp_rad), as in the step.
+        self._bearings = tuple.__new__(PeerBearings, (azimuths_rad, distances_m, now_s, yaw))
 
     # The control step.
 

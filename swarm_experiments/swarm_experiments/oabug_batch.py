@@ -143,7 +143,7 @@ class BatchRobot:
         return tag_ids.index(self.own_tag) if self.own_tag in tag_ids else -1
 
     @property
-    def scan_frame(self) -> tuple[float, float, float, float]:
+    def scan_frame(self) -> tuple[float, ...]:
         """The scan message's angle_min, angle_increment, range_min and range_max as the
         robot receives them (the same for every robot of a mission: one lidar model)."""
         return self._scan_frame
@@ -318,9 +318,10 @@ def _deliver(engine: SimEngine, out: Any, swarm: BatchSwarm) -> None:
         withheld = out.withheld.get('scan')
         frame = swarm.scan_frame
         if withheld is None and frame is not None:
-            # receive_scan of every robot, the scan built here (one call less per robot).
+            # receive_scan of every robot, the scan built here (one call less per robot;
+            # LaserScanData(ranges, *frame) without the class's Python-level __new__).
             for loop, ranges in zip(loops, ranges_m, strict=True):
-                loop.hold_scan(LaserScanData(ranges, *frame), now_s)
+                loop.hold_scan(tuple.__new__(LaserScanData, (ranges, *frame)), now_s)
         else:
             for i, (robot, ranges) in enumerate(zip(robots, ranges_m, strict=True)):
                 if withheld is None or not withheld[i]:
