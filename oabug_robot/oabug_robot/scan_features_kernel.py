@@ -215,7 +215,8 @@ def side_wall_fit(
 @njit(cache=True)
 def features_kernel(
     ranges: np.ndarray,
-    half_width: np.ndarray,
+    windows: np.ndarray,
+    window_half_width: np.ndarray,
     angles: np.ndarray,
     cos_t: np.ndarray,
     sin_t: np.ndarray,
@@ -231,8 +232,11 @@ def features_kernel(
 
     Args:
         ranges: (K, B) ranges [m], -inf already replaced by range_min.
-        half_width: (K, B) angular half width of a peer's window at each range [rad], read
-            only where the range is within the peer mask range.
+        windows: the flat (K * B) indices of the rays whose peer window may be read (the
+            returns within the peer mask range near a bearing); every other ray is in no
+            peer's window.
+        window_half_width: the angular half width of a peer's window at those rays'
+            ranges [rad].
         angles, cos_t, sin_t: (B,) ray directions in the robot frame.
         bearing_start: (K + 1,) slice bounds of each scan's peers in ``bearing``.
         bearing: (T,) peer bearings wrapped to [-pi, pi] [rad]; NaN to skip.
@@ -271,6 +275,10 @@ def features_kernel(
     ) = params
     body = 2.0 * radius
     num_scans, num_rays = ranges.shape
+    # NaN: no window (a ray this far from every bearing is in none).
+    half_width = np.full((num_scans, num_rays), np.nan)
+    for w in range(windows.shape[0]):
+        half_width[windows[w] // num_rays, windows[w] % num_rays] = window_half_width[w]
     index = np.empty(num_rays, dtype=np.int64)
     is_peer = np.empty(num_rays, dtype=np.bool_)
     xs = np.empty(num_rays)
@@ -717,18 +725,16 @@ def _extract(
         bearing = np.full(azimuths.size, math.nan)
         finite_azimuths = azimuths[finite]
         bearing[finite] = np.arctan2(np.sin(finite_azimuths), np.cos(finite_azimuths))
-    # NaN: no window (a ray this far from every bearing is in none).
-    half_width = np.full(ranges.size, math.nan)
-    if windows.size:
-        half_width[windows] = cfg.peer_bearing_tolerance_rad + np.arctan2(
-            cfg.robot_radius_m, window_ranges
-        )
+    window_half_width = cfg.peer_bearing_tolerance_rad + np.arctan2(
+        cfg.robot_radius_m, window_ranges
+    )
     k = len(scans)
     real_out = np.empty((k, 4))
     int_out = np.empty((k, 4), dtype=np.int64)
     features_kernel(
         ranges,
-        half_width.reshape(ranges.shape),
+        windows,
+        window_half_width,
         angles,
         cos_t,
         sin_t,
