@@ -347,8 +347,9 @@ def _deliver(engine: SimEngine, out: Any, swarm: BatchSwarm) -> None:
         return
     # A robot's control step reads only its own readings and controller, so the scan
     # features of every robot due can be computed first, all at once.
-    extract_features([loops[i] for i in due], now_s)
-    commands = [loops[i].command(now_s) for i in due]
+    due_loops = loops if len(due) == len(loops) else [loops[i] for i in due]
+    extract_features(due_loops, now_s)
+    commands = [loop.command(now_s) for loop in due_loops]
     engine.set_commands(
         due,
         [(command.linear_mps, command.angular_radps) for command in commands],
@@ -362,8 +363,12 @@ def _deliver_bearings(
     """:meth:`BatchRobot.receive_bearings` for every robot, each conversion done once for
     all (every robot's messages have the same field types) on the cycle's flat arrays."""
     field = robots[0].field_type
-    azimuths = cycle.azimuth_rad.astype(field).astype(float)
-    distances = cycle.distance_m.astype(field).astype(float)
+    if field is np.float64:  # one copy of the float64 values (rounding them is a no-op)
+        azimuths = cycle.azimuth_rad.astype(float)
+        distances = cycle.distance_m.astype(float)
+    else:
+        azimuths = cycle.azimuth_rad.astype(field).astype(float)
+        distances = cycle.distance_m.astype(field).astype(float)
     bounds = cycle.bounds
     keep = cycle.tags != own_tags[cycle.receivers]
     if np.count_nonzero(keep) < keep.size:  # not keep.all(), a cheaper call
