@@ -30,6 +30,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 from enum import Enum
+from typing import NamedTuple
 
 import numpy as np
 
@@ -39,7 +40,6 @@ from oabug_robot.motion import (
     Twist2D,
     follow_wall,
     go_straight,
-    inner_corner_ahead,
     turn_in_place,
     wrap_corner,
 )
@@ -90,9 +90,18 @@ class Event(Enum):
     RANDOM_TURN = 8
 
 
-@dataclass(frozen=True)
-class SensorSnapshot:
-    """Everything the controller reads in one control step.
+# tuple.__new__(cls, fields) builds a named tuple from all its fields without the Python-level
+# __new__ of the class (what its ``_make`` does); the per-step tuples are built so.
+_tuple_new = tuple.__new__
+# The members every step compares with, as module constants (cheaper to look up).
+_NO_EVENT = Event.NONE
+_TURN, _STRAIGHT, _FOLLOW, _WRAP = Mode.TURN, Mode.STRAIGHT, Mode.FOLLOW, Mode.WRAP
+_JUST_STARTED = FsmState.JUST_STARTED
+
+
+class SensorSnapshot(NamedTuple):
+    """Everything the controller reads in one control step (a named tuple: one is built per
+    robot and step, several times faster than a frozen dataclass).
 
     Attributes:
         time_s: current time [s] (sim time in simulation).
@@ -109,9 +118,9 @@ class SensorSnapshot:
     bearings: PeerBearings | None = None
 
 
-@dataclass(frozen=True)
-class Command:
-    """Output of one control step: velocity and pump."""
+class Command(NamedTuple):
+    """Output of one control step: velocity and pump (a named tuple, as
+    :class:`SensorSnapshot`)."""
 
     linear_mps: float
     angular_radps: float
@@ -166,6 +175,17 @@ class OABugFsm:
         self._uses_scent = config.variant.uses_scent
         self._random = config.variant is Variant.RANDOM
         self._gas_threshold = config.gas_threshold
+        perception, motion = config.perception, config.motion
+        self._motion = motion
+        self._wall_hit_m = perception.wall_hit_distance_m
+        self._robot_hit_m = perception.robot_hit_distance_m
+        self._wrap_stop_m = perception.wrap_stop_distance_m
+        self._body_radius_m = perception.robot_radius_m
+        self._heading_tolerance_rad = motion.heading_tolerance_rad
+        self._wrap_done_rad = math.pi / 2 - motion.heading_tolerance_rad
+        # inner_corner_ahead(front, motion) is: self._arcs and front <= self._arc_start_m.
+        self._arcs = motion.inner_corner_arc_radius_m > 0.0
+        self._arc_start_m = motion.wall_distance_m + motion.inner_corner_arc_radius_m
 
     @property
     def config(self) -> OABugConfig:
@@ -184,88 +204,103 @@ class OABugFsm:
     def step(self, snapshot: SensorSnapshot) -> Command:
         """Advance one control step and return the command to apply until the next one."""
         mem = self._memory
-        mem.event = Event.NONE
+        mem.event = _NO_EVENT
+        time_s = snapshot.time_s
         if mem.started_s is None:
-            mem.started_s = snapshot.time_s
+            mem.started_s = time_s
             self._record(Event.START)
-        dt = 0.0 if mem.last_step_s is None else snapshot.time_s - mem.last_step_s
-        mem.last_step_s = snapshot.time_s
+        last = mem.last_step_s
+        dt = 0.0 if last is None else time_s - last
+        mem.last_step_s = time_s
+        # min(max(dt, 0.0), _MAX_STEP_S), written out (NaN stays NaN as there).
+        if dt < 0.0:
+            dt = 0.0
+        elif dt > _MAX_STEP_S:
+            dt = _MAX_STEP_S
         gas = snapshot.gas_raw
         uses_scent = self._uses_scent
         if uses_scent and gas is not None and gas >= self._gas_threshold:
-            mem.last_scent_s = snapshot.time_s
+            mem.last_scent_s = time_s
         if self._random:
-            twist = self._step_random(snapshot, min(max(dt, 0.0), _MAX_STEP_S))
+            linear, angular = self._step_random(snapshot, dt)
         else:
-            twist = self._step_bug(snapshot, min(max(dt, 0.0), _MAX_STEP_S))
-        mem.last_linear_mps = twist.linear_mps
-        pump = uses_scent and self._pump.update(snapshot.time_s, twist.linear_mps)
-        return Command(float(twist.linear_mps), float(twist.angular_radps), bool(pump))
+            linear, angular = self._step_bug(snapshot, dt)
+        mem.last_linear_mps = linear
+        pump = uses_scent and self._pump.update(time_s, linear)
+        # Command(float(linear), float(angular), bool(pump)), without the class's __new__.
+        return _tuple_new(Command, (float(linear), float(angular), bool(pump)))
 
     def _step_bug(self, snap: SensorSnapshot, dt_s: float) -> Twist2D:
+        # The configuration values are the ones __init__ looked up (every step reads them).
         mem = self._memory
-        cfg = self._config
+        motion = self._motion
         scan = snap.scan
-        front_blocked = scan.front_wall_m <= cfg.perception.wall_hit_distance_m
+        yaw = snap.yaw_rad
+        front_wall_m = scan.front_wall_m
+        front_blocked = front_wall_m <= self._wall_hit_m
+        # A wall ahead at an inner corner (inner_corner_ahead), or one blocking the way.
+        corner_ahead = front_blocked or (self._arcs and front_wall_m <= self._arc_start_m)
         yaw_change = 0.0
-        if mem.previous_yaw_rad is not None:
-            yaw_change = angle_difference(snap.yaw_rad, mem.previous_yaw_rad)
-        mem.previous_yaw_rad = snap.yaw_rad
-        mem.driven_since_wrap_m += mem.last_linear_mps * max(dt_s, 0.0)
+        previous = mem.previous_yaw_rad
+        if previous is not None:
+            yaw_change = wrap_angle(yaw - previous)  # angle_difference(yaw, previous)
+        mem.previous_yaw_rad = yaw
+        mem.driven_since_wrap_m += mem.last_linear_mps * dt_s  # dt_s >= 0 (or NaN)
         # Only a robot that drives can hit another: not while it turns on the spot (to a
         # heading, or away from a wall at an inner corner).
-        driving = mem.mode is not Mode.TURN and not (mem.mode is Mode.FOLLOW and front_blocked)
-        if driving and scan.front_robot_m <= cfg.perception.robot_hit_distance_m:
+        mode = mem.mode
+        driving = mode is not _TURN and not (mode is _FOLLOW and front_blocked)
+        if driving and scan.front_robot_m <= self._robot_hit_m:
             self._on_hit_robot(snap)
-        if mem.mode is Mode.TURN:
-            error = angle_difference(mem.target_yaw_rad, snap.yaw_rad)
-            if abs(error) > cfg.motion.heading_tolerance_rad:
-                return turn_in_place(error, cfg.motion)
-            mem.mode = Mode.STRAIGHT
-        if mem.mode is Mode.STRAIGHT:
+            mode = mem.mode
+        if mode is _TURN:
+            error = wrap_angle(mem.target_yaw_rad - yaw)
+            if abs(error) > self._heading_tolerance_rad:
+                return turn_in_place(error, motion)
+            mem.mode = mode = _STRAIGHT
+        if mode is _STRAIGHT:
             if not front_blocked:
-                error = angle_difference(mem.target_yaw_rad, snap.yaw_rad)
-                return go_straight(error, cfg.motion)
+                return go_straight(wrap_angle(mem.target_yaw_rad - yaw), motion)
             self._on_hit_wall(snap)
-        elif mem.mode is Mode.WRAP:
-            turned = mem.wall_side * angle_difference(snap.yaw_rad, mem.wrap_start_yaw_rad)
-            wrap_blocked = scan.front_wall_m <= cfg.perception.wrap_stop_distance_m
-            if wrap_blocked or turned >= math.pi / 2 - cfg.motion.heading_tolerance_rad:
-                mem.mode = Mode.FOLLOW
+        elif mode is _WRAP:
+            turned = mem.wall_side * wrap_angle(yaw - mem.wrap_start_yaw_rad)
+            wrap_blocked = front_wall_m <= self._wrap_stop_m
+            if wrap_blocked or turned >= self._wrap_done_rad:
+                mem.mode = _FOLLOW
                 mem.driven_since_wrap_m = 0.0
             else:
-                return wrap_corner(mem.wall_side, cfg.motion)
-        elif front_blocked or inner_corner_ahead(scan.front_wall_m, cfg.motion):
+                return wrap_corner(mem.wall_side, motion)
+        elif corner_ahead:
             # Turning away from an inner corner swings the old wall out of the abeam strip
             # before the new one comes in: that is no outer corner.
             self._corners.reset()
             mem.driven_since_wrap_m = math.inf
-            if mem.state is FsmState.JUST_STARTED and cfg.inner_corner_resumes_following:
+            if mem.state is _JUST_STARTED and self._config.inner_corner_resumes_following:
                 self._on_inner_corner_after_revisit()
-        elif self._corners.update(scan.side(mem.wall_side)):
-            if mem.driven_since_wrap_m <= cfg.wall_end_face_m:
+        elif self._corners.update(scan.left if mem.wall_side > 0 else scan.right):
+            if mem.driven_since_wrap_m <= self._config.wall_end_face_m:
                 # The end face of a thin wall: still the same wall end, keep wrapping.
                 self._wrap(snap)
             else:
                 self._on_outer_corner(snap)
-            if mem.mode is Mode.TURN:
-                error = angle_difference(mem.target_yaw_rad, snap.yaw_rad)
-                return turn_in_place(error, cfg.motion)
-            if mem.mode is Mode.WRAP:  # type: ignore[comparison-overlap]  # set by _wrap
-                return wrap_corner(mem.wall_side, cfg.motion)
-        wall = scan.side(mem.wall_side)
-        corner_ahead = front_blocked or inner_corner_ahead(scan.front_wall_m, cfg.motion)
-        if mem.mode is Mode.FOLLOW and self._wall_lost(wall.found, corner_ahead, yaw_change):
+            if mem.mode is _TURN:
+                return turn_in_place(wrap_angle(mem.target_yaw_rad - yaw), motion)
+            if mem.mode is _WRAP:
+                return wrap_corner(mem.wall_side, motion)
+        side = mem.wall_side
+        wall = scan.left if side > 0 else scan.right  # scan.side(side)
+        if mem.mode is _FOLLOW and self._wall_lost(
+            math.isfinite(wall.distance_m), corner_ahead, yaw_change
+        ):
             self._leave_wall(mem.preferred_direction_rad, Event.LEAVE_WALL)
-            error = angle_difference(mem.target_yaw_rad, snap.yaw_rad)
-            return turn_in_place(error, cfg.motion)
+            return turn_in_place(wrap_angle(mem.target_yaw_rad - yaw), motion)
         return follow_wall(
-            mem.wall_side,
+            side,
             wall,
             front_blocked,
-            cfg.motion,
-            front_wall_m=scan.front_wall_m,
-            body_radius_m=cfg.perception.robot_radius_m,
+            motion,
+            front_wall_m=front_wall_m,
+            body_radius_m=self._body_radius_m,
         )
 
     def _wall_lost(self, wall_found: bool, front_blocked: bool, yaw_change_rad: float) -> bool:

@@ -25,6 +25,7 @@ bit-identical (``test_scan_features_kernel.py`` compares them on random scans wi
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Callable, Sequence
 from functools import lru_cache
@@ -214,7 +215,8 @@ def side_wall_fit(
 @njit(cache=True)
 def features_kernel(
     ranges: np.ndarray,
-    half_width: np.ndarray,
+    windows: np.ndarray,
+    window_half_width: np.ndarray,
     angles: np.ndarray,
     cos_t: np.ndarray,
     sin_t: np.ndarray,
@@ -230,8 +232,11 @@ def features_kernel(
 
     Args:
         ranges: (K, B) ranges [m], -inf already replaced by range_min.
-        half_width: (K, B) angular half width of a peer's window at each range [rad], read
-            only where the range is within the peer mask range.
+        windows: the flat (K * B) indices of the rays whose peer window may be read (the
+            returns within the peer mask range near a bearing); every other ray is in no
+            peer's window.
+        window_half_width: the angular half width of a peer's window at those rays'
+            ranges [rad].
         angles, cos_t, sin_t: (B,) ray directions in the robot frame.
         bearing_start: (K + 1,) slice bounds of each scan's peers in ``bearing``.
         bearing: (T,) peer bearings wrapped to [-pi, pi] [rad]; NaN to skip.
@@ -270,6 +275,10 @@ def features_kernel(
     ) = params
     body = 2.0 * radius
     num_scans, num_rays = ranges.shape
+    # NaN: no window (a ray this far from every bearing is in none).
+    half_width = np.full((num_scans, num_rays), np.nan)
+    for w in range(windows.shape[0]):
+        half_width[windows[w] // num_rays, windows[w] % num_rays] = window_half_width[w]
     index = np.empty(num_rays, dtype=np.int64)
     is_peer = np.empty(num_rays, dtype=np.bool_)
     xs = np.empty(num_rays)
@@ -420,10 +429,11 @@ def select_kernel(
 
     Returns:
         The kept bearings [rad] and distances [m], their (K + 1,) slice bounds, the indices
-        of the finite kept bearings, and the flat (K * B) indices of the rays whose peer
+        of the finite kept bearings, the flat (K * B) indices of the rays whose peer
         window may be read: the returns within the peer mask range that lie within
         ``widest_window`` of a finite kept bearing (the bearing wrapped here with ``%``,
-        within far less than the margin of the wrapped bearing the features use).
+        within far less than the margin of the wrapped bearing the features use), and
+        those rays' ranges [m].
     """
     num_scans, num_rays = ranges.shape
     total = held_azimuths.shape[0]
@@ -432,6 +442,7 @@ def select_kernel(
     start = np.empty(num_scans + 1, dtype=np.int64)
     finite = np.empty(total, dtype=np.int64)
     windows = np.empty(num_scans * num_rays, dtype=np.int64)
+    window_ranges = np.empty(num_scans * num_rays)
     directions = np.empty(total)
     reach = widest_window + 1e-6
     kept = 0
@@ -463,10 +474,18 @@ def select_kernel(
             for f in range(first_finite, num_finite):
                 if _in_window(angles[j], directions[f], reach):
                     windows[num_windows] = k * num_rays + j
+                    window_ranges[num_windows] = r
                     num_windows += 1
                     break
     start[num_scans] = kept
-    return azimuths[:kept], distances[:kept], start, finite[:num_finite], windows[:num_windows]
+    return (
+        azimuths[:kept],
+        distances[:kept],
+        start,
+        finite[:num_finite],
+        windows[:num_windows],
+        window_ranges[:num_windows],
+    )
 
 
 @lru_cache(maxsize=64)
@@ -506,8 +525,10 @@ def _constants(
     return params, widest
 
 
-def _frame(scan: LaserScanData) -> tuple[float, float, float, float]:
-    return (scan.angle_min_rad, scan.angle_increment_rad, scan.range_min_m, scan.range_max_m)
+def _frame(scan: LaserScanData) -> tuple[float, ...]:
+    # angle_min_rad, angle_increment_rad, range_min_m, range_max_m (a tuple slice is cheaper
+    # than four attribute reads)
+    return scan[1:]
 
 
 def extract_many(
@@ -618,9 +639,11 @@ def extract_held(
     if not len(scans) == len(held) == len(sides):
         msg = f'{len(scans)} scans, {len(held)} peer sets and {len(sides)} sides'
         raise ValueError(msg)
-    counts = [0 if h is None else len(h[0]) for h in held]
-    start = np.zeros(len(held) + 1, dtype=np.int64)
-    np.cumsum(counts, out=start[1:])
+    # The bounds of each scan's bearings (a cumulative sum in Python: numpy's cumsum of a
+    # short list costs more than the list).
+    start = np.array(
+        [0, *itertools.accumulate(0 if h is None else len(h[0]) for h in held)], dtype=np.int64
+    )
     rotation = np.array([0.0 if h is None else h[2] for h in held])
     if start[-1]:
         present = [h for h in held if h is not None]
@@ -641,6 +664,9 @@ def extract_held(
 
 
 _NO_ROTATION = np.zeros(0)
+# tuple.__new__(cls, fields) builds a named tuple from all its fields without the Python-level
+# __new__ of the class (what its ``_make`` does).
+_tuple_new = tuple.__new__
 _NO_WALL = SideWall()
 _NO_WALL_RIGHT = SideWall(math.inf, -0.0, False)
 _NO_FEATURES = ScanFeatures()
@@ -662,8 +688,9 @@ def _extract(
         return []
     first = scans[0]
     frame = _frame(first)
-    if any(_frame(scan) != frame for scan in scans[1:]):
-        raise ValueError('the scans must share their angles and range limits')
+    for scan in scans[1:]:
+        if scan[1:] != frame:  # _frame(scan), inline
+            raise ValueError('the scans must share their angles and range limits')
     num_rays = np.shape(first.ranges_m)
     if len(num_rays) != 1 or num_rays[0] == 0:
         msg = f'scans must have at least one range, got shape {num_rays}'
@@ -677,7 +704,7 @@ def _extract(
     range_min = max(float(first.range_min_m), 0.0)
     params, widest_window = _constants(extractor, range_min, float(first.range_max_m))
     # REP 117: -inf means "too close to measure", i.e. an obstacle at range_min.
-    azimuths, distances, start, finite, windows = select_kernel(
+    azimuths, distances, start, finite, windows, window_ranges = select_kernel(
         ranges,
         range_min,
         params[1],
@@ -698,18 +725,16 @@ def _extract(
         bearing = np.full(azimuths.size, math.nan)
         finite_azimuths = azimuths[finite]
         bearing[finite] = np.arctan2(np.sin(finite_azimuths), np.cos(finite_azimuths))
-    # NaN: no window (a ray this far from every bearing is in none).
-    half_width = np.full(ranges.size, math.nan)
-    if windows.size:
-        half_width[windows] = cfg.peer_bearing_tolerance_rad + np.arctan2(
-            cfg.robot_radius_m, ranges.ravel()[windows]
-        )
+    window_half_width = cfg.peer_bearing_tolerance_rad + np.arctan2(
+        cfg.robot_radius_m, window_ranges
+    )
     k = len(scans)
     real_out = np.empty((k, 4))
     int_out = np.empty((k, 4), dtype=np.int64)
     features_kernel(
         ranges,
-        half_width.reshape(ranges.shape),
+        windows,
+        window_half_width,
         angles,
         cos_t,
         sin_t,
@@ -721,7 +746,8 @@ def _extract(
         real_out,
         int_out,
     )
-    # The outputs as Python numbers once (the same values), not element by element.
+    # The outputs as Python numbers once (the same values), not element by element; the
+    # named tuples built from their complete field tuples (``_make`` without its checks).
     result = []
     for side, (wall_ahead, robot_ahead, distance, angle), (near, peers, count, abeam) in zip(
         sides, real_out.tolist(), int_out.tolist(), strict=True
@@ -731,9 +757,11 @@ def _extract(
             continue
         left = right = _NO_WALL
         if side > 0 and count:
-            left = SideWall(distance, angle, bool(abeam))
+            left = _tuple_new(SideWall, (distance, angle, bool(abeam)))
         elif side < 0:
             # The extractor mirrors the right side's wall, "no wall" (angle 0.0) too.
-            right = SideWall(distance, -angle, bool(abeam)) if count else _NO_WALL_RIGHT
-        result.append(ScanFeatures(wall_ahead, robot_ahead, left, right, near, peers))
+            right = (
+                _tuple_new(SideWall, (distance, -angle, bool(abeam))) if count else _NO_WALL_RIGHT
+            )
+        result.append(_tuple_new(ScanFeatures, (wall_ahead, robot_ahead, left, right, near, peers)))
     return result

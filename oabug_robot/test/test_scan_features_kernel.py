@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import dataclasses
 import math
 
 import numpy as np
@@ -144,10 +143,10 @@ def test_bad_batches_are_refused() -> None:
     good = _scan(np.ones(360))
     with pytest.raises(ScanError):
         extract_many(extractor, [_scan(np.zeros(0))], [(np.zeros(0), None)], [0])
-    bad_angles = dataclasses.replace(good, angle_min_rad=math.nan)
+    bad_angles = good._replace(angle_min_rad=math.nan)
     with pytest.raises(ScanError):
         extract_many(extractor, [bad_angles], [(np.zeros(0), None)], [0])
-    other = dataclasses.replace(good, range_max_m=6.0)
+    other = good._replace(range_max_m=6.0)
     with pytest.raises(ValueError, match='share'):
         extract_many(extractor, [good, other], [(np.zeros(0), None)] * 2, [0, 0])
     with pytest.raises(ValueError, match='sides'):

@@ -143,6 +143,12 @@ class BatchRobot:
         return tag_ids.index(self.own_tag) if self.own_tag in tag_ids else -1
 
     @property
+    def scan_frame(self) -> tuple[float, ...]:
+        """The scan message's angle_min, angle_increment, range_min and range_max as the
+        robot receives them (the same for every robot of a mission: one lidar model)."""
+        return self._scan_frame
+
+    @property
     def field_type(self) -> type:
         """The type of the messages' float32 fields as received: np.float32 or np.float64."""
         return self._field_type
@@ -288,6 +294,9 @@ class BatchSwarm:
         for i, robot in enumerate(self.robots):
             by_period.setdefault(robot.timer.period_ns, []).append(i)
         self._timers = [(self.robots[members[0]].timer, members) for members in by_period.values()]
+        frames = {robot.scan_frame for robot in self.robots}
+        #: The scan frame every robot receives, None when they differ.
+        self.scan_frame = frames.pop() if len(frames) == 1 else None
 
     def due(self, now_ns: int) -> list[int]:
         """The robots whose control step runs at ``now_ns``, in index order."""
@@ -307,9 +316,16 @@ def _deliver(engine: SimEngine, out: Any, swarm: BatchSwarm) -> None:
         # The message's float32 values, widened once for every robot's feature extractor.
         ranges_m = out.scans.astype(np.float32).astype(float)
         withheld = out.withheld.get('scan')
-        for i, (robot, ranges) in enumerate(zip(robots, ranges_m, strict=True)):
-            if withheld is None or not withheld[i]:
-                robot.receive_scan(ranges, now_s)
+        frame = swarm.scan_frame
+        if withheld is None and frame is not None:
+            # receive_scan of every robot, the scan built here (one call less per robot;
+            # LaserScanData(ranges, *frame) without the class's Python-level __new__).
+            for loop, ranges in zip(loops, ranges_m, strict=True):
+                loop.hold_scan(tuple.__new__(LaserScanData, (ranges, *frame)), now_s)
+        else:
+            for i, (robot, ranges) in enumerate(zip(robots, ranges_m, strict=True)):
+                if withheld is None or not withheld[i]:
+                    robot.receive_scan(ranges, now_s)
     if out.gas_raw is not None:
         # The int64 readings as Python ints (what receive_gas makes of them), held directly.
         for loop, raw in zip(loops, out.gas_raw.tolist(), strict=True):
@@ -331,8 +347,9 @@ def _deliver(engine: SimEngine, out: Any, swarm: BatchSwarm) -> None:
         return
     # A robot's control step reads only its own readings and controller, so the scan
     # features of every robot due can be computed first, all at once.
-    extract_features([loops[i] for i in due], now_s)
-    commands = [loops[i].command(now_s) for i in due]
+    due_loops = loops if len(due) == len(loops) else [loops[i] for i in due]
+    extract_features(due_loops, now_s)
+    commands = [loop.command(now_s) for loop in due_loops]
     engine.set_commands(
         due,
         [(command.linear_mps, command.angular_radps) for command in commands],
@@ -346,11 +363,15 @@ def _deliver_bearings(
     """:meth:`BatchRobot.receive_bearings` for every robot, each conversion done once for
     all (every robot's messages have the same field types) on the cycle's flat arrays."""
     field = robots[0].field_type
-    azimuths = cycle.azimuth_rad.astype(field).astype(float)
-    distances = cycle.distance_m.astype(field).astype(float)
+    if field is np.float64:  # one copy of the float64 values (rounding them is a no-op)
+        azimuths = cycle.azimuth_rad.astype(float)
+        distances = cycle.distance_m.astype(float)
+    else:
+        azimuths = cycle.azimuth_rad.astype(field).astype(float)
+        distances = cycle.distance_m.astype(field).astype(float)
     bounds = cycle.bounds
     keep = cycle.tags != own_tags[cycle.receivers]
-    if not keep.all():
+    if np.count_nonzero(keep) < keep.size:  # not keep.all(), a cheaper call
         # Kept before each report's first entry: the bounds in the filtered arrays.
         bounds = np.concatenate(([0], np.cumsum(keep)))[bounds].tolist()
         azimuths, distances = azimuths[keep], distances[keep]

@@ -150,50 +150,77 @@ def wrap_sum_kernel(a_rad: np.ndarray, b_rad: np.ndarray) -> np.ndarray:  # prag
 def heard_pairs_kernel(
     receiver: np.ndarray,
     transmitter: np.ndarray,
+    delta_m: np.ndarray,
     distance_m: np.ndarray,
-    reach_m: np.ndarray,
+    walls_crossed: np.ndarray,
+    reach_table_m: np.ndarray,
     range_m: float,
     uniform: np.ndarray,
     dropout_probability: float,
     sequence: np.ndarray,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:  # pragma: no cover - compiled
+    yaw_rad: np.ndarray,
+) -> tuple:  # pragma: no cover - compiled
     """The sight lines a locator cycle hears, ``BearingModel._cycle``'s selection: within
     ``range_m`` and the line's reach, and not dropped (a uniform draw at least the dropout
-    probability, when it is not 0).
+    probability, when it is not 0); and what the reports need of them.
 
     Args:
         receiver, transmitter: (L,) the lines' robots, receivers ascending.
+        delta_m: (L, 2) the offsets from receiver to transmitter [m].
         distance_m: (L,) their lengths [m].
-        reach_m: (L,) the range left after the walls each crosses [m].
+        walls_crossed: (L,) the walls each line crosses.
+        reach_table_m: per number of walls crossed (at least the largest in
+            ``walls_crossed``), the range left [m].
         range_m: the line-of-sight range [m].
         uniform: (L,) the dropout draws (read only with a dropout probability).
         dropout_probability: chance that one report is lost.
         sequence: (N, N) per receiver and tag, the report counter; the heard ones advance
             (modulo 65536).
+        yaw_rad: (N,) every robot's yaw [rad].
 
     Returns:
-        The indices of the heard lines, their new sequence numbers, and the (N + 1,) slice
+        Of the K heard lines: receivers, transmitters, offsets along y and x [m], lengths
+        [m], the receivers' yaws [rad] and the new sequence numbers; and the (N + 1,) slice
         bounds of each receiver's among them.
     """
     lines = receiver.shape[0]
     n = sequence.shape[0]
-    heard = np.empty(lines, dtype=np.int64)
+    rx = np.empty(lines, dtype=np.int64)
+    tx = np.empty(lines, dtype=np.int64)
+    dy = np.empty(lines)
+    dx = np.empty(lines)
+    dist = np.empty(lines)
+    rx_yaw = np.empty(lines)
     numbers = np.empty(lines, dtype=np.int64)
     bounds = np.zeros(n + 1, dtype=np.int64)
     count = 0
     for line in range(lines):
         d = distance_m[line]
-        if not (d <= range_m and d <= reach_m[line]):
+        if not (d <= range_m and d <= reach_table_m[walls_crossed[line]]):
             continue
         if dropout_probability > 0.0 and not uniform[line] >= dropout_probability:
             continue
         i = receiver[line]
         j = transmitter[line]
         sequence[i, j] = (sequence[i, j] + 1) % 65536
-        heard[count] = line
+        rx[count] = i
+        tx[count] = j
+        dy[count] = delta_m[line, 1]
+        dx[count] = delta_m[line, 0]
+        dist[count] = d
+        rx_yaw[count] = yaw_rad[i]
         numbers[count] = sequence[i, j]
         bounds[i + 1] += 1
         count += 1
     for i in range(n):
         bounds[i + 1] += bounds[i]
-    return heard[:count], numbers[:count], bounds
+    return (
+        rx[:count],
+        tx[:count],
+        dy[:count],
+        dx[:count],
+        dist[:count],
+        rx_yaw[:count],
+        numbers[:count],
+        bounds,
+    )

@@ -173,19 +173,21 @@ class BearingModel:
         uniform = dist
         if cfg.dropout_probability > 0.0:
             uniform = self._rng.random(len(rx))
-        heard, sequence, bounds = heard_pairs_kernel(
+        rx, tx, dy, dx, dist, rx_yaw, sequence, bounds = heard_pairs_kernel(
             rx,
             tx,
+            delta,
             dist,
-            self._reach_m(walls),
+            walls,
+            self._reach_table_for(walls),
             cfg.range_m,
             uniform,
             cfg.dropout_probability,
             self._sequence,
+            poses[:, 2],
         )
-        rx, tx, delta, dist = rx[heard], tx[heard], delta[heard], dist[heard]
         k = len(rx)
-        azimuth = np.arctan2(delta[:, 1], delta[:, 0]) - poses[rx, 2]
+        azimuth = np.arctan2(dy, dx) - rx_yaw
         azimuth = wrap_sum_kernel(azimuth, self._rng.normal(0.0, cfg.azimuth_noise_std_rad, k))
         elevation = self._rng.normal(0.0, cfg.elevation_noise_std_rad, k)
         distance = dist * np.exp(self._rng.normal(0.0, cfg.distance_noise_fraction, k))
@@ -199,13 +201,14 @@ class BearingModel:
             bounds=bounds.tolist(),
         )
 
-    def _reach_m(self, walls_crossed: np.ndarray) -> np.ndarray:
-        """:meth:`effective_range_m` by table: the same numpy values for every count of
-        walls (numpy's power of an element does not depend on the array around it)."""
+    def _reach_table_for(self, walls_crossed: np.ndarray) -> np.ndarray:
+        """:meth:`effective_range_m` of 0, 1, ... walls, at least up to the most in
+        ``walls_crossed``: the same numpy values as for the counts themselves (numpy's power
+        of an element does not depend on the array around it)."""
         top = int(walls_crossed.max(initial=0))
         if top >= len(self._reach_table):
             self._reach_table = self.effective_range_m(np.arange(max(top + 1, 16)))
-        return self._reach_table[walls_crossed]
+        return self._reach_table
 
     def measure_reference(self, poses: np.ndarray) -> list[PeerBearings]:
         """:meth:`measure` with the sight lines in numpy, the reference of the compiled

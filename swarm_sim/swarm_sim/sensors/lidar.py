@@ -172,7 +172,7 @@ class LidarModel:
         uniform = self._rng.random(exact.shape) if cfg.dropout_probability > 0.0 else exact
         redo = np.zeros(len(exact), dtype=bool)
         noisy = self._near_noise(exact, kind, normal, uniform, horizon_m, cut_m, redo)
-        if redo.any():
+        if np.count_nonzero(redo):  # redo.any(), without its Python-level dispatch
             full = caster.scan(poses, cfg.range_max_m)
             exact[redo] = full[redo]
             kind[redo] = np.where(np.isfinite(full[redo]), EXACT, NO_RETURN)

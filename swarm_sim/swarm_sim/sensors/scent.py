@@ -246,7 +246,8 @@ class PumpDepositor:
     def busy(self, pump_on: np.ndarray) -> bool:
         """False when a :meth:`step` with these pump states would do nothing (no pump runs
         and no puff is pending), so that the caller may skip it."""
-        return bool(pump_on.any() or self._on_time_s.any())
+        # count_nonzero: what any() tests, without its Python-level dispatch.
+        return bool(np.count_nonzero(pump_on) or np.count_nonzero(self._on_time_s))
 
     def step(self, pump_on: np.ndarray, nozzle_xy: np.ndarray, time_s: float, dt_s: float) -> None:
         """Account ``dt_s`` seconds of pumping and deposit the puffs that are complete.
