@@ -40,6 +40,7 @@ from oabug_robot.motion import (
     Twist2D,
     follow_wall,
     go_straight,
+    inner_corner_ahead,
     turn_in_place,
     wrap_corner,
 )
@@ -90,9 +91,6 @@ class Event(Enum):
     RANDOM_TURN = 8
 
 
-# tuple.__new__(cls, fields) builds a named tuple from all its fields without the Python-level
-# __new__ of the class (what its ``_make`` does); the per-step tuples are built so.
-_tuple_new = tuple.__new__
 # The members every step compares with, as module constants (cheaper to look up).
 _NO_EVENT = Event.NONE
 _TURN, _STRAIGHT, _FOLLOW, _WRAP = Mode.TURN, Mode.STRAIGHT, Mode.FOLLOW, Mode.WRAP
@@ -183,9 +181,6 @@ class OABugFsm:
         self._body_radius_m = perception.robot_radius_m
         self._heading_tolerance_rad = motion.heading_tolerance_rad
         self._wrap_done_rad = math.pi / 2 - motion.heading_tolerance_rad
-        # inner_corner_ahead(front, motion) is: self._arcs and front <= self._arc_start_m.
-        self._arcs = motion.inner_corner_arc_radius_m > 0.0
-        self._arc_start_m = motion.wall_distance_m + motion.inner_corner_arc_radius_m
 
     @property
     def config(self) -> OABugConfig:
@@ -227,8 +222,7 @@ class OABugFsm:
             linear, angular = self._step_bug(snapshot, dt)
         mem.last_linear_mps = linear
         pump = uses_scent and self._pump.update(time_s, linear)
-        # Command(float(linear), float(angular), bool(pump)), without the class's __new__.
-        return _tuple_new(Command, (float(linear), float(angular), bool(pump)))
+        return Command(float(linear), float(angular), bool(pump))
 
     def _step_bug(self, snap: SensorSnapshot, dt_s: float) -> Twist2D:
         # The configuration values are the ones __init__ looked up (every step reads them).
@@ -239,7 +233,7 @@ class OABugFsm:
         front_wall_m = scan.front_wall_m
         front_blocked = front_wall_m <= self._wall_hit_m
         # A wall ahead at an inner corner (inner_corner_ahead), or one blocking the way.
-        corner_ahead = front_blocked or (self._arcs and front_wall_m <= self._arc_start_m)
+        corner_ahead = front_blocked or inner_corner_ahead(front_wall_m, motion)
         yaw_change = 0.0
         previous = mem.previous_yaw_rad
         if previous is not None:

@@ -39,7 +39,6 @@ STOP = Twist2D(0.0, 0.0)
 _DRIVE_ERROR_RAD = math.radians(30.0)
 # Slowest forward speed while following, as a fraction of cruise speed.
 _MIN_FOLLOW_FRACTION = 0.3
-_HALF_PI = math.pi / 2
 
 
 def _clamp(value: float, limit: float) -> float:
@@ -89,35 +88,24 @@ def follow_wall(
         front_wall_m: forward distance to the nearest wall ahead [m].
         body_radius_m: the body's radius, where the wall ahead would touch it [m].
     """
-    # Every step of a follower comes here: the arithmetic of inner_corner_ahead, _clamp and
-    # the min / max below is written out (the same operations, without the calls).
-    radius = cfg.inner_corner_arc_radius_m
-    wall_distance = cfg.wall_distance_m
-    if radius > 0.0 and front_wall_m <= wall_distance + radius:
-        start_m = wall_distance + radius
+    if inner_corner_ahead(front_wall_m, cfg):
+        start_m = cfg.wall_distance_m + cfg.inner_corner_arc_radius_m
         room = (front_wall_m - body_radius_m) / max(start_m - body_radius_m, 1e-9)
-        speed = cfg.turn_rate_radps * radius
+        speed = cfg.turn_rate_radps * cfg.inner_corner_arc_radius_m
         speed = min(cfg.forward_speed_mps, speed) * min(1.0, max(0.0, room))
         return Twist2D(speed, -side * cfg.turn_rate_radps)
     if front_blocked:
         return Twist2D(0.0, -side * cfg.turn_rate_radps)
-    distance, angle, _ = wall
-    if not math.isfinite(distance):  # no wall found
+    if not wall.found:
         speed = 0.5 * cfg.forward_speed_mps
-        return Twist2D(speed, side * min(cfg.turn_rate_radps, speed / wall_distance))
-    distance_error = distance - wall_distance
-    rate = cfg.wall_angle_gain_per_s * angle
-    rate += side * cfg.wall_distance_gain_radps_per_m * distance_error
-    tilt = abs(angle)
-    fraction = math.cos(_HALF_PI if tilt > _HALF_PI else tilt)
-    if not fraction > _MIN_FOLLOW_FRACTION:  # max(_MIN_FOLLOW_FRACTION, fraction), NaN too
-        fraction = _MIN_FOLLOW_FRACTION
-    limit = cfg.turn_rate_radps
-    rate = rate if rate < limit else limit  # _clamp(rate, limit)
-    # Twist2D(...), without the class's Python-level __new__ (what its _make does).
-    return tuple.__new__(
-        Twist2D, (cfg.forward_speed_mps * fraction, rate if rate > -limit else -limit)
+        return Twist2D(speed, side * min(cfg.turn_rate_radps, speed / cfg.wall_distance_m))
+    distance_error = wall.distance_m - cfg.wall_distance_m
+    rate = (
+        cfg.wall_angle_gain_per_s * wall.angle_rad
+        + side * cfg.wall_distance_gain_radps_per_m * distance_error
     )
+    fraction = max(_MIN_FOLLOW_FRACTION, math.cos(min(abs(wall.angle_rad), math.pi / 2)))
+    return Twist2D(cfg.forward_speed_mps * fraction, _clamp(rate, cfg.turn_rate_radps))
 
 
 def inner_corner_ahead(front_wall_m: float, cfg: MotionConfig) -> bool:

@@ -170,8 +170,7 @@ class RobotLoop(Generic[_ScanT]):
         frame [rad] and distances [m, NaN unknown], stamped with the yaw held now (0 before
         the first IMU reading)."""
         yaw = self._yaw_rad if math.isfinite(self._yaw_rad) else 0.0
-        # PeerBearings(azimuths_rad, distances_m, stamp_s, yaw_at_stamp_rad), as in the step.
-        self._bearings = tuple.__new__(PeerBearings, (azimuths_rad, distances_m, now_s, yaw))
+        self._bearings = PeerBearings(azimuths_rad, distances_m, now_s, yaw)
 
     # The control step.
 
@@ -188,6 +187,14 @@ class RobotLoop(Generic[_ScanT]):
         return [
             name for name, stamp in required if stamp is None or not 0.0 <= now_s - stamp <= timeout
         ]
+
+    def _fresh(self, now_s: float) -> bool:
+        """``not self.stale_inputs(now_s)``, without building the list (every step asks)."""
+        timeout = self.stale_timeout_s
+        stamps = [self._features_time_s, self._imu_time_s]
+        if self.needs_gas:
+            stamps.append(self._gas_time_s)
+        return all(s is not None and 0.0 <= now_s - s <= timeout for s in stamps)
 
     def _near_peers(self, now_s: float) -> tuple[np.ndarray, np.ndarray]:
         bearings = self._bearings
@@ -284,26 +291,10 @@ class RobotLoop(Generic[_ScanT]):
         """Step the controller on the held readings; None (no step) while an input is
         missing or stale."""
         features = self._features
-        if features is None:
+        if features is None or not self._fresh(now_s):
             return None
-        # ``not self.stale_inputs(now_s)``, without building the list (every step asks).
-        timeout = self.stale_timeout_s
-        stamp = self._features_time_s
-        if stamp is None or not 0.0 <= now_s - stamp <= timeout:
-            return None
-        stamp = self._imu_time_s
-        if stamp is None or not 0.0 <= now_s - stamp <= timeout:
-            return None
-        if self.needs_gas:
-            stamp = self._gas_time_s
-            if stamp is None or not 0.0 <= now_s - stamp <= timeout:
-                return None
-        # SensorSnapshot(time_s, yaw_rad, scan, gas_raw, bearings), without the class's
-        # Python-level __new__ (what its _make does).
         return self.fsm.step(
-            tuple.__new__(
-                SensorSnapshot, (now_s, self._yaw_rad, features, self._gas_raw, self._bearings)
-            )
+            SensorSnapshot(now_s, self._yaw_rad, features, self._gas_raw, self._bearings)
         )
 
 

@@ -664,9 +664,6 @@ def extract_held(
 
 
 _NO_ROTATION = np.zeros(0)
-# tuple.__new__(cls, fields) builds a named tuple from all its fields without the Python-level
-# __new__ of the class (what its ``_make`` does).
-_tuple_new = tuple.__new__
 _NO_WALL = SideWall()
 _NO_WALL_RIGHT = SideWall(math.inf, -0.0, False)
 _NO_FEATURES = ScanFeatures()
@@ -757,11 +754,9 @@ def _extract(
             continue
         left = right = _NO_WALL
         if side > 0 and count:
-            left = _tuple_new(SideWall, (distance, angle, bool(abeam)))
+            left = SideWall(distance, angle, bool(abeam))
         elif side < 0:
             # The extractor mirrors the right side's wall, "no wall" (angle 0.0) too.
-            right = (
-                _tuple_new(SideWall, (distance, -angle, bool(abeam))) if count else _NO_WALL_RIGHT
-            )
-        result.append(_tuple_new(ScanFeatures, (wall_ahead, robot_ahead, left, right, near, peers)))
+            right = SideWall(distance, -angle, bool(abeam)) if count else _NO_WALL_RIGHT
+        result.append(ScanFeatures(wall_ahead, robot_ahead, left, right, near, peers))
     return result

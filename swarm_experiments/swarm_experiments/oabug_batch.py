@@ -318,10 +318,9 @@ def _deliver(engine: SimEngine, out: Any, swarm: BatchSwarm) -> None:
         withheld = out.withheld.get('scan')
         frame = swarm.scan_frame
         if withheld is None and frame is not None:
-            # receive_scan of every robot, the scan built here (one call less per robot;
-            # LaserScanData(ranges, *frame) without the class's Python-level __new__).
+            # receive_scan of every robot, the scan built here (one call less per robot).
             for loop, ranges in zip(loops, ranges_m, strict=True):
-                loop.hold_scan(tuple.__new__(LaserScanData, (ranges, *frame)), now_s)
+                loop.hold_scan(LaserScanData(ranges, *frame), now_s)
         else:
             for i, (robot, ranges) in enumerate(zip(robots, ranges_m, strict=True)):
                 if withheld is None or not withheld[i]:
