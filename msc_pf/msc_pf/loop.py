@@ -82,6 +82,7 @@ class RobotLoop:
         self.controller = controller
         self.steering = steering if steering is not None else Steering()
         self.period_s = controller.config.period_s
+        self._max_speed_m_s = controller.config.max_speed_m_s
         self._pose: tuple[float, float, float] | None = None
         self._pose_time_s = -math.inf
         self._readings: dict[int, float] = {}
@@ -106,9 +107,10 @@ class RobotLoop:
     # ------------------------------------------------------------------ inputs
     def receive_pose(self, pose: tuple[float, float, float], now_s: float) -> bool:
         """Hold ``pose`` as received at ``now_s``; False (ignored) when it is not finite."""
-        if not all(math.isfinite(v) for v in pose):
+        x, y, yaw = float(pose[0]), float(pose[1]), float(pose[2])
+        if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(yaw)):
             return False
-        self._pose = (float(pose[0]), float(pose[1]), float(pose[2]))
+        self._pose = (x, y, yaw)
         self._pose_time_s = now_s
         return True
 
@@ -172,7 +174,7 @@ class RobotLoop:
             pose,
             self._waypoint,
             self._deadline_s - now_s,
-            max_speed_m_s=self.controller.config.max_speed_m_s,
+            max_speed_m_s=self._max_speed_m_s,
             max_yaw_rate_rad_s=steering.max_yaw_rate_rad_s,
             heading_gain=steering.heading_gain,
         )

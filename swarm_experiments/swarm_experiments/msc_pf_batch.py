@@ -243,6 +243,7 @@ def run_batch(
         for i in range(scenario.n_robots)
     ]
     n = len(loops)
+    robot_indices = list(range(n))
     control_every = max(1, round(config.period_s * scenario.physics_rate_hz))
     drive_every = max(1, round(scenario.physics_rate_hz / scenario.drive_rate_hz))
     sample_every = max(1, round(scenario.physics_rate_hz))  # the extension samples at 1 Hz
@@ -250,10 +251,10 @@ def run_batch(
     phases: list[list[int]] | None = [] if record else None
     first_heard = np.full(scenario.n_targets, np.nan)
     first_heard_range = np.full(scenario.n_targets, np.nan)
-    search_only = scenario.n_targets == 0
     last: list[StepOutput | None] = [None] * n
     now = 0.0
-    while (search_only or not targets.all_captured) and now + 1e-9 < scenario.max_time_s:
+    all_captured = False  # only a capture can change it (a search-only run never ends so)
+    while not all_captured and now + 1e-9 < scenario.max_time_s:
         # The bridge's tick: physics, odometry, work and captures, RSSI samples.
         out = engine.step()
         step = engine.step_index
@@ -276,9 +277,12 @@ def run_batch(
         speeds = np.abs(engine.world.velocities[:, 0])
         if dropped is not None:
             speeds[dropped] = np.inf  # a dropped robot works on no target
-        for capture in targets.work(positions, speeds, engine.config.physics_period_s, out.time_s):
+        captures = targets.work(positions, speeds, engine.config.physics_period_s, out.time_s)
+        for capture in captures:
             for robot in capture.robot_indices:
                 loops[robot].receive_captured([capture.target_id])
+        if captures:
+            all_captured = targets.all_captured
         if step % sample_every == 0:
             samples = targets.sample_rssi(positions, noise_rng)
             if float32_fields:
@@ -303,9 +307,10 @@ def run_batch(
         drive_due = control_due or step % drive_every == 0
         if not drive_due:
             continue
+        commands: list[tuple[float, float]] = []
         for i, loop in enumerate(loops):
             if dropped is not None and dropped[i]:
-                engine.set_velocity_command(i, 0.0, 0.0)
+                commands.append((0.0, 0.0))
                 continue
             if control_due:
                 result = loop.control(now, with_estimates=False)
@@ -315,7 +320,9 @@ def run_batch(
                     for receiver in relay.receivers(i, engine.world.poses).tolist():
                         if dropped is None or not dropped[receiver]:
                             loops[receiver].receive_peer(message)
-            engine.set_velocity_command(i, *loop.command(now))
+            commands.append(loop.command(now))
+        # Commands act at the next physics step, so recording them after the loop is the same.
+        engine.set_velocity_commands(robot_indices, commands)
         if control_due:
             outputs = [o for o in last if o is not None]
             if paths is not None and phases is not None:

@@ -15,7 +15,7 @@ command is older than ``pump_timeout_s`` switches off.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -355,6 +355,11 @@ class SimEngine:
             msg = f'robot index {robot} out of range 0..{self.num_robots - 1}'
             raise WorldGeometryError(msg)
 
+    def _check_robots(self, robots: Sequence[int]) -> None:
+        if robots and not 0 <= min(robots) <= max(robots) < self.num_robots:
+            for robot in robots:
+                self._check_robot(robot)  # raises for the first index out of range
+
     def set_velocity_command(self, robot: int, speed_mps: float, yaw_rate_radps: float) -> None:
         """Record a velocity command (non-finite values are taken as zero)."""
         self._check_robot(robot)
@@ -368,6 +373,31 @@ class SimEngine:
         self._check_robot(robot)
         self._pump_on[robot] = bool(on)
         self._pump_time_s[robot] = self.time_s
+
+    def set_velocity_commands(
+        self, robots: Sequence[int], commands: Sequence[tuple[float, float]]
+    ) -> None:
+        """Record velocity commands of several robots at once: what
+        :meth:`set_velocity_command` does for each, in one call.
+
+        Args:
+            robots: K distinct robot indices.
+            commands: per robot, speed [m/s] and yaw rate [rad/s] (non-finite taken as zero).
+
+        Raises:
+            WorldGeometryError: a robot index is out of range (nothing is recorded).
+            ValueError: the two sequences differ in length.
+        """
+        if len(robots) != len(commands):
+            msg = f'{len(robots)} robots and {len(commands)} commands'
+            raise ValueError(msg)
+        self._check_robots(robots)
+        # Element by element: cheaper than array operations for a few robots.
+        command, command_time, now = self._command, self._command_time_s, self.time_s
+        for robot, (v, w) in zip(robots, commands, strict=True):
+            command[robot, 0] = v if math.isfinite(v) else 0.0
+            command[robot, 1] = w if math.isfinite(w) else 0.0
+            command_time[robot] = now
 
     def set_commands(
         self, robots: list[int], commands: list[tuple[float, float]], pumps: list[bool]
@@ -387,17 +417,9 @@ class SimEngine:
         if not len(robots) == len(commands) == len(pumps):
             msg = f'{len(robots)} robots, {len(commands)} commands and {len(pumps)} pump states'
             raise ValueError(msg)
-        if robots and not 0 <= min(robots) <= max(robots) < self.num_robots:
-            for robot in robots:
-                self._check_robot(robot)  # raises for the first index out of range
-        # Element by element: cheaper than array operations for a few robots.
-        command, pump_on = self._command, self._pump_on
-        command_time, pump_time = self._command_time_s, self._pump_time_s
-        now = self.time_s
-        for robot, (v, w), on in zip(robots, commands, pumps, strict=True):
-            command[robot, 0] = v if math.isfinite(v) else 0.0
-            command[robot, 1] = w if math.isfinite(w) else 0.0
-            command_time[robot] = now
+        self.set_velocity_commands(robots, commands)
+        pump_on, pump_time, now = self._pump_on, self._pump_time_s, self.time_s
+        for robot, on in zip(robots, pumps, strict=True):
             pump_on[robot] = bool(on)
             pump_time[robot] = now
 
@@ -455,29 +477,33 @@ class SimEngine:
             depositor.step(pumping, nozzles, self.time_s, dt)
         out = StepOutput(time_s=self.time_s, poses=poses)
         out.new_room_entries = self.coverage.update(poses, self.time_s)
-        sched = self._schedules
-        if sched['scan'].due(self.time_s)[0] and self.lidar is not None:
+        # A disabled sensor's schedule is not consulted (it has no output to time).
+        sched, now = self._schedules, self.time_s
+        if self.lidar is not None and sched['scan'].due(now)[0]:
             out.scans = self.lidar.measure(poses, self._scan_horizon_m)
-        due, elapsed = sched['gas'].due(self.time_s)
-        if due and self.gas is not None and self.scent is not None:
-            # gas_sensor_positions(poses) in compiled code.
-            sensors = body_points_kernel(poses, cfg.gas.sensor_offset_m)
-            c = self.scent.concentration(sensors, self.time_s)
-            out.gas_raw = self.gas.update(c, elapsed)
-        if sched['bearings'].due(self.time_s)[0] and self.bearing_model is not None:
+        if self.gas is not None and self.scent is not None:
+            due, elapsed = sched['gas'].due(now)
+            if due:
+                # gas_sensor_positions(poses) in compiled code.
+                sensors = body_points_kernel(poses, cfg.gas.sensor_offset_m)
+                c = self.scent.concentration(sensors, now)
+                out.gas_raw = self.gas.update(c, elapsed)
+        if self.bearing_model is not None and sched['bearings'].due(now)[0]:
             if self._bearing_cycles:
                 out.bearing_cycle = self.bearing_model.measure_cycle(poses)
             else:
                 out.bearings = self.bearing_model.measure(poses)
-        due, elapsed = sched['imu'].due(self.time_s)
-        if due and self.imu is not None:
-            change = yaw_change_kernel(poses[:, 2], self._imu_last_yaw)
-            self._imu_last_yaw = poses[:, 2].copy()
-            out.imu = self.imu.update(change, elapsed)
-        due, elapsed = sched['odometry'].due(self.time_s)
-        if due and self.odometry is not None:
-            out.odometry = self.odometry.update(poses, elapsed)
-        out.ground_truth_due = sched['ground_truth'].due(self.time_s)[0]
+        if self.imu is not None:
+            due, elapsed = sched['imu'].due(now)
+            if due:
+                change = yaw_change_kernel(poses[:, 2], self._imu_last_yaw)
+                self._imu_last_yaw = poses[:, 2].copy()
+                out.imu = self.imu.update(change, elapsed)
+        if self.odometry is not None:
+            due, elapsed = sched['odometry'].due(now)
+            if due:
+                out.odometry = self.odometry.update(poses, elapsed)
+        out.ground_truth_due = sched['ground_truth'].due(now)[0]
         for hook in self._hooks:
             hook.readings(out)
         return out

@@ -180,11 +180,13 @@ def test_a_mission_runs_only_the_sensors_it_chooses():
 
 
 def test_commands_set_together_equal_commands_set_one_by_one():
-    """set_commands (the batch path's call) records what set_velocity_command and set_pump
-    record robot by robot, non-finite values included; a bad index records nothing."""
+    """set_commands and set_velocity_commands (the batch paths' calls) record what
+    set_velocity_command and set_pump record robot by robot, non-finite values included;
+    a bad index records nothing."""
     rng = np.random.default_rng(8)
     poses = [[1.0 + 0.5 * i, 1.5, 0.0] for i in range(5)]
     together, one_by_one = make_engine(poses), make_engine(poses)
+    velocities = make_engine(poses)
     for _ in range(30):
         robots = sorted(rng.choice(5, int(rng.integers(0, 6)), replace=False).tolist())
         commands = [
@@ -195,13 +197,15 @@ def test_commands_set_together_equal_commands_set_one_by_one():
         ]
         pumps = [bool(p) for p in rng.random(len(robots)) < 0.5]
         together.set_commands(robots, commands, pumps)
+        velocities.set_velocity_commands(robots, commands)
         for robot, command, pump in zip(robots, commands, pumps, strict=True):
             one_by_one.set_velocity_command(robot, *command)
             one_by_one.set_pump(robot, pump)
         assert together.active_commands().tobytes() == one_by_one.active_commands().tobytes()
+        assert velocities.active_commands().tobytes() == one_by_one.active_commands().tobytes()
         assert together.pumps_running().tolist() == one_by_one.pumps_running().tolist()
-        together.step()
-        one_by_one.step()
+        for engine in (together, one_by_one, velocities):
+            engine.step()
     before = together.active_commands()
     with pytest.raises(WorldGeometryError, match='out of range'):
         together.set_commands([0, 7], [(0.3, 0.0), (0.3, 0.0)], [True, True])
@@ -210,6 +214,12 @@ def test_commands_set_together_equal_commands_set_one_by_one():
     assert together.active_commands().tobytes() == before.tobytes()
     with pytest.raises(ValueError, match='pump states'):
         together.set_commands([0], [(0.3, 0.0)], [])
+    before = velocities.active_commands()
+    with pytest.raises(WorldGeometryError, match='robot index 5 out of range'):
+        velocities.set_velocity_commands([0, 5], [(0.3, 0.0), (0.3, 0.0)])
+    with pytest.raises(ValueError, match='1 robots and 2 commands'):
+        velocities.set_velocity_commands([0], [(0.3, 0.0), (0.3, 0.0)])
+    assert velocities.active_commands().tobytes() == before.tobytes()
 
 
 def test_the_compiled_watchdogs_give_the_active_commands_and_pumps():

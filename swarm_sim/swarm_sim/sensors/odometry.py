@@ -72,20 +72,27 @@ class WheelOdometry:
         """
         cfg = self.config
         true_poses = np.asarray(true_poses, dtype=float)
-        delta_xy = true_poses[:, :2] - self._last_true[:, :2]
-        heading = self._last_true[:, 2]
-        forward = delta_xy[:, 0] * np.cos(heading) + delta_xy[:, 1] * np.sin(heading)
-        lateral = -delta_xy[:, 0] * np.sin(heading) + delta_xy[:, 1] * np.cos(heading)
+        last = self._last_true
+        delta_x = true_poses[:, 0] - last[:, 0]
+        delta_y = true_poses[:, 1] - last[:, 1]
+        heading = last[:, 2]
+        cos_h, sin_h = np.cos(heading), np.sin(heading)
+        forward = delta_x * cos_h + delta_y * sin_h
+        lateral = -delta_x * sin_h + delta_y * cos_h
         dyaw = np.asarray(wrap_angle(true_poses[:, 2] - heading), dtype=float)
         n = len(true_poses)
         if cfg.distance_noise_fraction > 0.0:
             forward = forward * (1.0 + self._rng.normal(0.0, cfg.distance_noise_fraction, n))
         if cfg.rotation_noise_fraction > 0.0:
             dyaw = dyaw * (1.0 + self._rng.normal(0.0, cfg.rotation_noise_fraction, n))
-        yaw = self._pose[:, 2]
-        self._pose[:, 0] += forward * np.cos(yaw) - lateral * np.sin(yaw)
-        self._pose[:, 1] += forward * np.sin(yaw) + lateral * np.cos(yaw)
-        self._pose[:, 2] = wrap_angle(yaw + dyaw)
+        pose = self._pose
+        yaw = pose[:, 2]
+        cos_y, sin_y = np.cos(yaw), np.sin(yaw)
+        pose[:, 0] += forward * cos_y - lateral * sin_y
+        pose[:, 1] += forward * sin_y + lateral * cos_y
+        pose[:, 2] = wrap_angle(yaw + dyaw)
         self._last_true = true_poses.copy()
-        twist = np.column_stack([forward / dt_s, dyaw / dt_s])
-        return self._pose.copy(), twist
+        twist = np.empty((n, 2))
+        twist[:, 0] = forward / dt_s
+        twist[:, 1] = dyaw / dt_s
+        return pose.copy(), twist
