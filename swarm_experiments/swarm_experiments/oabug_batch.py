@@ -47,7 +47,7 @@ from swarm_common.angles import yaw_from_quaternion, yaw_to_quaternion
 from swarm_common.params import ParameterError
 from swarm_common.stamps import seconds_to_ns
 from swarm_runtime.builtin._messages import cdr_roundtrip_enabled
-from swarm_sim.engine import EngineConfig, SimEngine, SiteGeometry
+from swarm_sim.engine import EngineConfig, SimEngine, SiteGeometry, StepOutput
 from swarm_sim.errors import ConfigurationError
 from swarm_sim.sensors.bearings import BearingCycle
 from swarm_sim.sensors.bearings import PeerBearings as BearingReport
@@ -224,18 +224,45 @@ def run_oabug_batch(
         bearing_cycles=True,
         scan_horizon_m=horizon_m + _SCAN_HORIZON_MARGIN_M,
     )
-    n = engine.num_robots
-    names = tuple(f'r{i}' for i in range(n))
+    names = tuple(f'r{i}' for i in range(engine.num_robots))
     swarm = BatchSwarm(robots, tuple(name.upper() for name in names))
+    return run_site_loop(
+        engine,
+        spec,
+        lambda out: _deliver(engine, out, swarm),
+        names=names,
+        site=site,
+        wall_start=wall_start,
+        progress=progress,
+        stop=stop,
+    )
+
+
+def run_site_loop(
+    engine: SimEngine,
+    spec: MissionSpec,
+    deliver: Callable[[StepOutput], None],
+    *,
+    names: tuple[str, ...],
+    site: Any,
+    wall_start: float,
+    progress: Callable[[MissionProgress], None] | None = None,
+    stop: Callable[[MissionProgress], bool] | None = None,
+) -> MissionResult:
+    """Step ``engine`` through ``spec``'s mission, handing each step's output to ``deliver``,
+    and close it; the batch paths' (OA-Bug, SGBA) mission loop.
+
+    The stop conditions (every room covered if the spec asks, the time budget, ``stop`` on a
+    progress report), the progress reports and the trajectory samples are those of
+    :func:`swarm_experiments.mission.run_mission`; the step that ends the mission is not
+    delivered.
+    """
     times = [0.0]
     poses = [engine.world.poses]
     next_sample_s = spec.trajectory_period_s
     next_report_s = 0.0
+    reports = progress is not None or stop is not None
     reason = StopReason.BUDGET
-
-    def snapshot() -> MissionProgress:
-        return MissionProgress.of_engine(engine, wall_start)
-
     while True:
         out = engine.step()
         if out.time_s + 1e-9 >= next_sample_s:
@@ -246,21 +273,20 @@ def run_oabug_batch(
             reason = StopReason.ALL_ROOMS_COVERED
             break
         if engine.time_s + 1e-9 >= spec.max_sim_time_s:
-            reason = StopReason.BUDGET
             break
-        if engine.time_s + 1e-9 >= next_report_s:
+        if reports and engine.time_s + 1e-9 >= next_report_s:
             next_report_s += spec.progress_period_s
-            report = snapshot()
+            report = MissionProgress.of_engine(engine, wall_start)
             if progress is not None:
                 progress(report)
             if stop is not None and stop(report):
                 reason = StopReason.PREDICATE
                 break
-        _deliver(engine, out, swarm)
+        deliver(out)
 
     # Release the physics backend (a pybullet client; a recorded run's animation is written).
     engine.close()
-    final = snapshot()
+    final = MissionProgress.of_engine(engine, wall_start)
     if progress is not None:
         progress(final)
     return MissionResult.of_engine(

@@ -34,9 +34,17 @@ from swarm_experiments.study import RunSpec, Smoke, Study
 from swarm_experiments.study.errors import UsageError
 
 if TYPE_CHECKING:
+    from swarm_experiments.mission import MissionResult
     from swarm_experiments.study.report import ReportPage
 
-__all__ = ['ACTIONS_PER_SAMPLE', 'FIG4', 'coverage_every', 'run_fig4', 'studies']
+__all__ = [
+    'ACTIONS_PER_SAMPLE',
+    'FIG4',
+    'coverage_every',
+    'coverage_metrics',
+    'run_fig4',
+    'studies',
+]
 
 FIG4 = 'oabug-fig4'
 #: The paper records coverage every 100 actions (of 0.1 m) per robot.
@@ -119,17 +127,16 @@ def coverage_every(
     return (covered / max(rooms_total, 1)).tolist()
 
 
-def run_fig4(spec: RunSpec) -> dict[str, Any]:
-    """One Fig. 4 run: the mission on the batch path, its coverage and the coverage curve."""
-    from swarm_experiments.oabug_batch import run_spawn_batch
+def coverage_metrics(
+    mission: MissionResult, budget_actions: int, speed_mps: float
+) -> dict[str, Any]:
+    """The Fig. 4 metrics of a finished site mission: coverage, rooms, time, robot metres and
+    the coverage every :data:`ACTIONS_PER_SAMPLE` actions of ``budget_actions`` at
+    ``speed_mps``."""
     from swarm_experiments.spawn import ACTION_LENGTH_M
 
-    settings = _settings(spec.config, spec.seed)
-    result = run_spawn_batch(settings)
-    mission = result.mission
-    budget = settings.budget_actions
-    samples = max(1, budget // ACTIONS_PER_SAMPLE)
-    period_s = ACTIONS_PER_SAMPLE * ACTION_LENGTH_M / settings.speed_mps
+    samples = max(1, budget_actions // ACTIONS_PER_SAMPLE)
+    period_s = ACTIONS_PER_SAMPLE * ACTION_LENGTH_M / speed_mps
     entries = np.array([entry.time_s for entry in mission.room_entries], dtype=float)
     return {
         'coverage_pct': 100.0 * mission.coverage,
@@ -143,6 +150,15 @@ def run_fig4(spec: RunSpec) -> dict[str, Any]:
             for value in coverage_every(entries, mission.rooms_total, period_s, samples)
         ],
     }
+
+
+def run_fig4(spec: RunSpec) -> dict[str, Any]:
+    """One Fig. 4 run: the mission on the batch path, its coverage and the coverage curve."""
+    from swarm_experiments.oabug_batch import run_spawn_batch
+
+    settings = _settings(spec.config, spec.seed)
+    result = run_spawn_batch(settings)
+    return coverage_metrics(result.mission, settings.budget_actions, settings.speed_mps)
 
 
 def _fixed_parameters() -> dict[str, Any]:

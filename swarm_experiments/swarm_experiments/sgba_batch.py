@@ -34,16 +34,16 @@ from swarm_sim.errors import ConfigurationError
 from swarm_sim.sensors.lidar import LidarConfig
 from swarm_sim.sensors_kernel import imu_message_yaw_kernel
 from swarm_sim.site_geometry import geometry_from_site
-from swarm_sim.site_loading import load_site, site_budget_actions
+from swarm_sim.site_loading import load_site
 
 from swarm_experiments.mission import (
     MissionProgress,
     MissionResult,
     MissionSpec,
     RobotNodeSpec,
-    StopReason,
 )
-from swarm_experiments.spawn import ACTION_LENGTH_M, DEFAULT_ACTIONS
+from swarm_experiments.oabug_batch import run_site_loop
+from swarm_experiments.spawn import SiteBudget
 
 __all__ = ['SgbaSettings', 'build_sgba_mission', 'run_sgba', 'run_sgba_batch']
 
@@ -59,7 +59,7 @@ MISSION_PARAMETERS = (
 
 
 @dataclass(frozen=True)
-class SgbaSettings:
+class SgbaSettings(SiteBudget):
     """One SGBA run (the OA-Bug spawner's settings that apply).
 
     Attributes:
@@ -93,18 +93,6 @@ class SgbaSettings:
         if reserved:
             msg = f'set by the mission, not as robot parameters: {", ".join(reserved)}'
             raise ConfigurationError(msg)
-
-    @property
-    def budget_actions(self) -> int:
-        """Max actions per robot of this run."""
-        if self.actions is not None:
-            return self.actions
-        return site_budget_actions(self.site) or DEFAULT_ACTIONS
-
-    @property
-    def budget_s(self) -> float:
-        """Mission time [s]: actions x 0.1 m / speed."""
-        return self.budget_actions * ACTION_LENGTH_M / self.speed_mps
 
 
 def _sgba_factory() -> Callable[..., object]:
@@ -210,37 +198,14 @@ def run_sgba_batch(
     )
     names = tuple(f'r{i}' for i in range(engine.num_robots))
     tags = [name.upper() for name in names]
-    times, poses = [0.0], [engine.world.poses]
-    next_sample_s = spec.trajectory_period_s
-    next_report_s = 0.0
-    reason = StopReason.BUDGET
-    while True:
-        out = engine.step()
-        if out.time_s + 1e-9 >= next_sample_s:
-            times.append(out.time_s)
-            poses.append(out.poses)
-            next_sample_s += spec.trajectory_period_s
-        if spec.stop_when_all_rooms_covered and engine.coverage.complete:
-            reason = StopReason.ALL_ROOMS_COVERED
-            break
-        if engine.time_s + 1e-9 >= spec.max_sim_time_s:
-            break
-        if progress is not None and engine.time_s + 1e-9 >= next_report_s:
-            next_report_s += spec.progress_period_s
-            progress(MissionProgress.of_engine(engine, wall_start))
-        _deliver(engine, out, robots, tags)
-    engine.close()
-    final = MissionProgress.of_engine(engine, wall_start)
-    if progress is not None:
-        progress(final)
-    return MissionResult.of_engine(
+    return run_site_loop(
         engine,
-        robot_names=names,
+        spec,
+        lambda out: _deliver(engine, out, robots, tags),
+        names=names,
         site=site,
-        stop_reason=reason,
-        wall_time_s=final.wall_time_s,
-        times=times,
-        poses=poses,
+        wall_start=wall_start,
+        progress=progress,
     )
 
 

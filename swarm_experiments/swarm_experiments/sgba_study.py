@@ -15,7 +15,6 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any
 
-import numpy as np
 import pandas as pd
 
 from swarm_experiments.study import RunSpec, Smoke, Study
@@ -96,9 +95,8 @@ def check_config(config: Mapping[str, Any]) -> None:
 def run_comparison(spec: RunSpec) -> dict[str, Any]:
     """One run: OA-Bug (``method`` a Table I variant) through the Fig. 4 run function, or
     SGBA on its batch path; the same metrics and coverage curve either way."""
-    from swarm_experiments.oabug_study import ACTIONS_PER_SAMPLE, coverage_every, run_fig4
+    from swarm_experiments.oabug_study import coverage_metrics, run_fig4
     from swarm_experiments.sgba_batch import run_sgba
-    from swarm_experiments.spawn import ACTION_LENGTH_M
 
     config = spec.config
     if config['method'] not in SGBA_METHODS:
@@ -108,21 +106,7 @@ def run_comparison(spec: RunSpec) -> dict[str, Any]:
         )
     settings = _sgba_settings(config, spec.seed)
     mission = run_sgba(settings)
-    samples = max(1, settings.budget_actions // ACTIONS_PER_SAMPLE)
-    period_s = ACTIONS_PER_SAMPLE * ACTION_LENGTH_M / settings.speed_mps
-    entries = np.array([entry.time_s for entry in mission.room_entries], dtype=float)
-    return {
-        'coverage_pct': 100.0 * mission.coverage,
-        'rooms_covered': int(mission.rooms_covered),
-        'rooms_total': int(mission.rooms_total),
-        'all_covered': bool(mission.rooms_covered == mission.rooms_total),
-        'sim_time_s': float(mission.sim_time_s),
-        'robot_m': float(mission.distance_travelled_m.sum()),
-        'coverage_pct_every_100_actions': [
-            100.0 * value
-            for value in coverage_every(entries, mission.rooms_total, period_s, samples)
-        ],
-    }
+    return coverage_metrics(mission, settings.budget_actions, settings.speed_mps)
 
 
 def studies() -> list[Study]:

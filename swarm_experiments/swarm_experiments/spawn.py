@@ -115,8 +115,30 @@ SPAWNER_PARAMETERS = (
 )
 
 
+class SiteBudget:
+    """The budget of a site mission, mixed into the site spawners' settings (OA-Bug, SGBA):
+    ``actions`` per robot (None: the preset's Table II value, else :data:`DEFAULT_ACTIONS`)
+    of :data:`ACTION_LENGTH_M` at ``speed_mps``."""
+
+    site: str
+    actions: int | None
+    speed_mps: float
+
+    @property
+    def budget_actions(self) -> int:
+        """Max actions per robot of this run."""
+        if self.actions is not None:
+            return self.actions
+        return site_budget_actions(self.site) or DEFAULT_ACTIONS
+
+    @property
+    def budget_s(self) -> float:
+        """Mission time [s]: actions x 0.1 m / speed."""
+        return self.budget_actions * ACTION_LENGTH_M / self.speed_mps
+
+
 @dataclass(frozen=True)
-class SpawnSettings:
+class SpawnSettings(SiteBudget):
     """One OA-Bug run.
 
     Attributes:
@@ -180,18 +202,6 @@ class SpawnSettings:
         if self.profile not in PROFILES:
             msg = f'unknown profile {self.profile!r}; choose one of {", ".join(PROFILES)}'
             raise ConfigurationError(msg)
-
-    @property
-    def budget_actions(self) -> int:
-        """Max actions per robot of this run."""
-        if self.actions is not None:
-            return self.actions
-        return site_budget_actions(self.site) or DEFAULT_ACTIONS
-
-    @property
-    def budget_s(self) -> float:
-        """Mission time [s]: actions x 0.1 m / speed."""
-        return self.budget_actions * ACTION_LENGTH_M / self.speed_mps
 
 
 @dataclass(frozen=True)
