@@ -144,11 +144,12 @@ def test_the_best_msc_is_chosen_on_the_seeds_every_msc_variant_ran():
 def test_the_reports_compare_with_the_paper_and_the_best_msc(tmp_path: Path):
     by_name = {s.name: s for s in studies()}
     overrides = {'targets': '1', 'robots': '3', 't_max_s': '600'}
-    for name, variants in (
-        ('msc_pf-fig4', 'proposed,msc_pf,msc'),
-        ('msc_pf-beyond', 'proposed,msc,msc-pbest,msc-solo,proposed-sweep'),
+    for name, variants, targets in (
+        ('msc_pf-fig4', 'proposed,msc_pf,msc', '1,2'),
+        ('msc_pf-beyond', 'proposed,msc,msc-pbest,msc-solo,proposed-sweep', '1'),
     ):
-        plan = make_specs(by_name[name], runs=2, overrides={**overrides, 'variant': variants})
+        given = {**overrides, 'variant': variants, 'targets': targets}
+        plan = make_specs(by_name[name], runs=2, overrides=given)
         with make_engine('serial') as engine:
             run_study(plan, tmp_path, engine, code_version='v')
     pages = {
@@ -159,6 +160,13 @@ def test_the_reports_compare_with_the_paper_and_the_best_msc(tmp_path: Path):
     assert 'prints no CCT values' in fig4
     assert "The paper's order, in the means" in fig4
     assert 'CCT minus MSC, paired by seed' in fig4
+    assert 'CCT against the number of targets' in fig4
+    assert (tmp_path / 'msc_pf-fig4' / 'figures' / 'fig4-cct.png').stat().st_size > 0
+    exported = json.loads((tmp_path / 'msc_pf-fig4' / 'results.json').read_text())['tables']
+    assert {'cct', 'order', 'rising', 'paired', 'breakdown'} <= set(exported)
+    # One row per scheme over the two target counts, each with its two means.
+    rising = exported['rising']
+    assert len(rising['rows']) == 3
     beyond = pages['msc_pf-beyond']
     assert 'The MSC baseline as a bracket' in beyond
     assert 'MSC configurations on the seeds all of them ran' in beyond
