@@ -13,8 +13,9 @@ Registered with ``swarm_study`` (entry point ``swarm_experiments.studies``):
   metric, and whether the crashed robot stopped, moved again after the restart and how long
   the restart took. These runs are in real time, so unlike the other studies they are not
   deterministic (the machine's load is recorded with each run);
-* ``sensors-oabug``: every OA-Bug variant on Small sites from both departures, under the
-  ``ideal`` and the ``realistic`` sensor profile.
+* ``sensors-oabug``: every OA-Bug variant on Small sites from both departures, with the
+  ``paper`` and the ``tuned`` robot profile, under the ``ideal`` and the ``realistic`` sensor
+  profile.
 
 A fault scenario is one string of ``--fault`` items (``'dropout_robots=2'``,
 ``'comm_loss_probability=0.5,comm_range_m=150'``; ``'none'``): the study's ``fault`` axis.
@@ -37,7 +38,7 @@ from swarm_sim.faults import FaultConfig, FaultPlan
 from swarm_sim.sensor_profiles import apply_sensor_profile
 
 from swarm_experiments.cli_args import fault_config
-from swarm_experiments.study import ReportPage, RunSpec, Smoke, Study
+from swarm_experiments.study import ReportPage, RunSpec, Smoke, Study, paired_differences
 
 __all__ = [
     'parse_fault',
@@ -217,10 +218,11 @@ def run_oabug_fault(spec: RunSpec) -> dict[str, Any]:
 
 
 def run_oabug_sensors(spec: RunSpec) -> dict[str, Any]:
-    """One OA-Bug run of the ``sensors-oabug`` study."""
+    """One OA-Bug run of the ``sensors-oabug`` study: the robot ``profile`` (paper, tuned)
+    under the sensor profile ``sensors`` (ideal, realistic)."""
     cfg = spec.config
-    engine = apply_sensor_profile(EngineConfig(), cfg['profile'])
-    mission = _oabug(spec, engine, cfg['variant'], cfg['departure'])
+    engine = apply_sensor_profile(EngineConfig(), cfg['sensors'])
+    mission = _oabug(spec, engine, cfg['variant'], cfg['departure'], cfg['profile'])
     return {
         'coverage': 100.0 * mission.coverage,
         'complete': bool(mission.rooms_covered == mission.rooms_total),
@@ -821,21 +823,40 @@ def _report_crash(page: ReportPage) -> None:
 
 
 def _report_sensors(page: ReportPage) -> None:
-    rows = _planned(page, (), ('config.variant', 'config.departure', 'config.profile'))
+    keys = ('config.profile', 'config.variant', 'config.departure', 'config.sensors')
+    rows = _planned(page, (), keys)
     if rows.empty:
         return
     rows = rows.assign(**{'metric.complete_pct': 100.0 * rows['metric.complete'].astype(float)})
+    rank = {'paper': 0, 'tuned': 1}  # the as-published robot leads
+    rows = rows.sort_values('config.profile', key=lambda p: p.map(rank), kind='stable')
     table = _summary(
         rows,
-        ['config.variant', 'config.departure', 'config.profile'],
+        list(keys),
         {'metric.coverage': 'coverage %', 'metric.complete_pct': 'runs covering all rooms %'},
         (),
     )
     page.add_table(
         table,
-        title='OA-Bug variants under both sensor profiles, Small, 10 robots',
+        title='OA-Bug variants under both sensor profiles, Small, 10 robots (robot profile '
+        'paper first)',
         export='sensors',
     )
+    if set(rows['config.sensors']) >= {'ideal', 'realistic'}:
+        paired = paired_differences(
+            rows,
+            'metric.coverage',
+            by='config.sensors',
+            baseline='ideal',
+            group_by=['config.profile', 'config.variant', 'config.departure'],
+        )
+        paired = paired.sort_values('config.profile', key=lambda p: p.map(rank), kind='stable')
+        page.add_table(
+            paired.reset_index(drop=True),
+            title='Coverage, realistic minus ideal sensors, paired by site (wins: realistic '
+            'covers more)',
+            export='sensors-paired',
+        )
 
 
 def studies() -> list[Study]:
@@ -919,15 +940,20 @@ def studies() -> list[Study]:
             name='sensors-oabug',
             run=run_oabug_sensors,
             axes={
+                'profile': ('paper', 'tuned'),
                 'variant': ('random', 'minimum', 'sound', 'gas', 'gas_sound'),
                 'departure': ('center', 'edge'),
-                'profile': ('ideal', 'realistic'),
+                'sensors': ('ideal', 'realistic'),
             },
             params={'site': 'small', 'robots': 10},
             runs=3,
             seed_label='site',
-            description='Every OA-Bug variant under the ideal and the realistic sensor profile.',
-            smoke=Smoke(runs=1, axes={'variant': ('gas_sound',), 'departure': ('center',)}),
+            description='Every OA-Bug variant, both robot profiles (paper first), under the ideal '
+            'and the realistic sensor profile.',
+            smoke=Smoke(
+                runs=1,
+                axes={'profile': ('paper',), 'variant': ('gas_sound',), 'departure': ('center',)},
+            ),
             report=_report_sensors,
         ),
     ]

@@ -139,3 +139,32 @@ def test_decisions_after_a_time_count_the_legs_started_since():
     assert reliability.decisions_after_s(path, 0.1, 0.0) == 3
     assert reliability.decisions_after_s(path, 0.1, 10.0) == 2
     assert reliability.decisions_after_s(path, 0.1, 25.0) == 0
+
+
+def test_the_sensor_table_leads_with_the_paper_profile_and_pairs_the_sites(tmp_path):
+    # Two sites; the tuned rows first in storage order, the realistic runs 10 points lower
+    # on site 0 and equal on site 1 (paper), 5 points higher on both sites (tuned).
+    rows = pd.DataFrame(
+        {
+            'status': 'ok',
+            'seed': [0, 1, 0, 1, 0, 1, 0, 1],
+            'config.profile': ['tuned'] * 4 + ['paper'] * 4,
+            'config.variant': 'gas_sound',
+            'config.departure': 'center',
+            'config.sensors': ['ideal', 'ideal', 'realistic', 'realistic'] * 2,
+            'metric.coverage': [90.0, 80.0, 95.0, 85.0, 100.0, 90.0, 90.0, 90.0],
+            'metric.complete': False,
+            'metric.sim_time_s': 333.0,
+        }
+    )
+    page = ReportPage(tmp_path, {'study': 'sensors-oabug', 'seeds': [0, 1]}, rows)
+    reliability._report_sensors(page)
+    assert [r[0] for r in page.exports['sensors']['rows']] == ['paper'] * 2 + ['tuned'] * 2
+    paired = page.exports['sensors-paired']
+    columns = paired['columns']
+    by_profile = {row[columns.index('profile')]: row for row in paired['rows']}
+    assert list(by_profile) == ['paper', 'tuned']
+    mean_diff = columns.index('mean_diff')
+    assert float(by_profile['paper'][mean_diff]) == pytest.approx(-5.0)
+    assert float(by_profile['tuned'][mean_diff]) == pytest.approx(5.0)
+    assert by_profile['tuned'][columns.index('wins')] == '2'
