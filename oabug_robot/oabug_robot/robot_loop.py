@@ -174,27 +174,27 @@ class RobotLoop(Generic[_ScanT]):
 
     # The control step.
 
-    def stale_inputs(self, now_s: float) -> list[str]:
-        """The inputs the step reads that are missing or not stamped within the stale
-        timeout before ``now_s`` (the scan by the time of the scan its features came from)."""
-        timeout = self.stale_timeout_s
+    def _required_stamps(self) -> list[tuple[str, float | None]]:
+        """(input, stamp of its newest reading) of the inputs the step reads."""
         required: list[tuple[str, float | None]] = [
             ('scan', self._features_time_s),
             ('imu', self._imu_time_s),
         ]
         if self.needs_gas:
             required.append(('gas', self._gas_time_s))
-        return [
-            name for name, stamp in required if stamp is None or not 0.0 <= now_s - stamp <= timeout
-        ]
+        return required
+
+    def _is_stale(self, stamp: float | None, now_s: float) -> bool:
+        return stamp is None or not 0.0 <= now_s - stamp <= self.stale_timeout_s
+
+    def stale_inputs(self, now_s: float) -> list[str]:
+        """The inputs the step reads that are missing or not stamped within the stale
+        timeout before ``now_s`` (the scan by the time of the scan its features came from)."""
+        return [name for name, stamp in self._required_stamps() if self._is_stale(stamp, now_s)]
 
     def _fresh(self, now_s: float) -> bool:
-        """``not self.stale_inputs(now_s)``, without building the list (every step asks)."""
-        timeout = self.stale_timeout_s
-        stamps = [self._features_time_s, self._imu_time_s]
-        if self.needs_gas:
-            stamps.append(self._gas_time_s)
-        return all(s is not None and 0.0 <= now_s - s <= timeout for s in stamps)
+        """``not self.stale_inputs(now_s)``, stopping at the first stale input."""
+        return not any(self._is_stale(stamp, now_s) for _, stamp in self._required_stamps())
 
     def _near_peers(self, now_s: float) -> tuple[np.ndarray, np.ndarray]:
         bearings = self._bearings

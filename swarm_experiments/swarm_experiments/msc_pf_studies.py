@@ -264,7 +264,7 @@ def _present(page: ReportPage) -> list[str]:
     return [v for v in VARIANTS if v in found]
 
 
-def _fig4_order_table(page: ReportPage) -> Any:
+def _fig4_claim_tables(page: ReportPage) -> Any:
     """The paper's claims on the means: per target count the order of the three schemes, and
     per scheme whether the CCT rises with the target count."""
     import pandas as pd
@@ -342,7 +342,7 @@ def report_fig4(page: ReportPage) -> None:
         'every target by T_max counts as T_max (the mean is then a lower bound).'
     )
     page.add_table(_mean_table(page, variants), title='CCT per scheme', export='cct')
-    order, rising = _fig4_order_table(page)
+    order, rising = _fig4_claim_tables(page)
     if len(order):
         page.add_table(order, title="The paper's order, in the means", export='order')
     if len(rising):

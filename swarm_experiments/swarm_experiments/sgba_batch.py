@@ -203,7 +203,6 @@ def run_sgba_batch(
         spec,
         lambda out: _deliver(engine, out, robots, tags),
         names=names,
-        site=site,
         wall_start=wall_start,
         progress=progress,
     )
