@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import importlib.util
 import json
+import re
 import sys
 from pathlib import Path
 
@@ -52,3 +53,22 @@ def test_a_hand_edit_of_a_region_is_caught(tmp_path: Path) -> None:
     documents = script.load_store(REPO / script.STORE)
     regenerated = script.update_text(edited, documents, page=str(page), store_label=script.STORE)
     assert regenerated == text
+
+
+def test_the_studies_page_lists_every_registered_study_with_its_size() -> None:
+    from swarm_experiments.study import load_registry, make_specs
+
+    text = (REPO / 'docs' / 'studies.md').read_text(encoding='utf-8')
+    section = text.split('## The registered studies', 1)[1].split('\n## ', 1)[0]
+    listed: dict[str, int] = {}
+    for line in section.splitlines():
+        cells = [cell.strip() for cell in line.strip().strip('|').split('|')]
+        if len(cells) < 3 or not cells[0].startswith('`'):
+            continue
+        names = re.findall(r'`([^`]+)`', cells[0])
+        sizes = [int(size.replace(',', '')) for size in cells[2].split(', ')]
+        assert len(names) == len(sizes), line
+        listed.update(zip(names, sizes, strict=True))
+    registry = load_registry()
+    registered = {study.name: len(make_specs(study).specs) for study in registry}
+    assert listed == registered
