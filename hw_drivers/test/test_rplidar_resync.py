@@ -135,7 +135,7 @@ def test_phantom_rate_over_megabytes_of_junk_is_below_one_per_10_kb():
 
 
 def test_forty_bursts_in_six_revolutions_lose_under_one_percent():
-    # The configuration of the issue: 40 bursts of 250 random bytes over 6 revolutions.
+    # A hostile line: 40 bursts of 250 random bytes over 6 revolutions.
     total_phantoms = total_lost = total_valid = 0
     for seed in range(10):
         rng = np.random.default_rng(seed)
