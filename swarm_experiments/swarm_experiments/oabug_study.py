@@ -364,5 +364,8 @@ def report_fig4(page: ReportPage) -> None:
             group_by=('config.site', 'config.variant', 'config.robots', 'config.departure'),
         )
         page.add_table(
-            table, title='Profiles against paper on the same sites (coverage points)', digits=2
+            table,
+            title='Profiles against paper on the same sites (coverage points)',
+            digits=2,
+            export='profiles-paired',
         )
