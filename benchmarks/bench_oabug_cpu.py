@@ -114,11 +114,16 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = parser.parse_args(argv)
     if not args.ours_only and args.simulator is None:
         parser.error('give --simulator DIR or --ours-only')
+    if args.repeat < 1 or args.sites < 1 or args.robots < 1:
+        parser.error('--repeat, --sites and --robots must be at least 1')
     grid = None
     if not args.ours_only:
-        from reference_oabug_grid import CONFIGS, GridSimulator
+        from reference_oabug_grid import CONFIGS, GridSimulator, SimulatorMissingError
 
-        grid = GridSimulator(args.simulator.resolve(), CONFIGS[args.config], 'right')
+        try:
+            grid = GridSimulator(args.simulator.resolve(), CONFIGS[args.config], 'right')
+        except SimulatorMissingError as error:
+            parser.error(str(error))
     # Warm-up: imports, numba compilation, caches.
     _ours(0, args.config, args.variant, args.departure, 2, args.oabug_profile)
     if grid is not None:
@@ -131,8 +136,6 @@ def main(argv: Sequence[str] | None = None) -> int:
     ours_cov: list[float] = []
     ours_timed = 0.0  # CPU of all our runs, repeats included
     grid_cov: list[float] = []
-    if args.repeat < 1:
-        parser.error('--repeat must be at least 1')
     for site in range(args.first_site, args.first_site + args.sites):
         grid_times: list[float] = []
         ours_times: list[float] = []
