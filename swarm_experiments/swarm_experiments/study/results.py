@@ -208,6 +208,17 @@ def _parts(directory: Path) -> list[Path]:
     return sorted(directory.glob('part-*.parquet'))
 
 
+def _read_part(part: Path, columns: list[str] | None = None) -> pa.Table:
+    """One part file; a damaged one is a :class:`ResultsError` that says what to do."""
+    try:
+        return pq.read_table(part, columns=columns)
+    except (OSError, pa.ArrowInvalid) as exc:
+        raise ResultsError(
+            f'{part}: unreadable part file ({exc}); move it out of the study directory '
+            'and the next run of the study runs its runs again'
+        ) from exc
+
+
 def read_rows(directory: str | os.PathLike[str], *, all_attempts: bool = False) -> pd.DataFrame:
     """The rows stored in a study directory as a DataFrame (one row per run id).
 
@@ -219,10 +230,7 @@ def read_rows(directory: str | os.PathLike[str], *, all_attempts: bool = False) 
         raise ResultsError(f'{directory}: not a directory')
     tables = []
     for part in _parts(directory):
-        try:
-            tables.append(pq.read_table(part))
-        except (OSError, pa.ArrowInvalid) as exc:
-            raise ResultsError(f'{part}: unreadable part file ({exc})') from exc
+        tables.append(_read_part(part))
     if not tables:
         return pd.DataFrame(columns=['run_id', 'study', 'seed', 'status'])
     try:
@@ -243,10 +251,7 @@ def done_run_ids(directory: Path) -> set[str]:
     """Run ids with an ``ok`` row in ``directory`` (reads only the two columns needed)."""
     done: set[str] = set()
     for part in _parts(directory):
-        try:
-            table = pq.read_table(part, columns=['run_id', 'status'])
-        except (OSError, pa.ArrowInvalid) as exc:
-            raise ResultsError(f'{part}: unreadable part file ({exc})') from exc
+        table = _read_part(part, ['run_id', 'status'])
         for rid, status in zip(
             table.column('run_id').to_pylist(), table.column('status').to_pylist(), strict=True
         ):

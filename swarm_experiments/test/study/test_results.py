@@ -128,10 +128,22 @@ def test_a_leftover_temporary_file_is_not_read(tmp_path: Path) -> None:
     assert read_rows(tmp_path).empty
 
 
-def test_a_corrupt_part_is_a_one_line_results_error(tmp_path: Path) -> None:
-    (tmp_path / 'part-1.parquet').write_bytes(b'not parquet')
-    with pytest.raises(ResultsError, match='unreadable part file'):
-        read_rows(tmp_path)
+def test_a_corrupt_part_is_a_one_line_error_and_set_aside_its_runs_run_again(
+    tmp_path: Path,
+) -> None:
+    writer = PartWriter(tmp_path, batch_rows=1)
+    writer.add({'study': 's', 'seed': 0, 'run_id': 'a', 'status': 'ok', 'metric.m': 1.0})
+    writer.add({'study': 's', 'seed': 1, 'run_id': 'b', 'status': 'ok', 'metric.m': 2.0})
+    damaged = sorted(tmp_path.glob('part-*.parquet'))[-1]
+    damaged.write_bytes(damaged.read_bytes()[:100])  # a copy cut short
+    for read in (read_rows, done_run_ids):
+        with pytest.raises(ResultsError, match='unreadable part file') as error:
+            read(tmp_path)
+        assert '\n' not in str(error.value)
+        assert 'move it out of the study directory' in str(error.value)
+    damaged.rename(tmp_path / 'damaged.parquet.bak')
+    assert done_run_ids(tmp_path) == {'a'}
+    assert list(read_rows(tmp_path)['run_id']) == ['a']
 
 
 def test_the_directory_lock_admits_one_writer(tmp_path: Path) -> None:
