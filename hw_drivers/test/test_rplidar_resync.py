@@ -19,11 +19,16 @@ from hw_drivers.rplidar_protocol import (
     ScanSamples,
     decode_samples,
 )
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 PROPERTY = settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 MIN_RUN = ResyncConfig().min_run
+# Samples one stray run in junk can give: junk that happens to pass the check bits, the angle
+# steps and the edge checks over MIN_RUN consecutive windows is accepted like real samples
+# (the middle MIN_RUN - 2 always, the two ends when their edge check passes), and such a run
+# rarely goes on past MIN_RUN windows.
+STRAY_RUN = MIN_RUN
 
 
 def _keys(samples):
@@ -98,9 +103,9 @@ def test_junk_bursts_spliced_into_a_stream_add_almost_nothing_and_remove_almost_
     valid = _frame_keys(frames[:closing])
     junk_bytes = sum(size for _, size in bursts)
     phantoms = sum((Counter(samples) - Counter(_frame_keys(frames))).values())
-    # Below one phantom per 10 kB of junk on average; one stray sample in one stream is
-    # tolerated (the aggregate rate is checked below over megabytes).
-    assert phantoms <= 1 + junk_bytes // 10_000
+    # Below one phantom per 10 kB of junk on average; one stray run in one stream is
+    # tolerated (see STRAY_RUN; the aggregate rate is checked below over megabytes).
+    assert phantoms <= STRAY_RUN + junk_bytes // 10_000
     recoverable = Counter(valid) - Counter(short)
     lost = sum((recoverable - Counter(samples)).values())
     assert lost <= 0.01 * len(valid) + 1
@@ -114,11 +119,12 @@ def test_junk_bursts_spliced_into_a_stream_add_almost_nothing_and_remove_almost_
 
 @PROPERTY
 @given(st.integers(0, 2**31), st.integers(1, 20_000), st.lists(st.integers(0, 20_000)))
+@example(130709, 3761, [])  # a stray run of three samples
 def test_random_junk_alone_decodes_to_almost_nothing(seed, size, cuts):
     _, samples, revolutions = _decode(_junk(seed, size), [c for c in cuts if c <= size])
-    # One accepted stray window can give two samples before the next check rejects it; the
-    # aggregate rate is checked below over megabytes.
-    assert len(samples) <= 2 + size // 10_000
+    # One stray run is tolerated (see STRAY_RUN); the aggregate rate is checked below over
+    # megabytes.
+    assert len(samples) <= STRAY_RUN + size // 10_000
     assert revolutions == []
 
 
