@@ -104,26 +104,9 @@ _SWEEPS: dict[tuple[str, int], dict[tuple[str, str], tuple[float, float]]] = {
     ),
 }
 
-#: Sites the authors' simulator figures average over, per (site, robots).
-AUTHORS_SIM_SITES: Mapping[tuple[str, int], int] = MappingProxyType(
-    {
-        ('small', 10): 100,
-        ('small', 8): 100,
-        ('small', 6): 100,
-        ('small', 4): 100,
-        ('small', 2): 100,
-        ('medium', 10): 100,
-        ('medium', 8): 100,
-        ('medium', 6): 100,
-        ('medium', 4): 100,
-        ('medium', 2): 100,
-        ('big', 10): 100,
-        ('big', 8): 100,
-        ('big', 6): 100,
-        ('big', 4): 100,
-        ('big', 2): 100,
-    }
-)
+#: Sites the authors' simulator figures average over, per (site, robots): every sweep above
+#: covers the paper's 100 sites, indices 0-99.
+AUTHORS_SIM_SITES: Mapping[tuple[str, int], int] = MappingProxyType(dict.fromkeys(_SWEEPS, 100))
 
 #: The authors' simulator: (site, robots, departure, variant) -> (mean, std) coverage [%]
 #: at the Table II budget.
