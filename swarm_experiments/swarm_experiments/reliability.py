@@ -946,7 +946,7 @@ def studies() -> list[Study]:
                 'sensors': ('ideal', 'realistic'),
             },
             params={'site': 'small', 'robots': 10},
-            runs=3,
+            runs=100,  # the OA-Bug paper's Fig. 4 site count
             seed_label='site',
             description='Every OA-Bug variant, both robot profiles (paper first), under the ideal '
             'and the realistic sensor profile.',
