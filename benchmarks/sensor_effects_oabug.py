@@ -1,0 +1,180 @@
+"""Each effect of the realistic sensor profile alone, on one OA-Bug variant, paired by site.
+
+The ``sensors-oabug`` study compares the ``ideal`` and the ``realistic`` sensor profile as a
+whole. This script takes the realistic profile apart: every run uses the ideal engine with
+one effect of :class:`swarm_sim.sensor_profiles.RealisticSensors` switched on (its default
+values), and reports the coverage against the ideal run on the same site (site index = site
+seed = run seed, as in the Fig. 4 and sensor studies, so the ``ideal`` and ``realistic`` rows
+equal that study's). ``aoa-random`` is a control, not part of the profile: every bearing is
+a multipath outlier, i.e. uniformly random. Example (the Sound variant from the centre)::
+
+    python benchmarks/sensor_effects_oabug.py --variant sound --sites 100 --workers 2
+
+Effects: ideal, realistic (all at once), aoa-nlos (the AoA non-line-of-sight model: wall
+bias, outliers and long distances together), aoa-bias, aoa-outliers, aoa-distances,
+aoa-los-noise (the line-of-sight azimuth noise), scent (evaporation), lidar (range noise and
+dropouts), imu (gyro bias and drift), aoa-random.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import math
+import statistics
+from collections.abc import Sequence
+from concurrent.futures import ProcessPoolExecutor
+from typing import Any
+
+from swarm_sim.engine import EngineConfig
+from swarm_sim.sensor_profiles import AoaRealismConfig, RealisticSensors, apply_sensor_profile
+
+
+def effect_configs(ideal: EngineConfig | None = None) -> dict[str, EngineConfig]:
+    """The engine configuration of every effect: ``ideal`` with that effect switched on."""
+    base = ideal if ideal is not None else EngineConfig()
+    r = RealisticSensors()
+    real = apply_sensor_profile(base, 'realistic', r)
+    replace = dataclasses.replace
+    return {
+        'ideal': base,
+        'realistic': real,
+        'aoa-nlos': replace(base, aoa=r.aoa),
+        'aoa-bias': replace(
+            base,
+            aoa=replace(
+                r.aoa,
+                outlier_probability_los=0.0,
+                outlier_probability_per_wall=0.0,
+                wall_distance_factor=1.0,
+            ),
+        ),
+        'aoa-outliers': replace(
+            base, aoa=replace(r.aoa, nlos_bias_std_rad_per_wall=0.0, wall_distance_factor=1.0)
+        ),
+        'aoa-distances': replace(
+            base,
+            aoa=replace(
+                r.aoa,
+                nlos_bias_std_rad_per_wall=0.0,
+                outlier_probability_los=0.0,
+                outlier_probability_per_wall=0.0,
+            ),
+        ),
+        'aoa-los-noise': replace(base, bearings=real.bearings),
+        'scent': replace(base, scent=real.scent),
+        'lidar': replace(base, lidar=real.lidar),
+        'imu': replace(base, imu=real.imu),
+        'aoa-random': replace(
+            base, aoa=AoaRealismConfig(outlier_probability_los=1.0, outlier_probability_max=1.0)
+        ),
+    }
+
+
+EFFECTS = tuple(effect_configs())
+
+
+def _coverage(job: tuple[str, int, dict[str, Any]]) -> float:
+    """Room coverage [%] of one run: (effect, site index, SpawnSettings fields)."""
+    from swarm_experiments.oabug_batch import run_spawn_batch
+    from swarm_experiments.spawn import SpawnSettings
+
+    effect, site, fields = job
+    settings = SpawnSettings(site_seed=site, seed=site, engine=effect_configs()[effect], **fields)
+    return 100.0 * run_spawn_batch(settings).mission.coverage
+
+
+def _wilcoxon_p(diffs: Sequence[float]) -> float:
+    from scipy.stats import wilcoxon
+
+    if not any(diffs):
+        return 1.0
+    return float(wilcoxon(diffs).pvalue)
+
+
+def table(coverage: dict[str, list[float]]) -> list[str]:
+    """Markdown rows: each effect's coverage and its difference from ``ideal`` by site."""
+    ideal = coverage['ideal']
+    lines = [
+        '| sensors | runs | coverage % | minus ideal (± s.e.) | more / same / less '
+        '| p (Wilcoxon) |',
+        '| --- | ---: | --- | --- | --- | ---: |',
+    ]
+    for effect, values in coverage.items():
+        spread = statistics.stdev(values) if len(values) > 1 else 0.0
+        row = f'| {effect} | {len(values)} | {statistics.fmean(values):.1f} ± {spread:.1f} |'
+        if effect == 'ideal':
+            lines.append(row + ' | | |')
+            continue
+        diffs = [a - b for a, b in zip(values, ideal, strict=True)]
+        se = statistics.stdev(diffs) / math.sqrt(len(diffs)) if len(diffs) > 1 else 0.0
+        more = sum(d > 0 for d in diffs)
+        less = sum(d < 0 for d in diffs)
+        row += f' {statistics.fmean(diffs):+.1f} ± {se:.1f} | {more} / {len(diffs) - more - less}'
+        row += f' / {less} | {_wilcoxon_p(diffs):.2g} |'
+        lines.append(row)
+    return lines
+
+
+def run(
+    effects: Sequence[str],
+    sites: Sequence[int],
+    fields: dict[str, Any],
+    workers: int,
+) -> dict[str, list[float]]:
+    """Coverage [%] of every effect (``ideal`` first) on every site, on ``workers`` local
+    processes."""
+    names = ['ideal', *(e for e in effects if e != 'ideal')]
+    jobs = [(effect, site, fields) for effect in names for site in sites]
+    if workers == 1:
+        values = [_coverage(job) for job in jobs]
+    else:
+        with ProcessPoolExecutor(workers) as pool:
+            values = list(pool.map(_coverage, jobs))
+    n = len(sites)
+    return {name: values[i * n : (i + 1) * n] for i, name in enumerate(names)}
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
+    parser.add_argument('--config', choices=('small', 'medium', 'big'), default='small')
+    parser.add_argument(
+        '--variant', choices=('random', 'minimum', 'sound', 'gas', 'gas_sound'), default='sound'
+    )
+    parser.add_argument('--departure', choices=('center', 'edge'), default='center')
+    parser.add_argument('--robots', type=int, default=10)
+    parser.add_argument('--sites', type=int, default=20)
+    parser.add_argument('--first-site', type=int, default=0)
+    parser.add_argument('--profile', choices=('paper', 'tuned'), default='paper')
+    parser.add_argument(
+        '--effects',
+        default=','.join(EFFECTS),
+        help=f'comma-separated, from: {", ".join(EFFECTS)} (ideal is always run)',
+    )
+    parser.add_argument('--workers', type=int, default=1, help='local processes')
+    args = parser.parse_args(argv)
+    effects = [e.strip() for e in args.effects.split(',') if e.strip()]
+    unknown = sorted(set(effects) - set(EFFECTS))
+    if unknown:
+        parser.error(f'unknown effect {", ".join(unknown)}; choose from {", ".join(EFFECTS)}')
+    if min(args.sites, args.robots, args.workers) < 1 or args.first_site < 0:
+        parser.error('--sites, --robots and --workers must be at least 1, --first-site >= 0')
+    fields = {
+        'site': args.config,
+        'variant': args.variant,
+        'robots': args.robots,
+        'departure': args.departure,
+        'profile': args.profile,
+    }
+    sites = range(args.first_site, args.first_site + args.sites)
+    coverage = run(effects, sites, fields, args.workers)
+    print(
+        f'{args.config}, {args.variant}, {args.robots} robots from the {args.departure}, '
+        f'profile {args.profile}, sites {sites.start}-{sites.stop - 1}'
+    )
+    print('\n'.join(table(coverage)))
+    return 0
+
+
+if __name__ == '__main__':
+    raise SystemExit(main())
