@@ -10,6 +10,11 @@ a multipath outlier, i.e. uniformly random. Example (the Sound variant from the 
 
     python benchmarks/sensor_effects_oabug.py --variant sound --sites 100 --workers 2
 
+``--trace`` adds where the robots went (from the true trajectories): their mean distance
+from the departure over the second half of the run, the share of those poses within
+``RIM_M`` of the outer bounds of all poses (the site's rim), and how many distinct 1 m cells
+the swarm visited.
+
 Effects: ideal, realistic (all at once), aoa-nlos (the AoA non-line-of-sight model: wall
 bias, outliers and long distances together), aoa-bias, aoa-outliers, aoa-distances,
 aoa-los-noise (the line-of-sight azimuth noise), scent (evaporation), lidar (range noise and
@@ -24,8 +29,9 @@ import math
 import statistics
 from collections.abc import Sequence
 from concurrent.futures import ProcessPoolExecutor
-from typing import Any
+from typing import Any, NamedTuple
 
+import numpy as np
 from swarm_sim.engine import EngineConfig
 from swarm_sim.sensor_profiles import AoaRealismConfig, RealisticSensors, apply_sensor_profile
 
@@ -74,14 +80,40 @@ def effect_configs(ideal: EngineConfig | None = None) -> dict[str, EngineConfig]
 EFFECTS = tuple(effect_configs())
 
 
-def _coverage(job: tuple[str, int, dict[str, Any]]) -> float:
-    """Room coverage [%] of one run: (effect, site index, SpawnSettings fields)."""
+RIM_M = 1.5
+
+
+class Outcome(NamedTuple):
+    """One run: its room coverage and where its robots went (:func:`trace_metrics`)."""
+
+    coverage_pct: float
+    distance_m: float
+    rim_share: float
+    cells: int
+
+
+def trace_metrics(trajectories: np.ndarray) -> tuple[float, float, int]:
+    """Where the robots of (T, N, >=2) true poses went: the mean distance [m] from the
+    robots' mean start over the second half of the samples, the share of those poses within
+    :data:`RIM_M` of the bounding box of all poses, and the distinct 1 m cells visited."""
+    xy = np.asarray(trajectories, dtype=float)[:, :, :2]
+    late = xy[len(xy) // 2 :]
+    distance = np.hypot(*(late - xy[0].mean(axis=0)).transpose(2, 0, 1))
+    low, high = xy.reshape(-1, 2).min(axis=0), xy.reshape(-1, 2).max(axis=0)
+    to_rim = np.minimum(late - low, high - late).min(axis=2)
+    cells = np.unique(np.floor(xy.reshape(-1, 2)).astype(np.int64), axis=0)
+    return float(distance.mean()), float((to_rim < RIM_M).mean()), len(cells)
+
+
+def _outcome(job: tuple[str, int, dict[str, Any]]) -> Outcome:
+    """One run: (effect, site index, SpawnSettings fields)."""
     from swarm_experiments.oabug_batch import run_spawn_batch
     from swarm_experiments.spawn import SpawnSettings
 
     effect, site, fields = job
     settings = SpawnSettings(site_seed=site, seed=site, engine=effect_configs()[effect], **fields)
-    return 100.0 * run_spawn_batch(settings).mission.coverage
+    mission = run_spawn_batch(settings).mission
+    return Outcome(100.0 * mission.coverage, *trace_metrics(mission.trajectories))
 
 
 def _wilcoxon_p(diffs: Sequence[float]) -> float:
@@ -121,18 +153,32 @@ def run(
     sites: Sequence[int],
     fields: dict[str, Any],
     workers: int,
-) -> dict[str, list[float]]:
-    """Coverage [%] of every effect (``ideal`` first) on every site, on ``workers`` local
-    processes."""
+) -> dict[str, list[Outcome]]:
+    """Every effect's runs (``ideal`` first) on every site, on ``workers`` local processes."""
     names = ['ideal', *(e for e in effects if e != 'ideal')]
     jobs = [(effect, site, fields) for effect in names for site in sites]
     if workers == 1:
-        values = [_coverage(job) for job in jobs]
+        values = [_outcome(job) for job in jobs]
     else:
         with ProcessPoolExecutor(workers) as pool:
-            values = list(pool.map(_coverage, jobs))
+            values = list(pool.map(_outcome, jobs))
     n = len(sites)
     return {name: values[i * n : (i + 1) * n] for i, name in enumerate(names)}
+
+
+def trace_table(outcomes: dict[str, list[Outcome]]) -> list[str]:
+    """Markdown rows: where each effect's robots went (means over the sites)."""
+    lines = [
+        f'| sensors | distance from the start, 2nd half m | poses within {RIM_M} m of the rim '
+        '| 1 m cells visited |',
+        '| --- | ---: | ---: | ---: |',
+    ]
+    for effect, runs in outcomes.items():
+        distance = statistics.fmean(o.distance_m for o in runs)
+        rim = statistics.fmean(o.rim_share for o in runs)
+        cells = statistics.fmean(o.cells for o in runs)
+        lines.append(f'| {effect} | {distance:.2f} | {100.0 * rim:.0f} % | {cells:.1f} |')
+    return lines
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -152,6 +198,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         help=f'comma-separated, from: {", ".join(EFFECTS)} (ideal is always run)',
     )
     parser.add_argument('--workers', type=int, default=1, help='local processes')
+    parser.add_argument('--trace', action='store_true', help='also where the robots went')
     args = parser.parse_args(argv)
     effects = [e.strip() for e in args.effects.split(',') if e.strip()]
     unknown = sorted(set(effects) - set(EFFECTS))
@@ -167,12 +214,14 @@ def main(argv: Sequence[str] | None = None) -> int:
         'profile': args.profile,
     }
     sites = range(args.first_site, args.first_site + args.sites)
-    coverage = run(effects, sites, fields, args.workers)
+    outcomes = run(effects, sites, fields, args.workers)
     print(
         f'{args.config}, {args.variant}, {args.robots} robots from the {args.departure}, '
         f'profile {args.profile}, sites {sites.start}-{sites.stop - 1}'
     )
-    print('\n'.join(table(coverage)))
+    print('\n'.join(table({k: [o.coverage_pct for o in v] for k, v in outcomes.items()})))
+    if args.trace:
+        print('\n'.join(trace_table(outcomes)))
     return 0
 
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 
+import numpy as np
 import pytest
 from swarm_sim.engine import EngineConfig
 from swarm_sim.sensor_profiles import RealisticSensors, apply_sensor_profile
@@ -85,10 +86,28 @@ def test_the_table_pairs_every_effect_with_ideal_site_by_site(effects):
     assert '| +0.0 ± 0.0 | 0 / 3 / 0 | 1 |' in imu
 
 
+def test_the_trace_measures_distance_rim_and_cells(effects):
+    # Two robots start at (1, 1) and (3, 1); in the second half one sits at the far corner
+    # (10, 10), on the rim of the poses' box, the other at (5, 5), 4.5 m from every edge.
+    start = [[1.0, 1.0, 0.0], [3.0, 1.0, 0.0]]
+    late = [[10.0, 10.0, 0.0], [5.0, 5.0, 0.0]]
+    trajectories = np.array([start, start, late, late])
+    distance, rim, cells = effects.trace_metrics(trajectories)
+    expected = (np.hypot(8.0, 9.0) + np.hypot(3.0, 4.0)) / 2.0
+    assert distance == pytest.approx(expected)
+    assert rim == pytest.approx(0.5)
+    assert cells == 4
+
+
 def test_a_run_covers_rooms_and_ideal_comes_first(effects):
     fields = {'site': 'small', 'variant': 'sound', 'robots': 2, 'departure': 'center'}
-    coverage = effects.run(['aoa-random', 'ideal'], [0], fields, workers=1)
-    assert list(coverage) == ['ideal', 'aoa-random']
-    for values in coverage.values():
-        assert len(values) == 1
-        assert 0.0 < values[0] <= 100.0
+    outcomes = effects.run(['aoa-random', 'ideal'], [0], fields, workers=1)
+    assert list(outcomes) == ['ideal', 'aoa-random']
+    for runs in outcomes.values():
+        assert len(runs) == 1
+        assert 0.0 < runs[0].coverage_pct <= 100.0
+        assert runs[0].distance_m > 0.0
+        assert 0.0 <= runs[0].rim_share <= 1.0
+        assert runs[0].cells > 1
+    rows = effects.trace_table(outcomes)
+    assert [row.split(' | ')[0] for row in rows[2:]] == ['| ideal', '| aoa-random']
