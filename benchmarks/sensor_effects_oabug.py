@@ -105,28 +105,31 @@ def trace_metrics(trajectories: np.ndarray) -> tuple[float, float, int]:
     return float(distance.mean()), float((to_rim < RIM_M).mean()), len(cells)
 
 
-def _outcome(job: tuple[str, int, dict[str, Any]]) -> Outcome:
-    """One run: (effect, site index, SpawnSettings fields)."""
+def _outcome(job: tuple[EngineConfig, int, dict[str, Any]]) -> Outcome:
+    """One run: (engine configuration, site index, SpawnSettings fields)."""
     from swarm_experiments.oabug_batch import run_spawn_batch
     from swarm_experiments.spawn import SpawnSettings
 
-    effect, site, fields = job
-    settings = SpawnSettings(site_seed=site, seed=site, engine=effect_configs()[effect], **fields)
+    engine, site, fields = job
+    settings = SpawnSettings(site_seed=site, seed=site, engine=engine, **fields)
     mission = run_spawn_batch(settings).mission
     return Outcome(100.0 * mission.coverage, *trace_metrics(mission.trajectories))
 
 
-def _wilcoxon_p(diffs: Sequence[float]) -> float:
-    from scipy.stats import wilcoxon
-
-    if not any(diffs):
-        return 1.0
-    return float(wilcoxon(diffs).pvalue)
-
-
 def table(coverage: dict[str, list[float]]) -> list[str]:
-    """Markdown rows: each effect's coverage and its difference from ``ideal`` by site."""
-    ideal = coverage['ideal']
+    """Markdown rows: each effect's coverage and its difference from ``ideal`` by site (the
+    studies' :func:`~swarm_experiments.study.report.paired_differences`)."""
+    import pandas as pd
+    from swarm_experiments.study.report import paired_differences
+
+    rows = pd.DataFrame(
+        [
+            {'sensors': effect, 'seed': index, 'coverage': value}
+            for effect, values in coverage.items()
+            for index, value in enumerate(values)
+        ]
+    )
+    paired = paired_differences(rows, 'coverage', by='sensors', baseline='ideal')
     lines = [
         '| sensors | runs | coverage % | minus ideal (± s.e.) | more / same / less '
         '| p (Wilcoxon) |',
@@ -138,12 +141,13 @@ def table(coverage: dict[str, list[float]]) -> list[str]:
         if effect == 'ideal':
             lines.append(row + ' | | |')
             continue
-        diffs = [a - b for a, b in zip(values, ideal, strict=True)]
-        se = statistics.stdev(diffs) / math.sqrt(len(diffs)) if len(diffs) > 1 else 0.0
-        more = sum(d > 0 for d in diffs)
-        less = sum(d < 0 for d in diffs)
-        row += f' {statistics.fmean(diffs):+.1f} ± {se:.1f} | {more} / {len(diffs) - more - less}'
-        row += f' / {less} | {_wilcoxon_p(diffs):.2g} |'
+        d = paired[paired['sensors'] == effect].iloc[0]
+        se = 0.0 if math.isnan(d.se_diff) else d.se_diff
+        # The signed-rank test needs two differing sites; identical runs everywhere is p 1.
+        p = 'n/a' if math.isnan(d.p_wilcoxon) else f'{d.p_wilcoxon:.2g}'
+        if d.ties == d.pairs:
+            p = '1'
+        row += f' {d.mean_diff:+.1f} ± {se:.1f} | {d.wins} / {d.ties} / {d.losses} | {p} |'
         lines.append(row)
     return lines
 
@@ -156,7 +160,8 @@ def run(
 ) -> dict[str, list[Outcome]]:
     """Every effect's runs (``ideal`` first) on every site, on ``workers`` local processes."""
     names = ['ideal', *(e for e in effects if e != 'ideal')]
-    jobs = [(effect, site, fields) for effect in names for site in sites]
+    configs = effect_configs()
+    jobs = [(configs[effect], site, fields) for effect in names for site in sites]
     if workers == 1:
         values = [_outcome(job) for job in jobs]
     else:

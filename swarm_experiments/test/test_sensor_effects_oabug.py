@@ -88,7 +88,7 @@ def test_the_table_pairs_every_effect_with_ideal_site_by_site(effects):
 
 def test_the_trace_measures_distance_rim_and_cells(effects):
     # Two robots start at (1, 1) and (3, 1); in the second half one sits at the far corner
-    # (10, 10), on the rim of the poses' box, the other at (5, 5), 4.5 m from every edge.
+    # (10, 10), on the rim of the poses' box, the other at (5, 5), 4 m or more from every edge.
     start = [[1.0, 1.0, 0.0], [3.0, 1.0, 0.0]]
     late = [[10.0, 10.0, 0.0], [5.0, 5.0, 0.0]]
     trajectories = np.array([start, start, late, late])
