@@ -191,11 +191,21 @@ def test_a_project_message_crosses_processes_over_dds() -> None:
         with NodeTestBed() as bed:
             received = bed.probe.collect('/xproc/gas', swarm.GasReading)
             bed.wait_for_graph(timeout_s=60.0)
-            assert bed.spin_until(lambda: len(received) >= 3, timeout_s=30.0)
-            names = bed.probe.node.get_node_names_and_namespaces()
+            # Data can arrive before the graph cache learns the publisher's node name (Fast
+            # DDS sends node names on a topic of their own), so wait for both.
+            graph = bed.probe.node
+
+            def heard_and_named() -> bool:
+                return len(received) >= 3 and (
+                    ('gas_sensor', '/') in graph.get_node_names_and_namespaces()
+                )
+
+            bed.spin_until(heard_and_named, timeout_s=30.0)
+            names = graph.get_node_names_and_namespaces()
     finally:
         child.terminate()
         _, stderr = child.communicate(timeout=30.0)
+    assert len(received) >= 3
     assert ('gas_sensor', '/') in names
     assert received[-1].raw == 417
     assert received[-1].volts == pytest.approx(2.5)

@@ -20,7 +20,7 @@ from sim_bridge.frames import compose
 from swarm_common.angles import yaw_from_quaternion
 from swarm_common.stamps import stamp_to_seconds
 from swarm_runtime.bag import read_bag_info, read_messages
-from swarm_runtime.ros import message_module
+from swarm_runtime.ros import message_module, using_real_rclpy
 
 try:
     message_module('tf2_msgs')
@@ -42,13 +42,16 @@ MARKER_TOPICS = (
 )
 # The viewer topics may make a bag at most this much bigger (the demo: 2.8 -> 4.9 MB).
 MAX_GROWTH = 2.0
+# On DDS the mission runs this much faster than real time (as far as the nodes keep up), so
+# the two recordings take seconds, not minutes; the built-in runtime runs as fast as it can.
+TIME_SCALE = 4.0 if using_real_rclpy() else 1.0
 
 
 def _settings(bag: Path, **extra) -> SpawnSettings:
     # The mission's topics only: the growth below is the viewer topics' against those.
     return SpawnSettings(
         site='small', robots=ROBOTS, actions=200, seed=4, record=bag, record_topics='mission',
-        **extra,
+        time_scale=TIME_SCALE, **extra,
     )  # fmt: skip
 
 
