@@ -35,6 +35,7 @@ from __future__ import annotations
 
 import contextlib
 import importlib
+import re
 import signal
 from collections.abc import Callable, Sequence
 from types import FrameType
@@ -46,7 +47,7 @@ from swarm_common.params import ParameterSpec
 from swarm_runtime.parameters import ParameterFileError, check_parameter_arguments
 from swarm_runtime.ros import ExternalShutdownException, rclpy, using_real_rclpy
 
-__all__ = ['EXIT_FATAL_ERROR', 'STOP_SIGNALS', 'run_node']
+__all__ = ['EXIT_FATAL_ERROR', 'STOP_SIGNALS', 'describe_init_error', 'run_node']
 
 NodeT = TypeVar('NodeT')
 
@@ -91,6 +92,27 @@ class _StopSignals:
     def restore(self) -> None:
         for signum, handler in self._previous.items():
             signal.signal(signum, handler)
+
+
+# rcl appends where in its C sources an error arose (", at /path/src/rcl/arguments.c:352").
+_RCL_SOURCE_LOCATION = re.compile(r', at \S+\.c:\d+')
+
+
+def describe_init_error(error: RuntimeError) -> str:
+    """The one line for a failed ``rclpy.init``: malformed or unknown ROS arguments, mostly.
+
+    Real rclpy raises ``RCLError`` ("failed to initialize rcl: Couldn't parse remap rule:
+    '-r foo'. Error: ..., at .../arguments.c:380") or ``UnknownROSArgsError``
+    ("['--bogus']"); the built-in runtime raises their mirrors. The rcl source locations
+    and the "failed to initialize rcl" prefix are dropped, unknown flags listed as typed.
+    """
+    if type(error).__name__ == 'UnknownROSArgsError':
+        text = str(error)
+        flags = re.findall(r"'([^']*)'", text)  # the message is the list: "['--bogus']"
+        return f'unknown ROS arguments after --ros-args: {" ".join(flags) if flags else text}'
+    text = _RCL_SOURCE_LOCATION.sub('', ' '.join(str(error).split()))
+    text = text.removeprefix('failed to initialize rcl: ')
+    return f'cannot start ROS: {text}'
 
 
 class _Teardown:
@@ -145,7 +167,8 @@ def run_node(
 
     Returns:
         0 after a stop (Ctrl-C, SIGTERM, shutdown by a callback or another thread),
-        ``EXIT_FATAL_ERROR`` after one of ``fatal_errors`` or a bad parameter argument.
+        ``EXIT_FATAL_ERROR`` after one of ``fatal_errors``, a bad parameter argument or
+        malformed ROS arguments (one line on stderr, e.g. a ``-p`` without ``name:=value``).
 
     Raises:
         Exception: whatever the node or a callback raised while the context was still ok.
@@ -166,7 +189,10 @@ def run_node(
     started = False
     try:
         try:
-            rclpy.init(args=None if args is None else list(args))
+            try:
+                rclpy.init(args=None if args is None else list(args))
+            except RuntimeError as err:  # rclpy's RCLError, UnknownROSArgsError, mirrors
+                return fail(name, describe_init_error(err), EXIT_FATAL_ERROR)
             started = True
             stop_signals.check_rclpy_handlers()
             teardown.node = node_factory()

@@ -83,7 +83,8 @@ class RosArguments:
 def _split_rule(rule: str, flag: str) -> tuple[str | None, str, str]:
     left, separator, right = rule.partition(':=')
     if not separator or not left:
-        msg = f"Couldn't parse rule '{flag} {rule}': expected '[node:]name:=value'"
+        form = '[node:]from:=to' if flag in ('-r', '--remap') else '[node:]name:=value'
+        msg = f"Couldn't parse rule '{flag} {rule}': expected '{form}'"
         raise RCLInvalidROSArgsError(msg)
     node_name, colon, name = left.rpartition(':')
     if colon and not node_name:
@@ -155,8 +156,7 @@ def parse_ros_arguments(args: Sequence[str]) -> RosArguments:
         elif arg not in _SWITCHES_IGNORED:
             unknown.append(arg)
     if unknown:
-        msg = f'Found unknown ROS arguments: {unknown}'
-        raise UnknownROSArgsError(msg)
+        raise UnknownROSArgsError(str(unknown))  # rclpy's message: the list itself
     return RosArguments(tuple(remaps), tuple(parameters), tuple(log_levels), tuple(non_ros))
 
 
