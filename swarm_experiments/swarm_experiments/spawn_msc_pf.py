@@ -45,6 +45,7 @@ from swarm_common.cli import (
     fail,
     run_tool,
 )
+from swarm_common.errors import UsageError
 from swarm_sim.engine import EngineConfig, SiteGeometry
 from swarm_sim.faults import FaultConfig
 from swarm_sim.physics import require_backend
@@ -106,6 +107,9 @@ SENSOR_TOPICS = ('/r*/odom', '/r*/rssi', '/r*/captured', '/r*/peers/in')
 #: Largest swarm the spawner runs: every robot is a node in this one process (the paper's
 #: sweep goes to 30; msc_pf_batch runs larger swarms without nodes).
 MAX_ROBOTS = 100
+#: Most targets the spawner places: every robot's node keeps a particle filter per target
+#: (the paper's largest scenario has 20; msc_pf_batch has no such limit).
+MAX_TARGETS = 100
 
 
 @dataclass(frozen=True)
@@ -197,8 +201,12 @@ def check_settings(settings: SpawnSettings) -> None:
             f'msc_pf_batch runs larger swarms), got {settings.robots}'
         )
         raise ExperimentError(msg)
-    if settings.targets < 1:
-        raise ExperimentError(f'--targets must be >= 1, got {settings.targets}')
+    if not 1 <= settings.targets <= MAX_TARGETS:
+        msg = (
+            f'--targets must be in 1..{MAX_TARGETS} (a particle filter per target in every '
+            f'robot node), got {settings.targets}'
+        )
+        raise ExperimentError(msg)
     if settings.seed < 0:
         raise ExperimentError(f'--seed must be >= 0, got {settings.seed}')
     for name, value in (
@@ -451,7 +459,9 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument('--scheme', choices=SCHEMES, default='proposed')
     parser.add_argument('--robots', type=int, default=15)
-    parser.add_argument('--targets', type=int, default=10)
+    parser.add_argument(
+        '--targets', type=int, default=None, help='(default 10, or as many as --target-positions)'
+    )
     parser.add_argument(
         '--target-positions',
         type=points_argument('--target-positions'),
@@ -484,7 +494,13 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 def _main(argv: list[str]) -> int:
     args = build_parser().parse_args(argv)
-    targets = args.targets if args.target_positions is None else len(args.target_positions)
+    if args.target_positions is None:
+        targets = 10 if args.targets is None else args.targets
+    else:
+        targets = len(args.target_positions)
+        if args.targets is not None and args.targets != targets:
+            msg = f'--targets {args.targets} but --target-positions gives {targets} positions'
+            raise UsageError(msg)
     require_backend(args.physics)
     check_runtime(args.runtime)
     faults = fault_config(args.fault)
