@@ -284,3 +284,55 @@ def test_a_lone_mcap_file_reads_like_its_bag(intact: Path) -> None:
     values = [m.message.data for m in read_messages(intact / 'intact.mcap')]
     assert values == list(range(30))
     assert read_bag_info(intact / 'intact.mcap').message_count == 30
+
+
+@pytest.mark.parametrize(
+    ('text', 'problem'),
+    [
+        ('rosbag2_bagfile_information: {version: 5}', "the field 'relative_file_paths' is missing"),
+        ('rosbag2_bagfile_information: 3', 'a field is missing or is not the mapping'),
+        ('[1, 2]', 'a field is missing or is not the mapping'),
+    ],
+)
+def test_metadata_of_the_wrong_shape_is_reported_in_its_own_terms(
+    intact: Path, tmp_path: Path, text: str, problem: str
+) -> None:
+    copy = tmp_path / 'badmeta'
+    shutil.copytree(intact, copy)
+    (copy / 'metadata.yaml').write_text(text)
+    with pytest.raises(CorruptBagError) as caught:
+        list(read_messages(copy))
+    assert problem in str(caught.value)
+    assert 'NoneType' not in str(caught.value)
+
+
+def test_an_empty_mcap_file_is_called_empty(intact: Path, tmp_path: Path) -> None:
+    damaged = _damaged_copy(intact, tmp_path, lambda data: b'')
+    with pytest.raises(CorruptBagError, match=r'intact\.mcap: cannot read the bag: it is empty'):
+        list(read_messages(damaged))
+
+
+def _summary_start(data: bytes) -> int:
+    # Footer: opcode, length, summary start, summary offset start, CRC; then the magic.
+    return int.from_bytes(data[-8 - 20 : -8 - 12], 'little')
+
+
+def test_a_damaged_summary_fails_its_crc_and_recovery_reads_the_records(
+    intact: Path, tmp_path: Path
+) -> None:
+    # The summary repeats the schema the data section holds; damage its copy only.
+    def damage(data: bytes) -> bytes:
+        at = data.index(b'std_msgs/msg/Int32', _summary_start(data)) + 20
+        return data[:at] + bytes([data[at] ^ 0xFF]) + data[at + 1 :]
+
+    damaged = _damaged_copy(intact, tmp_path, damage)
+    with pytest.raises(CorruptBagError, match=r'summary section .* fails its CRC') as caught:
+        list(read_messages(damaged))
+    assert caught.value.recoverable
+    values, warnings = _recover(damaged)
+    assert values == list(range(30))
+    assert any('fails its CRC' in text for text in warnings)
+    info = read_bag_info(damaged, allow_truncated=True)
+    assert info.message_count == 30
+    assert not info.complete  # recovery says what it read around, not "intact"
+    assert any('fails its CRC' in problem for problem in info.problems)

@@ -62,6 +62,13 @@ def _parse(typename: str, encoding: str, text: str) -> dict[str, Any]:
     raise BagTypeError(msg)
 
 
+def _excerpt(error: Exception, limit: int = 120) -> str:
+    """The parser's complaint on one line, printable and short (it may quote damaged bytes)."""
+    text = ' '.join(str(error).split())
+    text = ''.join(c if c.isprintable() else '?' for c in text)
+    return text if len(text) <= limit else text[: limit - 3] + '...'
+
+
 def definition_typestore(
     typename: str, encoding: str, text: str, fallback: Typestore | None = None
 ) -> Typestore:
@@ -73,7 +80,7 @@ def definition_typestore(
     try:
         types = _parse(typename, encoding, text)
     except TypesysError as err:
-        msg = f'the definition of {typename} stored in the bag cannot be parsed: {err}'
+        msg = f'the definition of {typename} stored in the bag cannot be parsed ({_excerpt(err)})'
         raise BagTypeError(msg) from err
     if typename not in types:
         msg = f'the definition stored for {typename} does not define it'

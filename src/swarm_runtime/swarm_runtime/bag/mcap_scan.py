@@ -27,7 +27,7 @@ import zlib
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, NamedTuple
+from typing import Any, BinaryIO, NamedTuple
 
 __all__ = [
     'MCAP_MAGIC',
@@ -444,12 +444,38 @@ def open_layout(path: Path, *, walk: bool) -> McapLayout:
     return layout
 
 
+_FOOTER_FIELDS = struct.Struct('<BQQQI')  # opcode, length, summary start, offsets start, crc
+
+
+def _summary_crc_problem(stream: BinaryIO, size: int) -> str | None:
+    """Why the summary section fails its CRC (MCAP footer), or None if it passes.
+
+    The footer's CRC covers the bytes from the summary's start through the footer's summary
+    offset field; 0 means the writer computed none. The summary holds the schemas, channels
+    and chunk index that reading by the summary trusts, so a damaged one is not read.
+    """
+    footer_at = size - len(MCAP_MAGIC) - _FOOTER_SIZE
+    stream.seek(footer_at)
+    _, _, summary_start, _, crc = _FOOTER_FIELDS.unpack(stream.read(_FOOTER_SIZE))
+    if crc == 0 or summary_start == 0:
+        return None
+    crc_end = size - len(MCAP_MAGIC) - 4
+    if not len(MCAP_MAGIC) <= summary_start <= footer_at:
+        return f'its MCAP footer is damaged (summary start {summary_start} outside the file)'
+    stream.seek(summary_start)
+    if zlib.crc32(stream.read(crc_end - summary_start)) != crc:
+        return 'its summary section (schemas, channels, index) fails its CRC (it is damaged)'
+    return None
+
+
 def _from_summary(layout: McapLayout) -> str | None:
     """Fill ``layout`` from the file's summary; return why that is impossible, if it is."""
     from mcap.exceptions import McapError
     from mcap.reader import SeekingReader
 
     size = layout.size
+    if size == 0:
+        return 'it is empty (0 bytes)'
     with layout.path.open('rb') as stream:
         if stream.read(len(MCAP_MAGIC)) != MCAP_MAGIC:
             return 'it does not start with the MCAP magic bytes (not an MCAP file)'
@@ -461,6 +487,9 @@ def _from_summary(layout: McapLayout) -> str | None:
                 f'it is cut or damaged: its {size} bytes do not end with the MCAP footer '
                 '(the recording was not finished, or the copy is incomplete)'
             )
+        problem = _summary_crc_problem(stream, size)
+        if problem is not None:
+            return problem
         stream.seek(0)
         try:
             summary = SeekingReader(stream).get_summary()

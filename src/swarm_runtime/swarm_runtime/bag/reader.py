@@ -172,9 +172,18 @@ def _read_metadata(path: Path) -> _Metadata:
             duration_ns=int(info['duration']['nanoseconds']),
         )
     except (OSError, yaml.YAMLError, KeyError, TypeError, ValueError, AttributeError) as err:
-        text = str(err).strip().splitlines()[0] if str(err).strip() else type(err).__name__
-        msg = f'{path}: not a valid rosbag2 metadata file ({text})'
+        msg = f'{path}: not a valid rosbag2 metadata file ({_metadata_problem(err)})'
         raise CorruptBagError(msg) from err
+
+
+def _metadata_problem(error: Exception) -> str:
+    """What is wrong with a metadata.yaml, in the file's terms rather than Python's."""
+    if isinstance(error, KeyError):
+        return f'the field {error.args[0]!r} is missing'
+    if isinstance(error, TypeError | AttributeError):
+        return 'a field is missing or is not the mapping, list or number rosbag2 writes'
+    text = str(error).strip()
+    return text.splitlines()[0] if text else type(error).__name__
 
 
 # --------------------------------------------------------------------------- locating files
