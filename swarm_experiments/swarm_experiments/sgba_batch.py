@@ -88,7 +88,7 @@ class SgbaSettings(SiteBudget):
         if self.robots < 1:
             raise ConfigurationError(f'robots must be >= 1, got {self.robots}')
         if not (math.isfinite(self.speed_mps) and self.speed_mps > 0.0):
-            raise ConfigurationError(f'speed_mps must be positive, got {self.speed_mps}')
+            raise ConfigurationError(f'speed_mps must be positive and finite, got {self.speed_mps}')
         reserved = sorted(set(self.robot_parameters) & set(MISSION_PARAMETERS))
         if reserved:
             msg = f'set by the mission, not as robot parameters: {", ".join(reserved)}'

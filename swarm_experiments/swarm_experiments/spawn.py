@@ -194,7 +194,7 @@ class SpawnSettings(SiteBudget):
             msg = f'actions must be >= 1, got {self.actions}'
             raise ConfigurationError(msg)
         if not (math.isfinite(self.speed_mps) and self.speed_mps > 0.0):
-            msg = f'speed_mps must be positive, got {self.speed_mps}'
+            msg = f'speed_mps must be positive and finite, got {self.speed_mps}'
             raise ConfigurationError(msg)
         if self.seed < 0 or self.site_seed < 0:
             msg = f'seeds must be >= 0, got seed {self.seed}, site seed {self.site_seed}'
