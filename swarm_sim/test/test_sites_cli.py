@@ -165,3 +165,80 @@ def test_import_and_validate_log_the_sites_warnings_on_stderr(
     err = capsys.readouterr().err
     assert 'warning' not in err
     assert err.count('\n') == 1
+
+
+@pytest.mark.parametrize(
+    ('argv', 'expected'),
+    [
+        (['import-lay', 'IN', '-o', 'out.txt'], '--output out.txt: expected a .yaml or .yml file'),
+        (['import-lay', 'IN', '-o', 'plan.lay'], '--output plan.lay: expected a .yaml or .yml'),
+        (['import-lay', 'IN', '-o', 'a.yaml', '--png', 'a.yaml'], '--png a.yaml: expected a .png'),
+        (['import-lay', 'IN', '-o', 'a.yaml', '--name', ''], '--name must not be empty'),
+        (['generate', '--seed', '1', '-o', 'g.yaml', '--lay', 'g.yaml'], '--lay g.yaml: expected'),
+        (['generate', '--seed', '1', '-o', 'g.yaml', '--png', 'g2.yaml'], '--png g2.yaml: exp'),
+        (['render', 'IN', '-o', 'x.yaml'], '--output x.yaml: expected a .png, .svg or .pdf'),
+        (
+            [
+                'generate',
+                '--seed',
+                '1',
+                '--width-cells',
+                '0',
+                '--height-cells',
+                '40',
+                '-o',
+                'g.yaml',
+            ],
+            '--width-cells must be a positive integer, got 0',
+        ),
+        (['generate', '--seed', '1', '--rooms', '-2', '-o', 'g.yaml'], '--rooms must be a pos'),
+    ],
+)
+def test_bad_outputs_and_options_are_refused_before_anything_is_written(
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+    argv: list[str],
+    expected: str,
+) -> None:
+    plan = tmp_path / 'plan.lay'
+    plan.write_bytes((CONFIG_DIR / 'office_plan.lay').read_bytes())
+    monkeypatch.chdir(tmp_path)
+    assert main([str(plan) if item == 'IN' else item for item in argv]) == 2
+    err = capsys.readouterr().err
+    assert err.count('\n') == 1
+    assert expected in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ['plan.lay']
+    assert plan.read_bytes() == (CONFIG_DIR / 'office_plan.lay').read_bytes()
+
+
+def test_an_output_that_is_the_input_is_refused_even_through_a_link(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    plan = tmp_path / 'plan.yaml'  # a layout under a site file's name
+    original = (CONFIG_DIR / 'office_plan.lay').read_bytes()
+    plan.write_bytes(original)
+    link = tmp_path / 'link.yaml'
+    link.symlink_to(plan)
+    for out in (plan, link):
+        assert main(['import-lay', str(plan), '-o', str(out)]) == 2
+        assert 'is the input file; it is never overwritten' in capsys.readouterr().err
+    assert plan.read_bytes() == original
+
+
+def test_validate_refuses_oversized_and_recursive_site_files_in_one_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    text = (CONFIG_DIR / 'small_seed1.yaml').read_text()
+    big = tmp_path / 'big.yaml'
+    big.write_text(text.replace('width_m: 15.733333', 'width_m: 10000.0'))
+    recursive = tmp_path / 'loop.yaml'
+    recursive.write_text('a: &a [*a]\n')
+    assert main(['validate', str(big)]) == 2
+    assert 'big.yaml:6: bounds.width_m: 10000 m is larger than the 1000 m' in (
+        capsys.readouterr().err
+    )
+    assert main(['validate', str(recursive)]) == 2
+    err = capsys.readouterr().err
+    assert 'loop.yaml:1: a[0]: an alias refers to the collection that contains it' in err
+    assert err.count('\n') == 1

@@ -7,7 +7,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 from swarm_sim.sites import SiteFileError, generate_site
-from swarm_sim.sites.site_file import FORMAT, dump_site, load_site, parse_site, save_site
+from swarm_sim.sites.site_file import (
+    FORMAT,
+    MAX_FILE_BYTES,
+    dump_site,
+    load_site,
+    parse_site,
+    save_site,
+)
 
 CONFIG_DIR = Path(__file__).resolve().parents[1] / 'config' / 'sites'
 
@@ -178,3 +185,97 @@ def test_broken_yaml_and_empty_files_are_reported_with_the_file() -> None:
         parse_site('', 'box.yaml')
     with pytest.raises(SiteFileError, match=r'box\.yaml:1: expected a mapping'):
         parse_site('- 1\n- 2\n', 'box.yaml')
+
+
+@pytest.mark.parametrize(
+    ('old', 'new', 'expected'),
+    [
+        (
+            'width_m: 4.0',
+            'width_m: 10000.0',
+            r'box\.yaml:3: bounds\.width_m: 10000 m is larger than the 1000 m a site side may be',
+        ),
+        (
+            'height_m: 3.0',
+            'height_m: 1.0e+308',
+            r'box\.yaml:3: bounds\.height_m: 1e\+308 m is larger than the 1000 m',
+        ),
+        (
+            'width_m: 4.0, height_m: 3.0',
+            'width_m: 900.0, height_m: 900.0',
+            r'box\.yaml:3: bounds: 900 x 900 m is too large to check: .* more than the 10,000,000',
+        ),
+        (
+            'name: box\n',
+            'name: box\ngrid_m: 0.00001\n',
+            r'box\.yaml:4: bounds: .*a quarter of grid_m 1e-05 m.* more than the 10,000,000',
+        ),
+    ],
+)
+def test_bounds_too_large_to_simulate_are_refused_before_anything_is_built(
+    old: str, new: str, expected: str
+) -> None:
+    assert old in MINIMAL
+    with pytest.raises(SiteFileError, match=expected):
+        parse_site(MINIMAL.replace(old, new, 1), 'box.yaml')
+
+
+def test_walls_longer_in_total_than_the_raster_allows_are_refused() -> None:
+    many = '  - [0.0, 0.0, 0.0, 1000.0]\n' * 300
+    text = MINIMAL.replace('walls:\n', 'walls:\n' + many, 1)
+    with pytest.raises(
+        SiteFileError, match=r'box\.yaml:8: walls: the walls are 300016 m long in total'
+    ):
+        parse_site(text, 'box.yaml')
+
+
+def test_a_recursive_alias_is_a_site_file_error_not_a_crash() -> None:
+    with pytest.raises(SiteFileError, match=r'box\.yaml:1: a\[0\]: .*recursive alias'):
+        parse_site('a: &a [*a]\n', 'box.yaml')
+    text = MINIMAL.replace('walls:\n', 'walls: &w\n  - *w\n', 1)
+    with pytest.raises(SiteFileError, match=r'box\.yaml:8: walls\[0\]: .*recursive alias'):
+        parse_site(text, 'box.yaml')
+
+
+def test_deep_nesting_is_a_site_file_error_not_a_crash() -> None:
+    with pytest.raises(SiteFileError, match=r'box\.yaml:1: .*nested more than 32 levels deep'):
+        parse_site('[' * 5000 + ']' * 5000, 'box.yaml')
+
+
+def test_an_alias_used_many_times_is_read_once() -> None:
+    bomb = 'a: &a [x, x, x, x, x, x, x, x, x]\n' + ''.join(
+        f'{b}: &{b} [{", ".join([f"*{a}"] * 9)}]\n'
+        for a, b in zip('abcdefgh', 'bcdefghi', strict=True)
+    )
+    with pytest.raises(SiteFileError, match=r'box\.yaml:1: a: unknown key'):
+        parse_site(bomb, 'box.yaml')
+
+
+def test_a_duplicate_key_names_both_lines() -> None:
+    text = MINIMAL + 'name: again\n'
+    with pytest.raises(
+        SiteFileError, match=r"box\.yaml:23: name: duplicate key 'name' \(first at line 2\)"
+    ):
+        parse_site(text, 'box.yaml')
+    nested = MINIMAL.replace('{x_m: 1.0, y_m: 1.5}', '{x_m: 1.0, y_m: 1.5, x_m: 2.0}')
+    with pytest.raises(SiteFileError, match=r'box\.yaml:5: departure_points\.center\.x_m: dup'):
+        parse_site(nested, 'box.yaml')
+
+
+def test_a_door_must_name_a_room_but_the_entrance_need_not() -> None:
+    for door in ('{segment: [2.5, 1.9, 2.5, 2.5], rooms: []}', '{segment: [2.5, 1.9, 2.5, 2.5]}'):
+        text = MINIMAL.replace('{segment: [2.5, 1.9, 2.5, 2.5], rooms: [1]}', door)
+        with pytest.raises(SiteFileError, match=r'box\.yaml:22: doors\[0\].*a door joins rooms'):
+            parse_site(text, 'box.yaml')
+    text = MINIMAL.replace(
+        'entrance: {segment: [1.8, 0.0, 2.2, 0.0]}',
+        'entrance: {segment: [1.8, 0.0, 2.2, 0.0], rooms: []}',
+    )
+    assert parse_site(text, 'box.yaml').entrance is not None
+
+
+def test_a_file_larger_than_a_site_file_may_be_is_refused_unread(tmp_path: Path) -> None:
+    path = tmp_path / 'big.yaml'
+    path.write_text(MINIMAL + '#' * MAX_FILE_BYTES)
+    with pytest.raises(SiteFileError, match=r'big\.yaml: the file is larger than the 16 MiB'):
+        load_site(path)

@@ -222,3 +222,13 @@ def test_any_size_gives_a_valid_site_with_exactly_the_rooms_asked_for_or_a_clear
     else:
         assert len(site.rooms) == rooms
         validate_site(site)
+
+
+def test_sizes_beyond_the_layout_and_site_limits_are_rejected() -> None:
+    with pytest.raises(GeneratorError, match='5000 x 40 cells is too large'):
+        GeneratorConfig(5000, 40)
+    with pytest.raises(GeneratorError, match='1000 x 1000 cells is too large'):
+        GeneratorConfig(1000, 1000)
+    with pytest.raises(GeneratorError, match='a side may be at most 1000 m'):
+        GeneratorConfig(60, 30, cell_m=20.0)
+    assert GeneratorConfig(2000, 300, rooms=1, victims=0).width_cells == 2000

@@ -20,7 +20,13 @@ from swarm_sim.sites import (
     layout_to_site,
 )
 from swarm_sim.sites.door_gaps import DoorGap, closing_masks, find_door_gaps
-from swarm_sim.sites.layout import parse_layout, read_layout, write_layout
+from swarm_sim.sites.layout import (
+    MAX_LAYOUT_COLUMNS,
+    MAX_LAYOUT_LINES,
+    parse_layout,
+    read_layout,
+    write_layout,
+)
 
 CONFIG_DIR = Path(__file__).resolve().parents[1] / 'config' / 'sites'
 
@@ -390,3 +396,30 @@ def test_door_gaps_are_missing_vertices_in_wall_lines_not_narrow_passages() -> N
     assert closed[3, 2]
     assert closed_h[3, 1:3].all()
     assert not closed_v.any()
+
+
+def test_a_layout_larger_than_the_limits_is_refused_before_it_is_read(tmp_path: Path) -> None:
+    wide = '%' * (MAX_LAYOUT_COLUMNS + 1) + '\n'
+    with pytest.raises(LayoutError, match=r'^plan\.lay: the layout is 3 lines of 2001 characters'):
+        parse_layout(wide * 3, 'plan.lay')
+    with pytest.raises(LayoutError, match=r'^plan\.lay: the layout is 2001 lines of 3'):
+        parse_layout('%%%\n' * (MAX_LAYOUT_LINES + 1), 'plan.lay')
+    square = ('%' * 1000 + '\n') * 1000
+    with pytest.raises(LayoutError, match=r'at most 2000 lines, 2000 columns and 600000 char'):
+        parse_layout(square, 'plan.lay')
+    huge = tmp_path / 'huge.lay'
+    huge.write_text(('%' * 3000 + '\n') * 3000)
+    with pytest.raises(LayoutError, match=r'huge\.lay: the file is larger than'):
+        read_layout(huge)
+
+
+def test_a_cell_size_that_makes_the_site_too_large_is_refused(tmp_path: Path) -> None:
+    with pytest.raises(
+        LayoutError, match=r'plan\.lay: .* bounds\.width_m: .* larger than the 1000'
+    ):
+        import_text(tmp_path, LABELLED, cell_m=100.0)
+
+
+def test_an_empty_site_name_is_refused(tmp_path: Path) -> None:
+    with pytest.raises(LayoutError, match='the site name must not be empty'):
+        import_text(tmp_path, LABELLED, name='')

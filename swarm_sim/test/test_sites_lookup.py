@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from swarm_sim.sites import NO_ROOM, Room, RoomLookup, SiteValidationError, generate_site
+from swarm_sim.sites.room_lookup import points_in_polygon
 
 
 def brute_force_room_ids(rooms: tuple[Room, ...], points: np.ndarray) -> np.ndarray:
@@ -69,3 +70,18 @@ def test_lookup_accepts_a_single_point_and_returns_int32() -> None:
     ids = site.room_ids_at(np.asarray(room.label_point))
     assert ids.dtype == np.int32
     assert ids.tolist() == [room.room_id]
+
+
+def test_rooms_fill_only_their_own_cells_of_the_raster() -> None:
+    triangle = np.array([(2.0, 0.0), (3.0, 0.0), (2.0, 1.1)])
+    rooms = (
+        Room(4, [(0.5, 0.5, 1.0, 1.0), (2.5, 1.5, 3.0, 2.0)]),
+        Room(7, np.empty((0, 4)), polygon=triangle),
+    )
+    lookup = RoomLookup(rooms, 3.0, 2.0, 0.25)
+    iy, ix = np.mgrid[0:8, 0:12]
+    centres = np.column_stack([(ix.ravel() + 0.5) * 0.25, (iy.ravel() + 0.5) * 0.25])
+    expected = brute_force_room_ids(rooms[:1], centres)
+    expected[points_in_polygon(centres, triangle)] = 7
+    np.testing.assert_array_equal(lookup.raster, expected.reshape(8, 12))
+    assert np.count_nonzero(lookup.raster == 4) == 8

@@ -149,3 +149,22 @@ def test_a_site_without_rooms_is_valid_but_not_searchable() -> None:
     with pytest.raises(SiteValidationError, match=r'^box\.yaml: the site has no rooms'):
         require_rooms(empty, 'box.yaml')
     require_rooms(box_site())
+
+
+def test_a_door_that_names_no_room_is_rejected_but_an_entrance_may() -> None:
+    with pytest.raises(SiteValidationError, match=r'door at .* names no room') as caught:
+        validate_site(box_site(doors=(Door((2.5, 1.9, 2.5, 2.5)),)))
+    assert caught.value.key_path == ('doors', 0)
+    site = box_site()
+    assert site.entrance is not None
+    assert site.entrance.room_ids == ()
+    validate_site(site)
+
+
+def test_a_site_too_large_to_rasterize_is_rejected_when_it_is_built() -> None:
+    with pytest.raises(SiteValidationError, match='larger than the 1000 m') as caught:
+        box_site(width_m=1e6)
+    assert caught.value.key_path == ('bounds', 'width_m')
+    with pytest.raises(SiteValidationError, match='too large to check') as caught:
+        box_site(grid_m=1e-6)
+    assert caught.value.key_path == ('bounds',)

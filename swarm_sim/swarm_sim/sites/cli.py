@@ -11,8 +11,10 @@ Examples::
 Every command exits with 0 on success and 2 on an invalid site or bad input (``validate``
 also refuses a site without rooms, which ``import-lay`` writes with a warning), printing the
 error as one line (file, line and column or key) on stderr; ``--debug`` adds the traceback.
-Outputs are checked before anything is built and written under a temporary name first, so
-a failed command leaves no partial file.
+Outputs are checked before anything is built (each must have a suffix its reader takes:
+``.yaml``/``.yml`` site files, ``.lay`` layouts, ``.png``/``.svg``/``.pdf`` pictures, and
+none may be an input or another output) and written under a temporary name first, so a
+failed command leaves no partial file and never overwrites its input.
 The site's warnings (a sealed void read as solid, a departure point inside a room, ...) go
 to stderr as ``warning: ...`` lines.
 """
@@ -24,8 +26,10 @@ import sys
 from collections.abc import Sequence
 from dataclasses import replace
 from pathlib import Path
+from typing import Final
 
 from swarm_common.cli import ToolParser, run_tool
+from swarm_common.errors import UsageError
 from swarm_common.outputs import check_output_file
 
 from swarm_sim.sites.errors import SiteError
@@ -76,25 +80,87 @@ def _render(site: Site, path: str) -> None:
     print(f'wrote {path}')
 
 
-def _check_outputs(args: argparse.Namespace, *options: str) -> None:
-    """Every output the command will write can be written (checked before any work)."""
-    for option in options:
+_SITE_SUFFIXES: Final = ('.yaml', '.yml')
+_LAYOUT_SUFFIXES: Final = ('.lay',)
+_PICTURE_SUFFIXES: Final = ('.png', '.svg', '.pdf')
+
+
+def _same_file(a: Path, b: Path) -> bool:
+    if a.resolve() == b.resolve():
+        return True
+    try:
+        return a.exists() and b.exists() and a.samefile(b)
+    except OSError:
+        return False
+
+
+def _check_outputs(
+    args: argparse.Namespace, inputs: Sequence[str], outputs: dict[str, tuple[str, ...]]
+) -> None:
+    """Every output the command will write can be written, has a suffix its reader takes
+    (``site_tool validate`` for site files and layouts), and is neither an input nor another
+    output; checked before any work, so a refused command writes nothing.
+
+    Args:
+        args: the parsed arguments.
+        inputs: the input files of the command.
+        outputs: option -> the suffixes its file may have.
+
+    Raises:
+        UsageError: a suffix that does not fit, or an output that is an input or another
+            output.
+        OutputError: an output that cannot be written.
+    """
+    seen: list[tuple[str, Path]] = [('the input', Path(path)) for path in inputs]
+    for option, suffixes in outputs.items():
         value = getattr(args, option.lstrip('-').replace('-', '_'), None)
-        if value:
-            check_output_file(value, option=option)
+        if value is None:
+            continue
+        path = Path(value)
+        if path.suffix.lower() not in suffixes:
+            names = ', '.join(suffixes[:-1]) + ' or ' + suffixes[-1] if len(suffixes) > 1 else ''
+            msg = (
+                f'{option} {value}: expected a {names or suffixes[0]} file name, got '
+                f'{repr(path.suffix) if path.suffix else "no suffix"}'
+            )
+            raise UsageError(msg)
+        check_output_file(path, option=option)
+        for what, other in seen:
+            if _same_file(path, other):
+                if what == 'the input':
+                    msg = f'{option} {value}: is the input file; it is never overwritten'
+                else:
+                    msg = f'{option} {value}: is also the output of {what}'
+                raise UsageError(msg)
+        seen.append((option, path))
+
+
+def _check_name(name: str | None) -> None:
+    if name is not None and not name.strip():
+        raise UsageError(f'--name must not be empty, got {name!r}')
+
+
+def _check_size_option(option: str, value: int | None) -> None:
+    if value is not None and value <= 0:
+        raise UsageError(f'{option} must be a positive integer, got {value}')
 
 
 def _generate(args: argparse.Namespace) -> int:
     if args.seed < 0:
         raise SiteError(f'--seed must be >= 0, got {args.seed}')
-    _check_outputs(args, '--output', '--lay', '--png')
+    _check_size_option('--width-cells', args.width_cells)
+    _check_size_option('--height-cells', args.height_cells)
+    _check_size_option('--rooms', args.rooms)
+    _check_name(args.name)
+    outputs = {'--output': _SITE_SUFFIXES, '--lay': _LAYOUT_SUFFIXES, '--png': _PICTURE_SUFFIXES}
+    _check_outputs(args, (), outputs)
     config = resolve_config(args.config)
     sizes = (args.width_cells, args.height_cells, args.rooms)
     if any(v is not None for v in sizes):
         config = with_size(
             config,
-            width_cells=args.width_cells or config.width_cells,
-            height_cells=args.height_cells or config.height_cells,
+            width_cells=config.width_cells if args.width_cells is None else args.width_cells,
+            height_cells=config.height_cells if args.height_cells is None else args.height_cells,
             rooms=config.rooms if args.rooms is None else args.rooms,
         )
     if args.victims is not None:
@@ -126,7 +192,8 @@ def _parse_departure(text: str) -> tuple[str, tuple[float, float]]:
 
 
 def _import_lay(args: argparse.Namespace) -> int:
-    _check_outputs(args, '--output', '--png')
+    _check_name(args.name)
+    _check_outputs(args, (args.layout,), {'--output': _SITE_SUFFIXES, '--png': _PICTURE_SUFFIXES})
     result = import_layout(
         args.layout,
         mode=args.mode,
@@ -166,7 +233,7 @@ def _validate(args: argparse.Namespace) -> int:
 
 
 def _render_command(args: argparse.Namespace) -> int:
-    _check_outputs(args, '--output')
+    _check_outputs(args, (args.site,), {'--output': _PICTURE_SUFFIXES})
     site = load_any(args.site)
     _log_warnings(site)
     _render(site, args.output)
@@ -225,7 +292,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     render = commands.add_parser('render', help='draw a site to a PNG, rooms labelled by id')
     render.add_argument('site', help='a .yaml site file or .lay layout')
-    render.add_argument('-o', '--output', required=True, help='PNG to write')
+    render.add_argument('-o', '--output', required=True, help='picture to write (.png, .svg, .pdf)')
     render.set_defaults(run=_render_command)
     return parser
 

@@ -40,13 +40,16 @@ from swarm_sim.sites.errors import GeneratorError
 from swarm_sim.sites.layout import (
     CORRIDOR_DOOR,
     FREE,
+    MAX_LAYOUT_CHARACTERS,
+    MAX_LAYOUT_COLUMNS,
+    MAX_LAYOUT_LINES,
     ROOM_DOOR,
     WALL,
     Layout,
     LayoutMode,
     layout_to_site,
 )
-from swarm_sim.sites.model import CELL_M, Site
+from swarm_sim.sites.model import CELL_M, MAX_SIDE_M, Site
 
 __all__ = [
     'BIG',
@@ -126,6 +129,23 @@ class GeneratorConfig:
             )
         if not (math.isfinite(self.cell_m) and self.cell_m > 0):
             msg = f'cell_m must be positive, got {self.cell_m!r}'
+            raise GeneratorError(msg)
+        if (
+            self.width_cells > MAX_LAYOUT_COLUMNS
+            or self.height_cells > MAX_LAYOUT_LINES
+            or self.width_cells * self.height_cells > MAX_LAYOUT_CHARACTERS
+        ):
+            msg = (
+                f'a site of {self.width_cells} x {self.height_cells} cells is too large: at most '
+                f'{MAX_LAYOUT_COLUMNS} x {MAX_LAYOUT_LINES} cells and {MAX_LAYOUT_CHARACTERS} '
+                'in all (the largest layout the importer reads)'
+            )
+            raise GeneratorError(msg)
+        if max(self.width_m, self.height_m) > MAX_SIDE_M:
+            msg = (
+                f'a site of {self.width_m:g} x {self.height_m:g} m is too large: a side may be at '
+                f'most {MAX_SIDE_M:g} m'
+            )
             raise GeneratorError(msg)
 
     @property

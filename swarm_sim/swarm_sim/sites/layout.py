@@ -61,8 +61,16 @@ from swarm_common.outputs import write_text_atomic
 
 from swarm_sim.sites import lattice
 from swarm_sim.sites.door_gaps import closing_masks, find_door_gaps
-from swarm_sim.sites.errors import LayoutError, SiteValidationError, SiteWarning
-from swarm_sim.sites.model import CELL_M, NO_ROOM, DeparturePoint, Door, Room, Site
+from swarm_sim.sites.errors import LayoutError, SiteValidationError, SiteWarning, format_key_path
+from swarm_sim.sites.model import (
+    CELL_M,
+    NO_ROOM,
+    DeparturePoint,
+    Door,
+    Room,
+    Site,
+    check_site_size,
+)
 from swarm_sim.sites.validation import validate_site
 
 __all__ = [
@@ -70,6 +78,9 @@ __all__ = [
     'DEPARTURE',
     'FLOOR',
     'FREE',
+    'MAX_LAYOUT_CHARACTERS',
+    'MAX_LAYOUT_COLUMNS',
+    'MAX_LAYOUT_LINES',
     'ROOM_DOOR',
     'WALL',
     'Layout',
@@ -95,6 +106,20 @@ _DIGIT_FIRST: Final = ord('0')
 _DIGIT_LAST: Final = ord('9')
 EDGE_INSET_CELLS: Final = 2.5
 """How far inside the entrance the "edge" departure point sits [cells] (authors' runner)."""
+
+MAX_LAYOUT_LINES: Final = 2000
+"""Most lines a layout may have (the paper's Big site has 60)."""
+MAX_LAYOUT_COLUMNS: Final = 2000
+"""Most characters a layout line may have (Big has 120)."""
+MAX_LAYOUT_CHARACTERS: Final = 600_000
+"""Most characters a layout may have in all (Big has 7200; a site is validated on a raster
+of 16 cells per character, which :data:`~swarm_sim.sites.model.MAX_RASTER_CELLS` bounds)."""
+_SIZE_LIMITS: Final = (
+    f'{MAX_LAYOUT_LINES} lines, {MAX_LAYOUT_COLUMNS} columns and {MAX_LAYOUT_CHARACTERS} characters'
+)
+_MAX_LAYOUT_BYTES: Final = 4 * MAX_LAYOUT_CHARACTERS + 2 * MAX_LAYOUT_LINES + 4096
+"""Largest .lay file read: the limits in 4-byte UTF-8 characters, CR LF line ends and some
+trailing blank lines."""
 
 _KNOWN_CHARACTERS = (
     "'%' wall, ' ' and '.' free, 'A'-'z' room letters, '0'-'9' victim rooms, '/' and '#' "
@@ -135,6 +160,7 @@ class Layout:
                 None,
                 f'a layout needs at least 3 x 3 characters, got shape {codes.shape}',
             )
+        _check_layout_size(self.source, int(codes.shape[0]), int(codes.shape[1]))
         codes.flags.writeable = False
         object.__setattr__(self, 'codes', codes)
 
@@ -182,12 +208,30 @@ def _is_digit(codes: np.ndarray) -> np.ndarray:
     return (codes >= _DIGIT_FIRST) & (codes <= _DIGIT_LAST)
 
 
+def _check_layout_size(source: str, lines: int, columns: int) -> None:
+    """Raise :class:`LayoutError` for a layout larger than the limits (checked before the
+    layout is read character by character)."""
+    if (
+        lines <= MAX_LAYOUT_LINES
+        and columns <= MAX_LAYOUT_COLUMNS
+        and lines * columns <= MAX_LAYOUT_CHARACTERS
+    ):
+        return
+    msg = (
+        f'the layout is {lines} lines of {columns} characters; a layout may have at most '
+        f'{_SIZE_LIMITS}'
+    )
+    raise LayoutError(source, None, None, msg)
+
+
 def parse_layout(text: str, source: str = '<layout>') -> Layout:
     """Parse layout text. Lines must all have the same length; trailing empty lines are
     ignored; ``\\r\\n`` line ends are accepted.
 
     Raises:
-        LayoutError: ragged lines or an unknown character, with its line and column.
+        LayoutError: ragged lines or an unknown character, with its line and column; a
+            layout larger than :data:`MAX_LAYOUT_LINES` lines, :data:`MAX_LAYOUT_COLUMNS`
+            columns or :data:`MAX_LAYOUT_CHARACTERS` characters.
     """
     lines = text.replace('\r\n', '\n').split('\n')
     while lines and lines[-1] == '':
@@ -195,6 +239,7 @@ def parse_layout(text: str, source: str = '<layout>') -> Layout:
     if not lines:
         raise LayoutError(source, None, None, 'the layout is empty')
     width = len(lines[0])
+    _check_layout_size(source, len(lines), width)
     for number, line in enumerate(lines, start=1):
         if len(line) != width:
             msg = (
@@ -216,17 +261,32 @@ def parse_layout(text: str, source: str = '<layout>') -> Layout:
 
 
 def read_layout(path: str | Path) -> Layout:
-    """Read and parse a ``.lay`` file."""
+    """Read and parse a ``.lay`` file.
+
+    Raises:
+        LayoutError: an unreadable file, one larger than a layout of
+            :data:`MAX_LAYOUT_CHARACTERS` can be, or a malformed layout (see
+            :func:`parse_layout`).
+    """
     path = Path(path)
     try:
-        text = path.read_text(encoding='utf-8')
+        with path.open('rb') as file:
+            data = file.read(_MAX_LAYOUT_BYTES + 1)
+    except OSError as err:
+        raise LayoutError(str(path), None, None, err.strerror or str(err)) from None
+    if len(data) > _MAX_LAYOUT_BYTES:
+        msg = (
+            f'the file is larger than {_MAX_LAYOUT_BYTES} bytes, more than a layout of at most '
+            f'{_SIZE_LIMITS} can take'
+        )
+        raise LayoutError(str(path), None, None, msg)
+    try:
+        text = data.decode('utf-8')
     except UnicodeDecodeError as err:
-        before = path.read_bytes()[: err.start]
+        before = data[: err.start]
         line = before.count(b'\n') + 1
         column = err.start - (before.rfind(b'\n') + 1) + 1
         raise LayoutError(str(path), line, column, 'the file is not UTF-8 text') from None
-    except OSError as err:
-        raise LayoutError(str(path), None, None, err.strerror or str(err)) from None
     return parse_layout(text, str(path))
 
 
@@ -310,6 +370,17 @@ def layout_to_site(
         raise LayoutError(
             layout.source, None, None, f'cell size must be positive, got {cell_m!r} m'
         )
+    if name is not None and not name:
+        raise LayoutError(layout.source, None, None, 'the site name must not be empty')
+    lines, columns = layout.shape
+    try:
+        check_site_size((columns - 1) * cell_m, (lines - 1) * cell_m, cell_m)
+    except SiteValidationError as err:
+        msg = (
+            f'{lines} lines of {columns} characters at {cell_m:g} m per cell: '
+            f'{format_key_path(err.key_path)}: {err.message}'
+        )
+        raise LayoutError(layout.source, None, None, msg) from None
     if mode is LayoutMode.AUTO:
         mode = detect_mode(layout)
     builder = _SiteBuilder(layout, cell_m, mode)

@@ -22,18 +22,23 @@ from typing import TYPE_CHECKING, Final
 
 import numpy as np
 
-from swarm_sim.sites.errors import SiteError
+from swarm_sim.sites.errors import SiteError, SiteValidationError
 
 if TYPE_CHECKING:
     from swarm_sim.sites.room_lookup import RoomLookup
 
 __all__ = [
     'CELL_M',
+    'MAX_RASTER_CELLS',
+    'MAX_SIDE_M',
     'NO_ROOM',
+    'RASTER_RESOLUTION_M',
     'DeparturePoint',
     'Door',
     'Room',
     'Site',
+    'check_site_size',
+    'raster_resolution_m',
 ]
 
 CELL_M: Final = 4.0 / 15.0
@@ -41,6 +46,70 @@ CELL_M: Final = 4.0 / 15.0
 
 NO_ROOM: Final = -1
 """Room id returned for points that lie in no room (corridors, walls, outside)."""
+
+MAX_SIDE_M: Final = 1000.0
+"""Longest side a site's bounds may have [m]. The paper's largest site, Big, is 31.7 x 15.7 m;
+the simulator rasterizes a site to check and look it up, so the size is bounded before
+anything is allocated."""
+
+RASTER_RESOLUTION_M: Final = 0.025
+"""Cell size of the validation raster of a site without ``grid_m`` [m]; a site on a grid is
+rasterized at a quarter of its grid spacing (see :mod:`.validation`)."""
+
+MAX_RASTER_CELLS: Final = 10_000_000
+"""Most cells a site's validation raster may have (about 90 bytes of memory each while a
+site is validated): 12 times a free-form site of Big's size, 85 times Big on its grid. It
+bounds a site without ``grid_m`` to about 79 x 79 m, a grid site to about 790 x 790 grid
+cells."""
+
+
+def raster_resolution_m(grid_m: float | None) -> float:
+    """Cell size [m] of the raster a site is validated on: a quarter of its grid spacing, or
+    :data:`RASTER_RESOLUTION_M` without one."""
+    return grid_m / 4.0 if grid_m is not None else RASTER_RESOLUTION_M
+
+
+def check_site_size(
+    width_m: float, height_m: float, grid_m: float | None, wall_length_m: float = 0.0
+) -> None:
+    """Raise :class:`~swarm_sim.sites.errors.SiteValidationError` when a site of these bounds
+    is larger than the simulator handles: a side longer than :data:`MAX_SIDE_M`, a validation
+    raster of more than :data:`MAX_RASTER_CELLS` cells, or walls that together cross more
+    raster cells than that. Cheap: call it before building anything of that size.
+
+    Args:
+        width_m: extent along x [m] (positive, finite).
+        height_m: extent along y [m] (positive, finite).
+        grid_m: grid spacing [m], or None.
+        wall_length_m: total length of the walls [m].
+    """
+    for key, side in (('width_m', width_m), ('height_m', height_m)):
+        if side > MAX_SIDE_M:
+            msg = f'{side:g} m is larger than the {MAX_SIDE_M:g} m a site side may be'
+            raise SiteValidationError(msg, key_path=('bounds', key))
+    resolution = raster_resolution_m(grid_m)
+    # FreeSpaceRaster adds 2.5 cells of margin on each side and one more cell.
+    nx = width_m / resolution + 6.0
+    ny = height_m / resolution + 6.0
+    if nx * ny > MAX_RASTER_CELLS:
+        spacing = (
+            f'a quarter of grid_m {grid_m:g} m'
+            if grid_m is not None
+            else 'for a site without grid_m'
+        )
+        hint = '' if grid_m is not None else '; a grid_m above 0.1 m makes the raster coarser'
+        msg = (
+            f'{width_m:g} x {height_m:g} m is too large to check: at {resolution:g} m per raster '
+            f'cell ({spacing}) it needs {nx * ny:.3g} cells, more than the '
+            f'{MAX_RASTER_CELLS:,} a site may have{hint}'
+        )
+        raise SiteValidationError(msg, key_path=('bounds',))
+    if wall_length_m / resolution > MAX_RASTER_CELLS:
+        msg = (
+            f'the walls are {wall_length_m:.6g} m long in total, {wall_length_m / resolution:.3g} '
+            f'raster cells of {resolution:g} m: more than the {MAX_RASTER_CELLS:,} a site may have'
+        )
+        raise SiteValidationError(msg, key_path=('walls',))
 
 
 def _readonly(array: np.ndarray) -> np.ndarray:
@@ -209,7 +278,8 @@ class Site:
 
     Construct it with any iterables; ``__post_init__`` turns them into read-only arrays,
     tuples and a read-only mapping. Structural problems (wrong shapes, duplicate ids) raise
-    :class:`SiteError` here; geometric invariants are checked by
+    :class:`SiteError` here, a site too large to simulate (:func:`check_site_size`) a
+    :class:`~swarm_sim.sites.errors.SiteValidationError`; geometric invariants are checked by
     :func:`swarm_sim.sites.validation.validate_site`.
 
     Attributes:
@@ -259,6 +329,15 @@ class Site:
             raise SiteError(msg)
         if not np.all(np.isfinite(walls)):
             raise SiteError('walls contain a non-finite coordinate')
+        grid = None
+        if self.grid_m is not None:
+            grid = float(self.grid_m)
+            if not (math.isfinite(grid) and grid > 0):
+                msg = f'grid_m must be positive, got {self.grid_m!r}'
+                raise SiteError(msg)
+            object.__setattr__(self, 'grid_m', grid)
+        wall_length = float(np.sum(np.hypot(walls[:, 2] - walls[:, 0], walls[:, 3] - walls[:, 1])))
+        check_site_size(width, height, grid, wall_length)
         object.__setattr__(self, 'walls', _readonly(walls))
         rooms = tuple(self.rooms)
         ids = [room.room_id for room in rooms]
@@ -276,12 +355,6 @@ class Site:
                 msg = f'departure point stored under {key!r} is named {point.name!r}'
                 raise SiteError(msg)
         object.__setattr__(self, 'departure_points', MappingProxyType(dict(points)))
-        if self.grid_m is not None:
-            grid = float(self.grid_m)
-            if not (math.isfinite(grid) and grid > 0):
-                msg = f'grid_m must be positive, got {self.grid_m!r}'
-                raise SiteError(msg)
-            object.__setattr__(self, 'grid_m', grid)
         if self.seed is not None:
             object.__setattr__(self, 'seed', int(self.seed))
         warnings = self.warnings

@@ -73,17 +73,18 @@ class RoomLookup:
         ny = max(1, math.ceil(height_m / resolution_m - 1e-9))
         raster = np.full((ny, nx), NO_ROOM, dtype=np.int32)
         for index, room in enumerate(rooms):
-            claimed = self._room_mask(room, nx, ny)
-            clash = claimed & (raster != NO_ROOM)
+            (j0, i0), claimed = self._room_mask(room, nx, ny)
+            window = raster[j0 : j0 + claimed.shape[0], i0 : i0 + claimed.shape[1]]
+            clash = claimed & (window != NO_ROOM)
             if np.any(clash):
-                iy, ix = np.argwhere(clash)[0]
+                iy, ix = np.argwhere(clash)[0] + (j0, i0)
                 x, y = self._cell_centre(int(ix), int(iy))
                 msg = (
                     f'rooms {int(raster[iy, ix])} and {room.room_id} overlap near '
                     f'({x:.3f}, {y:.3f}) m'
                 )
                 raise SiteValidationError(msg, position_m=(x, y), key_path=('rooms', index))
-            raster[claimed] = room.room_id
+            window[claimed] = room.room_id
         raster.flags.writeable = False
         self.raster = raster
 
@@ -117,14 +118,22 @@ class RoomLookup:
         probes = points[:, None, :] + reach_m * _PROBE_DIRECTIONS[None, :, :]
         return self.room_ids(probes.reshape(-1, 2)).reshape(len(points), len(_PROBE_DIRECTIONS))
 
-    def _room_mask(self, room: Room, nx: int, ny: int) -> np.ndarray:
-        mask = np.zeros((ny, nx), dtype=bool)
+    def _room_mask(self, room: Room, nx: int, ny: int) -> tuple[tuple[int, int], np.ndarray]:
+        """The cells of ``room``: the (row, column) of the lower-left cell of the room's
+        bounding window in the raster, and the window's bool mask (only the window is
+        allocated, so many rooms cost their own area, not the site's each)."""
         res = self.resolution_m
+        bx0, by0, bx1, by1 = room.bounding_rect
+        wi0 = min(nx, max(0, math.floor(bx0 / res)))
+        wj0 = min(ny, max(0, math.floor(by0 / res)))
+        wi1 = min(nx, max(wi0, math.ceil(bx1 / res)))
+        wj1 = min(ny, max(wj0, math.ceil(by1 / res)))
+        mask = np.zeros((wj1 - wj0, wi1 - wi0), dtype=bool)
         for x0, y0, x1, y1 in room.rects:
             # Cells whose centre (k + 0.5) * res lies in [x0, x1).
             i0, i1 = (max(0, math.ceil(v / res - 0.5)) for v in (x0, x1))
             j0, j1 = (max(0, math.ceil(v / res - 0.5)) for v in (y0, y1))
-            mask[j0 : min(j1, ny), i0 : min(i1, nx)] = True
+            mask[j0 - wj0 : min(j1, ny) - wj0, i0 - wi0 : min(i1, nx) - wi0] = True
         if room.polygon is not None:
             x0, y0 = room.polygon.min(axis=0)
             x1, y1 = room.polygon.max(axis=0)
@@ -134,8 +143,8 @@ class RoomLookup:
                 ii, jj = np.meshgrid(np.arange(i0, i1), np.arange(j0, j1))
                 centres = np.column_stack([(ii.ravel() + 0.5) * res, (jj.ravel() + 0.5) * res])
                 inside = points_in_polygon(centres, room.polygon).reshape(ii.shape)
-                mask[j0:j1, i0:i1] |= inside
-        return mask
+                mask[j0 - wj0 : j1 - wj0, i0 - wi0 : i1 - wi0] |= inside
+        return (wj0, wi0), mask
 
     def _cell_centre(self, ix: int, iy: int) -> tuple[float, float]:
         return ((ix + 0.5) * self.resolution_m, (iy + 0.5) * self.resolution_m)

@@ -21,13 +21,28 @@ import yaml
 from swarm_common.outputs import write_text_atomic
 
 from swarm_sim.sites.errors import SiteError, SiteFileError, SiteValidationError
-from swarm_sim.sites.model import DeparturePoint, Door, Room, Site
+from swarm_sim.sites.model import DeparturePoint, Door, Room, Site, check_site_size
 from swarm_sim.sites.validation import validate_site
 
-__all__ = ['FORMAT', 'dump_site', 'load_site', 'parse_site', 'save_site', 'site_to_dict']
+__all__ = [
+    'FORMAT',
+    'MAX_FILE_BYTES',
+    'MAX_NESTING',
+    'dump_site',
+    'load_site',
+    'parse_site',
+    'save_site',
+    'site_to_dict',
+]
 
 FORMAT: Final = 'swarm_site/1'
 """Format tag every site file starts with; bumped when a change is incompatible."""
+
+MAX_FILE_BYTES: Final = 16 * 1024 * 1024
+"""Largest site file the loader reads [bytes] (a Big site's file is about 33 kB)."""
+
+MAX_NESTING: Final = 32
+"""Deepest nesting of YAML collections the loader accepts (a site file needs 5 levels)."""
 
 _DECIMALS: Final = 6
 _TOP_KEYS: Final = (
@@ -119,9 +134,15 @@ def load_site(path: str | Path) -> Site:
     """
     path = Path(path)
     try:
-        data = path.read_bytes()
+        with path.open('rb') as file:
+            data = file.read(MAX_FILE_BYTES + 1)
     except OSError as err:
         raise SiteFileError(str(path), err.strerror or str(err)) from None
+    if len(data) > MAX_FILE_BYTES:
+        msg = (
+            f'the file is larger than the {MAX_FILE_BYTES // (1024 * 1024)} MiB a site file may be'
+        )
+        raise SiteFileError(str(path), msg)
     try:
         text = data.decode('utf-8')
     except UnicodeDecodeError as err:
@@ -148,36 +169,78 @@ def parse_site(text: str, source: str = '<site>') -> Site:
 
 
 def _compose(text: str, source: str) -> tuple[Any, dict[KeyPath, int]]:
-    """YAML data and the 1-based line of every key path."""
+    """YAML data and the 1-based line of every key path.
+
+    The node tree is checked before it is turned into data: no key twice in a mapping, no
+    alias that contains itself, no nesting deeper than :data:`MAX_NESTING` (a site file
+    needs 5 levels).
+    """
     loader_class = getattr(yaml, 'CSafeLoader', yaml.SafeLoader)
     loader = loader_class(text)
+    lines: dict[KeyPath, int] = {}
     try:
         node = loader.get_single_node()
         if node is None:
             raise SiteFileError(source, 'the file is empty')
+        _NodeChecker(source, lines).walk(node, (), 0)
         data = loader.construct_document(node)
     except yaml.YAMLError as err:
         mark = getattr(err, 'problem_mark', None)
         line = None if mark is None else mark.line + 1
         problem = getattr(err, 'problem', None) or str(err)
         raise SiteFileError(source, f'not valid YAML: {problem}', line=line) from None
+    except RecursionError:
+        msg = f'not valid YAML for a site file: nested more than {MAX_NESTING} levels deep'
+        raise SiteFileError(source, msg) from None
     finally:
         loader.dispose()
-    lines: dict[KeyPath, int] = {}
-
-    def walk(item: yaml.Node, path: KeyPath) -> None:
-        lines.setdefault(path, item.start_mark.line + 1)
-        if isinstance(item, yaml.MappingNode):
-            for key_node, value_node in item.value:
-                child = (*path, str(key_node.value))
-                lines[child] = key_node.start_mark.line + 1
-                walk(value_node, child)
-        elif isinstance(item, yaml.SequenceNode):
-            for index, value_node in enumerate(item.value):
-                walk(value_node, (*path, index))
-
-    walk(node, ())
     return data, lines
+
+
+class _NodeChecker:
+    """Walks a YAML node tree once, recording the line of every key path and rejecting
+    duplicate keys, self-containing aliases and deep nesting."""
+
+    def __init__(self, source: str, lines: dict[KeyPath, int]) -> None:
+        self.source = source
+        self.lines = lines
+        self.open: set[int] = set()  # nodes being walked: the ancestors of the current one
+        self.done: set[int] = set()  # nodes walked already (aliases are walked once)
+
+    def walk(self, item: yaml.Node, path: KeyPath, depth: int) -> None:
+        line = item.start_mark.line + 1
+        self.lines.setdefault(path, line)
+        if id(item) in self.open:
+            msg = 'an alias refers to the collection that contains it (a recursive alias)'
+            raise SiteFileError(self.source, msg, key_path=path, line=self._line(path, line))
+        if id(item) in self.done or not isinstance(item, yaml.CollectionNode):
+            return
+        if depth >= MAX_NESTING:
+            msg = f'nested more than {MAX_NESTING} levels deep; a site file needs 5'
+            raise SiteFileError(self.source, msg, key_path=path[:3], line=line)
+        self.open.add(id(item))
+        if isinstance(item, yaml.MappingNode):
+            seen: dict[tuple[str, str], int] = {}
+            for key_node, value_node in item.value:
+                key_line = key_node.start_mark.line + 1
+                child = (*path, str(key_node.value))
+                if isinstance(key_node, yaml.ScalarNode):
+                    key = (key_node.tag, key_node.value)
+                    if key in seen:
+                        msg = f'duplicate key {key_node.value!r} (first at line {seen[key]})'
+                        raise SiteFileError(self.source, msg, key_path=child, line=key_line)
+                    seen[key] = key_line
+                self.lines[child] = key_line
+                self.walk(value_node, child, depth + 1)
+        else:
+            for index, value_node in enumerate(item.value):
+                self.walk(value_node, (*path, index), depth + 1)
+        self.open.discard(id(item))
+        self.done.add(id(item))
+
+    def _line(self, path: KeyPath, default: int) -> int:
+        line = self.lines.get(path[:-1]) if path else None
+        return default if line is None else line
 
 
 class _Reader:
@@ -253,6 +316,12 @@ class _Reader:
         )
         width = self.number(bounds['width_m'], ('bounds', 'width_m'), positive=True)
         height = self.number(bounds['height_m'], ('bounds', 'height_m'), positive=True)
+        grid = top.get('grid_m')
+        grid = None if grid is None else self.number(grid, ('grid_m',), positive=True)
+        try:  # before anything of the site's size is built
+            check_site_size(width, height, grid)
+        except SiteValidationError as err:
+            raise self.error(err.key_path, err.message) from err
         points = self.mapping(
             top['departure_points'], ('departure_points',), tuple(top['departure_points'] or ())
         )
@@ -260,15 +329,14 @@ class _Reader:
             raise self.error(('departure_points',), 'at least one departure point is required')
         departures = {str(name): self.departure(str(name), value) for name, value in points.items()}
         seed = top.get('seed')
-        grid = top.get('grid_m')
         entrance = top.get('entrance')
         parts: dict[str, Any] = {
             'name': self.text(top['name'], ('name',)),
             'walls': self.each(top['walls'], ('walls',), self.wall),
             'rooms': tuple(self.each(top.get('rooms') or [], ('rooms',), self.room)),
-            'doors': tuple(self.each(top.get('doors') or [], ('doors',), self.door)),
+            'doors': tuple(self.each(top.get('doors') or [], ('doors',), self.inner_door)),
             'entrance': None if entrance is None else self.door(entrance, ('entrance',)),
-            'grid_m': None if grid is None else self.number(grid, ('grid_m',), positive=True),
+            'grid_m': grid,
             'seed': None if seed is None else self.integer(seed, ('seed',)),
         }
         try:
@@ -327,6 +395,17 @@ class _Reader:
             label = str(label)
         # Room's __post_init__ turns the lists into read-only float arrays.
         return Room(room_id, rects, label=label, has_victim=victim, polygon=polygon)  # type: ignore[arg-type]
+
+    def inner_door(self, value: Any, path: KeyPath) -> Door:
+        door = self.door(value, path)
+        if not door.room_ids:
+            where = (*path, 'rooms') if isinstance(value, dict) and 'rooms' in value else path
+            msg = (
+                'a door joins rooms: give the id of the room behind it (one id: room to '
+                'corridor) or of both rooms (two ids)'
+            )
+            raise self.error(where, msg)
+        return door
 
     def door(self, value: Any, path: KeyPath) -> Door:
         entry = self.mapping(value, path, ('segment', 'rooms'), ('segment',))

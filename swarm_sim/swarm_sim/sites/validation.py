@@ -1,8 +1,8 @@
 """Invariants every site must hold, checked the same way for generated, imported and loaded
 sites.
 
-1. Walls and rooms lie within the bounds; rooms do not overlap; doors name existing rooms
-   and are at least as wide as a robot.
+1. Walls and rooms lie within the bounds; rooms do not overlap; doors name one or two
+   existing rooms (the entrance may name none) and are at least as wide as a robot.
 2. Every departure point has a robot's clearance from every wall (it is not inside a wall)
    and is not walled into a pocket too small to move in.
 3. The enclosure is closed except for the entrance: with the entrance sealed, no departure
@@ -33,7 +33,7 @@ import numpy as np
 from scipy import ndimage
 
 from swarm_sim.sites.errors import SiteValidationError, SiteWarning
-from swarm_sim.sites.model import NO_ROOM, Door, Room, Site
+from swarm_sim.sites.model import NO_ROOM, Door, Room, Site, raster_resolution_m
 
 __all__ = [
     'DEFAULT_ROBOT_RADIUS_M',
@@ -48,8 +48,8 @@ __all__ = [
 DEFAULT_ROBOT_RADIUS_M: Final = 0.1
 """Robot body radius the clearance checks assume [m] (the OA-Bug robots are 0.2 m wide)."""
 
-_FREE_FORM_RESOLUTION_M: Final = 0.025
 _PAD_CELLS: Final = 2
+_SAMPLES_PER_BATCH: Final = 1_000_000
 _BOUNDS_TOLERANCE_M: Final = 1e-6
 
 
@@ -85,18 +85,29 @@ class FreeSpaceRaster:
         if len(segments):
             lengths = np.hypot(segments[:, 2] - segments[:, 0], segments[:, 3] - segments[:, 1])
             samples = np.ceil(lengths / (0.5 * resolution_m)).astype(np.intp) + 1
-            owner = np.repeat(np.arange(len(segments)), samples)
-            first = np.cumsum(samples) - samples
-            t = (np.arange(owner.size) - first[owner]) / np.maximum(samples[owner] - 1, 1)
-            start = segments[owner, :2]
-            points = start + t[:, None] * (segments[owner, 2:] - start)
-            cells = self.cells_of(points)
-            inside = (
-                (cells[:, 0] >= 0) & (cells[:, 0] < nx) & (cells[:, 1] >= 0) & (cells[:, 1] < ny)
-            )
-            blocked[cells[inside, 1], cells[inside, 0]] = True
+            # Sample the walls a batch at a time so long walls do not need one huge array.
+            ends = np.cumsum(samples)
+            begin = 0
+            while begin < len(segments):
+                offset_samples = ends[begin] - samples[begin]
+                stop = int(np.searchsorted(ends, offset_samples + _SAMPLES_PER_BATCH, 'right'))
+                stop = max(stop, begin + 1)
+                self._draw(blocked, segments[begin:stop], samples[begin:stop])
+                begin = stop
         self.blocked = blocked
         self.labels, _ = ndimage.label(~blocked)
+
+    def _draw(self, blocked: np.ndarray, segments: np.ndarray, samples: np.ndarray) -> None:
+        """Mark the cells of ``samples`` points along each of ``segments`` as blocked."""
+        ny, nx = blocked.shape
+        owner = np.repeat(np.arange(len(segments)), samples)
+        first = np.cumsum(samples) - samples
+        t = (np.arange(owner.size) - first[owner]) / np.maximum(samples[owner] - 1, 1)
+        start = segments[owner, :2]
+        points = start + t[:, None] * (segments[owner, 2:] - start)
+        cells = self.cells_of(points)
+        inside = (cells[:, 0] >= 0) & (cells[:, 0] < nx) & (cells[:, 1] >= 0) & (cells[:, 1] < ny)
+        blocked[cells[inside, 1], cells[inside, 0]] = True
 
     def cells_of(self, points: np.ndarray) -> np.ndarray:
         """(N, 2) int cell indices (ix, iy) of (N, 2) points [m]."""
@@ -117,7 +128,7 @@ class FreeSpaceRaster:
 
 def free_space_raster(site: Site, *, sealed: bool = True) -> FreeSpaceRaster:
     """The site's free-space raster, with the entrance closed when ``sealed``."""
-    resolution = site.grid_m / 4.0 if site.grid_m is not None else _FREE_FORM_RESOLUTION_M
+    resolution = raster_resolution_m(site.grid_m)
     walls = site.sealed_walls if sealed else site.walls
     return FreeSpaceRaster(walls, site.width_m, site.height_m, resolution)
 
@@ -310,6 +321,10 @@ def _check_within_bounds(site: Site) -> None:
     if site.entrance is not None:
         doors.append(('entrance', -1, site.entrance))
     for key, index, door in doors:
+        if key == 'doors' and not door.room_ids:
+            x, y = door.midpoint
+            msg = f'door at ({x:.3f}, {y:.3f}) m names no room; a door joins one or two rooms'
+            raise SiteValidationError(msg, position_m=door.midpoint, key_path=(key, index))
         unknown = sorted(set(door.room_ids) - known_rooms)
         if unknown:
             path = (key,) if index < 0 else (key, index)
