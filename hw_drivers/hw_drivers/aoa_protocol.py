@@ -32,6 +32,10 @@ __all__ = [
 
 # A JSON literal split at the end of the buffer fails this close to it (longest: -Infinity).
 _INCOMPLETE_TAIL_CHARS = 16
+# Largest magnitude of a report's numbers: the bearing messages carry float32.
+_FLOAT32_MAX = 3.4028234663852886e38
+# Characters of an offending value quoted in an error message.
+_SHOWN_CHARS = 60
 
 
 class JsonStreamDecoder:
@@ -94,7 +98,9 @@ class JsonStreamDecoder:
                 self.malformed += 1
                 pos = start + 1
                 continue
-            except RecursionError:
+            except (RecursionError, ValueError):
+                # Nesting deeper than the recursion limit, an integer of more than
+                # sys.get_int_max_str_digits() digits: malformed, never an escaping error.
                 self.malformed += 1
                 pos = start + 1
                 continue
@@ -141,6 +147,15 @@ class AngleReport:
     locator_id: str = ''
 
 
+def _shown(value: Any) -> str:
+    """``repr(value)`` cut to one short line for an error message."""
+    try:
+        text = repr(value)
+    except RecursionError:  # nesting that parsed just below the limit
+        return f'<deeply nested {type(value).__name__}>'
+    return text if len(text) <= _SHOWN_CHARS else f'{text[:_SHOWN_CHARS]}... ({len(text)} chars)'
+
+
 def _number(obj: dict[str, Any], key: str, *, required: bool = False) -> float:
     value = obj.get(key)
     if value is None:
@@ -148,10 +163,15 @@ def _number(obj: dict[str, Any], key: str, *, required: bool = False) -> float:
             raise ProtocolError(f'locator report without "{key}"')
         return math.nan
     if isinstance(value, bool) or not isinstance(value, int | float):
-        raise ProtocolError(f'locator report "{key}" is not a number: {value!r}')
-    number = float(value)
+        raise ProtocolError(f'locator report "{key}" is not a number: {_shown(value)}')
+    try:
+        number = float(value)
+    except OverflowError:  # an integer beyond the float range
+        number = math.inf
     if not math.isfinite(number):
-        raise ProtocolError(f'locator report "{key}" is not finite: {value!r}')
+        raise ProtocolError(f'locator report "{key}" is not finite: {_shown(value)}')
+    if abs(number) > _FLOAT32_MAX:
+        raise ProtocolError(f'locator report "{key}" is out of range: {_shown(value)}')
     return number
 
 
@@ -168,24 +188,26 @@ def parse_angle_report(obj: Any) -> AngleReport | None:
 
     Raises:
         ProtocolError: not an object, missing/empty tag id, missing or non-finite azimuth,
-            or fields of the wrong type.
+            numbers beyond the float32 range of the bearing messages, or fields of the
+            wrong type.
     """
     if not isinstance(obj, dict):
-        raise ProtocolError(f'locator report is not a JSON object: {str(obj)[:60]}')
+        raise ProtocolError(f'locator report is not a JSON object: {_shown(obj)}')
     kind = obj.get('type', 'auditory')
     if kind != 'auditory':
         return None
     tag = obj.get('tagId')
     if not isinstance(tag, str) or not tag.strip():
-        raise ProtocolError(f'locator report without a usable "tagId": {tag!r}')
+        raise ProtocolError(f'locator report without a usable "tagId": {_shown(tag)}')
     quality = obj.get('quality', 0)
     if isinstance(quality, bool) or not isinstance(quality, int) or quality < 0:
-        raise ProtocolError(f'locator report "quality" must be an unsigned integer: {quality!r}')
+        msg = f'locator report "quality" must be an unsigned integer: {_shown(quality)}'
+        raise ProtocolError(msg)
     sequence = obj.get('sequence', obj.get('timeStamp'))
     if sequence is not None:
         if isinstance(sequence, bool) or not isinstance(sequence, int) or sequence < 0:
             raise ProtocolError(
-                f'locator report sequence must be an unsigned integer: {sequence!r}'
+                f'locator report sequence must be an unsigned integer: {_shown(sequence)}'
             )
         sequence &= 0xFFFF
     locator = obj.get('locatorId', '')
@@ -197,7 +219,7 @@ def parse_angle_report(obj: Any) -> AngleReport | None:
         quality=quality,
         sequence=sequence,
         rssi_dbm=_number(obj, 'rssi'),
-        locator_id=locator if isinstance(locator, str) else str(locator),
+        locator_id=locator if isinstance(locator, str) else _shown(locator),
     )
 
 

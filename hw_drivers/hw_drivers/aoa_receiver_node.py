@@ -131,6 +131,10 @@ class AoaReceiverNode(Node):
     def _publish_diagnostics(self) -> None:
         now_ns = self.get_clock().now().nanoseconds
         server = self.server
+        if server is not None and server.closed:
+            # The worker closed it after a fault and will listen again after its back-off;
+            # its status tells why. A closed socket must not be touched.
+            server = None
         collector = self._collector
         extra = {
             'own_tag_reports': str(collector.own_reports),

@@ -65,6 +65,9 @@ class LocatorServer:
             raise FatalDeviceError(f'cannot listen on {host}:{port}: {err}') from err
         self._listener.setblocking(False)
         self._selector.register(self._listener, selectors.EVENT_READ)
+        # Read once: another thread may ask after the socket has been closed.
+        self._port = int(self._listener.getsockname()[1])
+        self._closed = False
         self._client: socket.socket | None = None
         self.client_address: tuple[str, int] | None = None
         self.connections = 0
@@ -77,8 +80,13 @@ class LocatorServer:
 
     @property
     def port(self) -> int:
-        """The bound TCP port."""
-        return int(self._listener.getsockname()[1])
+        """The bound TCP port (still known after :meth:`close`)."""
+        return self._port
+
+    @property
+    def closed(self) -> bool:
+        """True once :meth:`close` has run: the server no longer listens."""
+        return self._closed
 
     @property
     def client_connected(self) -> bool:
@@ -156,7 +164,10 @@ class LocatorServer:
         return produced
 
     def close(self) -> None:
-        """Close the client and the listening socket."""
+        """Close the client and the listening socket (again: nothing)."""
+        if self._closed:
+            return
+        self._closed = True
         self._drop_client()
         self._selector.unregister(self._listener)
         self._listener.close()

@@ -19,6 +19,7 @@ __all__ = [
     'ADS_CONFIG_REGISTER',
     'ADS_CONVERSION_REGISTER',
     'GROVE_PRODUCT_IDS',
+    'MAX_XIAO_REPLY_BYTES',
     'RAW10_MAX',
     'AdsChip',
     'AdsConfig',
@@ -37,6 +38,10 @@ __all__ = [
 ]
 
 RAW10_MAX = 1023
+#: Longest gas reply decoded (the firmware's buffer is 96 bytes; the device reader stops at 256).
+MAX_XIAO_REPLY_BYTES = 1024
+# Characters of an offending value quoted in an error message.
+_SHOWN_CHARS = 40
 
 ADS_CONVERSION_REGISTER = 0x00
 ADS_CONFIG_REGISTER = 0x01
@@ -215,20 +220,31 @@ def decode_xiao_reply(data: bytes) -> XiaoSample:
     """Decode one multi-line JSON reply (``{"timeStamp": n, "type": "olfactory", "value": v}``).
 
     Raises:
-        ProtocolError: not UTF-8 JSON, not an object, wrong type, or values out of range.
+        ProtocolError: longer than :data:`MAX_XIAO_REPLY_BYTES`, not UTF-8 JSON (also: nested
+            too deeply, an integer of thousands of digits), not an object, wrong type, or
+            values out of range.
     """
+    if len(data) > MAX_XIAO_REPLY_BYTES:
+        raise ProtocolError(f'gas reply longer than {MAX_XIAO_REPLY_BYTES} bytes: {len(data)}')
     try:
         obj = json.loads(data.decode('utf-8'))
-    except (UnicodeDecodeError, json.JSONDecodeError) as err:
+    except (ValueError, RecursionError) as err:  # UnicodeDecodeError, JSONDecodeError too
         raise ProtocolError(f'gas reply is not JSON: {data[:80]!r}') from err
     if not isinstance(obj, dict):
         raise ProtocolError(f'gas reply is not a JSON object: {data[:80]!r}')
     if obj.get('type') != 'olfactory':
-        raise ProtocolError(f'gas reply type is {obj.get("type")!r}, expected "olfactory"')
+        kind = _shown(obj.get('type'))
+        raise ProtocolError(f'gas reply type is {kind}, expected "olfactory"')
     value = obj.get('value')
     counter = obj.get('timeStamp')
     if isinstance(value, bool) or not isinstance(value, int) or not 0 <= value <= RAW10_MAX:
-        raise ProtocolError(f'gas reply value must be an integer 0..1023, got {value!r}')
+        raise ProtocolError(f'gas reply value must be an integer 0..1023, got {_shown(value)}')
     if isinstance(counter, bool) or not isinstance(counter, int) or not 0 <= counter < 2**32:
-        raise ProtocolError(f'gas reply timeStamp must be an unsigned integer, got {counter!r}')
+        msg = f'gas reply timeStamp must be an unsigned 32-bit integer, got {_shown(counter)}'
+        raise ProtocolError(msg)
     return XiaoSample(counter=counter, value=value)
+
+
+def _shown(value: object) -> str:
+    text = repr(value)
+    return text if len(text) <= _SHOWN_CHARS else f'{text[:_SHOWN_CHARS]}... ({len(text)} chars)'

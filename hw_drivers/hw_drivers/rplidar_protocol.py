@@ -23,6 +23,7 @@ from hw_drivers.errors import ConfigurationError, ProtocolError
 __all__ = [
     'HEALTH_DESCRIPTOR',
     'INFO_DESCRIPTOR',
+    'MAX_BINS',
     'SAMPLE_SIZE',
     'SCAN_DESCRIPTOR',
     'Command',
@@ -50,6 +51,8 @@ REQUEST_SYNC = 0xA5
 RESPONSE_SYNC = (0xA5, 0x5A)
 DESCRIPTOR_SIZE = 7
 SAMPLE_SIZE = 5
+#: Most LaserScan bins (the A1 gives ~1500 samples per revolution; more bins only cost memory).
+MAX_BINS = 4096
 ANGLE_Q6_FULL_TURN = 360 * 64
 _EMPTY = np.zeros(0, dtype=np.uint8)
 
@@ -726,7 +729,7 @@ class ScanBinning:
     180° mark.
 
     Attributes:
-        bins: number of bins over [-pi, pi).
+        bins: number of bins over [-pi, pi), 4..MAX_BINS.
         angle_direction: +1 or -1 (the device measures clockwise).
         zero_offset_rad: ROS angle of the device's 0° mark [rad].
         range_min_m: shortest valid range [m]; shorter readings become -inf (REP 117).
@@ -740,8 +743,8 @@ class ScanBinning:
     range_max_m: float = 12.0
 
     def __post_init__(self) -> None:
-        if self.bins < 4:
-            raise ConfigurationError(f'bins must be >= 4, got {self.bins}')
+        if not 4 <= self.bins <= MAX_BINS:
+            raise ConfigurationError(f'bins must be 4..{MAX_BINS}, got {self.bins}')
         if self.angle_direction not in (-1, 1):
             msg = f'angle_direction must be +1 or -1, got {self.angle_direction}'
             raise ConfigurationError(msg)

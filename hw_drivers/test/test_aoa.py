@@ -101,11 +101,40 @@ def test_objects_of_other_types_are_ignored():
         ({'tagId': 'D2', 'azimuth': 1.0, 'quality': -1}, 'quality'),
         ({'tagId': 'D2', 'azimuth': 1.0, 'sequence': 1.5}, 'sequence'),
         ({'tagId': 'D2', 'azimuth': True}, 'not a number'),
+        ({'tagId': 'D2', 'azimuth': int('9' * 400)}, 'not finite'),
+        ({'tagId': 'D2', 'azimuth': -(10**309)}, 'not finite'),
+        ({'tagId': 'D2', 'azimuth': float('inf')}, 'not finite'),
+        ({'tagId': 'D2', 'azimuth': 1.0, 'elevation': int('9' * 400)}, 'not finite'),
+        ({'tagId': 'D2', 'azimuth': 1.0, 'distance': 1e300}, 'out of range'),
+        ({'tagId': 'D2', 'azimuth': 1.0, 'elevation': 10**39}, 'out of range'),
+        ({'tagId': 'D2', 'azimuth': 1.0, 'rssi': -1e39}, 'out of range'),
+        ({'tagId': 'D2', 'azimuth': 1.0, 'quality': [[1]] * 100}, 'quality'),
     ],
 )
 def test_invalid_reports_raise_protocol_errors(obj, match):
-    with pytest.raises(ProtocolError, match=match):
+    with pytest.raises(ProtocolError, match=match) as raised:
         parse_angle_report(obj)
+    assert len(str(raised.value)) < 160  # one short line, whatever the value
+
+
+def test_a_huge_integer_in_the_stream_is_an_invalid_report_then_the_next_one_decodes():
+    decoder = JsonStreamDecoder()
+    values = decoder.feed(
+        b'{"tagId":"D2","azimuth":' + b'9' * 400 + b'}' + ndjson_payload(1, 'AC', 5.0)
+    )
+    assert len(values) == 2
+    with pytest.raises(ProtocolError, match='not finite'):
+        parse_angle_report(values[0])
+    assert parse_angle_report(values[1]).azimuth_deg == 5.0
+
+
+def test_an_integer_too_long_for_python_to_read_is_malformed_json():
+    decoder = JsonStreamDecoder(max_buffer_bytes=16384)
+    values = decoder.feed(
+        b'{"tagId":"D2","azimuth":' + b'9' * 5000 + b'}' + ndjson_payload(1, 'AC', 5.0)
+    )
+    assert [parse_angle_report(v).tag_id for v in values] == ['AC']
+    assert decoder.malformed == 1
 
 
 def test_sequence_filter_drops_duplicates_and_old_reports_across_the_wrap():
@@ -198,6 +227,27 @@ def test_server_receives_the_authors_format_split_across_sends(server):
     assert _pump(server, lambda: len(server.reports_seen) == 5)
     assert [r.azimuth_deg for r in server.reports_seen] == [0.0, 1.0, 2.0, 3.0, 4.0]
     client.close()
+
+
+def test_server_counts_a_report_with_a_huge_number_as_invalid_and_keeps_the_client(server):
+    client = FakeLocatorClient(server.port)
+    client.send(b'{"tagId":"D2","azimuth":' + b'9' * 400 + b'}')
+    assert _pump(server, lambda: server.invalid_reports == 1)
+    client.send(ndjson_payload(1, 'C3', 9.0))
+    assert _pump(server, lambda: len(server.reports_seen) == 1)
+    assert server.client_connected
+    assert server.disconnects == 0
+    assert 'not finite' in server.last_error
+    client.close()
+
+
+def test_a_closed_server_still_reports_its_port_and_closes_only_once():
+    srv = LocatorServer('127.0.0.1', 0, print)
+    port = srv.port
+    srv.close()
+    assert srv.closed
+    assert srv.port == port  # no call on the closed socket (EBADF)
+    srv.close()
 
 
 def test_server_counts_malformed_and_invalid_reports_and_keeps_going(server):

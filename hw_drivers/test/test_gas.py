@@ -113,11 +113,20 @@ def test_xiao_multi_line_reply_decodes():
         (b'{"timeStamp": 1, "type": "olfactory", "value": 3.5}', '0..1023'),
         (b'{"timeStamp": -1, "type": "olfactory", "value": 3}', 'unsigned'),
         (b'\xff\xfe', 'not JSON'),
+        (b'[' * 100000, 'longer than 1024 bytes'),
+        (b'[' * 1000, 'not JSON'),  # nesting past the recursion limit, within the length
+        (b'{"timeStamp": 1, "type": "olfactory", "value": ' + b'9' * 400 + b'}', '0..1023'),
+        (b'{"timeStamp": ' + b'9' * 400 + b', "type": "olfactory", "value": 3}', 'unsigned'),
+        (b'{"timeStamp": 1, "type": "olfactory", "value": NaN}', '0..1023'),
+        (b'{"timeStamp": 1, "type": "olfactory", "value": -Infinity}', '0..1023'),
+        (b'{"timeStamp": 1, "type": "olfactory", "value": 1e999}', '0..1023'),
     ],
 )
 def test_bad_xiao_replies_are_protocol_errors(reply, match):
-    with pytest.raises(ProtocolError, match=match):
+    with pytest.raises(ProtocolError, match=match) as raised:
         decode_xiao_reply(reply)
+    assert len(str(raised.value)) < 160
+    assert '\n' not in str(raised.value)
 
 
 def _ads(volts=0.645, **kwargs):

@@ -175,6 +175,58 @@ def test_aoa_node_publishes_peer_bearings_and_rssi_from_a_locator(bed):
     assert len(bearings) == count
 
 
+def _value(diagnostics, name_part, key):
+    statuses = _statuses(diagnostics, name_part)
+    values = {kv.key: kv.value for kv in statuses[-1].values} if statuses else {}
+    return values.get(key)
+
+
+def test_aoa_node_counts_a_garbled_report_and_outlives_a_failed_read(bed):
+    diagnostics = _collect(bed, diagnostic_msgs.DiagnosticArray, '/diagnostics', 10)
+    bearings = _collect(bed, swarm_interfaces.PeerBearingArray, '/bearings')
+    node = bed.add_node(
+        AoaReceiverNode,
+        parameter_overrides=[
+            Parameter('device_thread', value=False),
+            Parameter('listen_port', value=0),
+        ],
+    )
+    bed.wait_for_graph()
+    assert bed.spin_until(lambda: node.server is not None, timeout_s=5.0)
+    server = node.server
+    client = FakeLocatorClient(server.port)
+    try:
+        # An azimuth too large for a float: one invalid report, the connection stays.
+        client.send(b'{"tagId":"D2","azimuth":' + b'9' * 400 + b'}')
+        assert bed.spin_until(lambda: server.invalid_reports == 1, timeout_s=5.0)
+        assert bed.spin_until(
+            lambda: _value(diagnostics, 'aoa', 'invalid_reports') == '1', timeout_s=3.0
+        )
+        client.send(ndjson_payload(1, 'AC', 30.0))
+        assert bed.spin_until(lambda: bool(bearings), timeout_s=5.0)
+        assert server.client_connected
+    finally:
+        client.close()
+
+    # A failed read: the worker closes the server; diagnostics must not touch its socket.
+    def failing_poll():
+        raise OSError('connection reset (test)')
+
+    server.poll = failing_poll
+    assert bed.spin_until(lambda: server.closed, timeout_s=3.0)
+    seen = len(_statuses(diagnostics, 'aoa'))
+    assert bed.spin_until(
+        lambda: any(
+            'connection reset (test)' in status.message
+            for status in _statuses(diagnostics, 'aoa')[seen:]
+        ),
+        timeout_s=5.0,
+    )
+    # ... and listens again after its back-off.
+    assert bed.spin_until(lambda: node.server is not server, timeout_s=5.0)
+    assert not node.server.closed
+
+
 def test_aoa_node_reports_a_missing_locator_as_stale(bed):
     diagnostics = _collect(bed, diagnostic_msgs.DiagnosticArray, '/diagnostics', 10)
     bed.add_node(

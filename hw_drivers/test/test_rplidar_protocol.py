@@ -9,6 +9,7 @@ from hw_drivers.fakes.lidar import FakeRPLidar, RectangularRoom, encode_sample, 
 from hw_drivers.rplidar_protocol import (
     HEALTH_DESCRIPTOR,
     INFO_DESCRIPTOR,
+    MAX_BINS,
     SCAN_DESCRIPTOR,
     Command,
     HealthStatus,
@@ -271,8 +272,21 @@ def test_synthetic_room_scan_matches_the_room_geometry():
 
 @pytest.mark.parametrize(
     'kwargs',
-    [{'bins': 2}, {'angle_direction': 0}, {'range_min_m': 5.0, 'range_max_m': 1.0}],
+    [
+        {'bins': 2},
+        {'bins': MAX_BINS + 1},
+        {'bins': 1_000_000_000},
+        {'angle_direction': 0},
+        {'range_min_m': 5.0, 'range_max_m': 1.0},
+    ],
 )
 def test_impossible_binning_is_refused(kwargs):
     with pytest.raises(ConfigurationError):
         ScanBinning(**kwargs)
+
+
+def test_the_most_bins_allowed_still_bin_a_revolution():
+    binning = ScanBinning(bins=MAX_BINS, angle_direction=1, zero_offset_rad=0.0)
+    ranges, _ = bin_revolution(_revolution([90.0], [1500]), binning)
+    assert ranges.shape == (MAX_BINS,)
+    assert np.nanmin(ranges) == pytest.approx(1.5)

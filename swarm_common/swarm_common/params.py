@@ -481,6 +481,8 @@ def _same(value: Any, none_value: Any) -> bool:
 def _num(value: float | None) -> str:
     if value is None:
         return ''
+    if isinstance(value, int):
+        return str(value)  # exactly, as typed: 1000000000, not 1e+09
     if isinstance(value, float) and value.is_integer() and abs(value) < 1e15:
         return str(int(value)) if abs(value) >= 1 or value == 0 else f'{value:g}'
     return f'{value:g}'
