@@ -101,14 +101,16 @@ def check_config(config: Mapping[str, Any]) -> None:
 
     overrides = _robot_parameters(config)
     try:
-        checked = {name: OABUG_PARAMETERS.check(name, value) for name, value in overrides.items()}
-        settings = _settings({**config, **checked}, 0)
+        for name, value in overrides.items():
+            OABUG_PARAMETERS.check(name, value)
+        # build() takes the values as given (e.g. 'toward'), as the run passes them on.
+        settings = _settings(config, 0)
         OABUG_PARAMETERS.build(
             {
                 'variant': settings.variant,
                 'robot_count': settings.robots,
                 **PROFILES[settings.profile],
-                **checked,
+                **overrides,
             }
         )
     except (ParameterError, SwarmError, ValueError, TypeError) as err:

@@ -85,9 +85,11 @@ def check_config(config: Mapping[str, Any]) -> None:
         raise UsageError(f'unknown SGBA parameters: {", ".join(unknown)}')
     try:
         overrides = _sgba_overrides(config)
-        checked = {name: SGBA_PARAMETERS.check(name, value) for name, value in overrides.items()}
-        settings = _sgba_settings({**config, 'sgba': checked}, 0)
-        SGBA_PARAMETERS.build({'robot_count': settings.robots, **checked})
+        for name, value in overrides.items():
+            SGBA_PARAMETERS.check(name, value)
+        # build() takes the values as given (e.g. 'authors'), as the run passes them on.
+        settings = _sgba_settings(config, 0)
+        SGBA_PARAMETERS.build({'robot_count': settings.robots, **overrides})
     except (ParameterError, SwarmError, ValueError, TypeError) as err:
         raise UsageError(' '.join(str(err).split())) from err
 

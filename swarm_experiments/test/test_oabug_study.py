@@ -45,6 +45,17 @@ def test_bad_parameters_are_refused_before_any_run(override, message):
         make_specs(study, overrides={name: value}, smoke=True)
 
 
+@pytest.mark.parametrize(
+    'override',
+    ['sound_turn_rule=toward', 'gas_sound_wall_side=every_contact', 'fixed_turn=left'],
+)
+def test_named_choices_are_accepted_as_the_spawner_accepts_them(override):
+    (study,) = studies()
+    name, _, value = override.partition('=')
+    plan = make_specs(study, overrides={name: value}, smoke=True)
+    assert {spec.config[name] for spec in plan.specs} == {value}
+
+
 def test_node_parameters_are_set_with_the_spawners_names():
     (study,) = studies()
     plan = make_specs(study, overrides={'gas_threshold': '300', 'robots': '4'}, smoke=True)

@@ -9,6 +9,7 @@ import pytest
 from swarm_experiments.mission import run_mission
 from swarm_experiments.sgba_batch import SgbaSettings, build_sgba_mission, run_sgba_batch
 from swarm_experiments.sgba_study import (
+    SGBA_METHODS,
     SGBA_VS_OABUG,
     _sgba_overrides,
     run_comparison,
@@ -85,6 +86,14 @@ def test_bad_parameters_are_refused_before_any_run(name, value, message):
     (study,) = studies()
     with pytest.raises(UsageError, match=message):
         make_specs(study, overrides={name: value}, smoke=True)
+
+
+def test_a_named_choice_is_accepted_as_the_spawner_accepts_it():
+    (study,) = studies()
+    plan = make_specs(study, overrides={'sgba.heading_scheme': 'authors'}, smoke=True)
+    sgba = [spec for spec in plan.specs if spec.config['method'] in SGBA_METHODS]
+    assert sgba
+    assert all(_sgba_overrides(spec.config)['heading_scheme'] == 'authors' for spec in sgba)
 
 
 def test_smoke_runs_both_methods_and_reports_the_paired_comparison(tmp_path):
