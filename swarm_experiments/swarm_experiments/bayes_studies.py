@@ -45,11 +45,23 @@ from bayes_swarm.settings import BayesSwarmConfig
 from swarm_sim.signal_fields import SignalCase, avalanche_case, get_case
 
 from swarm_experiments.bayes_batch import run_mission
-from swarm_experiments.spawn_bayes_swarm import batch_mission_spec
+from swarm_experiments.spawn_bayes_swarm import (
+    MAX_ROBOTS,
+    SpawnSettings,
+    batch_mission_spec,
+    check_settings,
+)
 from swarm_experiments.study import ReportPage, RunSpec, Smoke, Study
+from swarm_experiments.study.checks import (
+    check_choice,
+    check_number,
+    check_whole,
+    settings_error,
+)
+from swarm_experiments.study.errors import UsageError
 from swarm_experiments.study.report import paired_differences, reference_table
 
-__all__ = ['COMM_RANGES_M', 'PAPER', 'PAPER_ROBOTS', 'run_bayes', 'studies']
+__all__ = ['COMM_RANGES_M', 'PAPER', 'PAPER_ROBOTS', 'check_config', 'run_bayes', 'studies']
 
 PAPER_ROBOTS = {'case1': 5, 'case2': 10, 'case3': 48, 'avalanche': 6}
 #: comm_level 1-3 of each case (Table 6), longest first.
@@ -157,10 +169,23 @@ def _random_source_offset(case: SignalCase, seed: int) -> np.ndarray:
     return target - np.asarray(case.source_m, dtype=float)
 
 
-def run_bayes(spec: RunSpec) -> dict[str, Any]:
-    """One seeded mission of a Bayes-Swarm study (parameter names: module docstring)."""
-    config = dict(spec.config)
-    seed = spec.seed + int(config.get('seed_offset', 0) or 0)
+@dataclasses.dataclass(frozen=True)
+class _Mission:
+    """What :func:`run_bayes` runs: the batch mission spec and how."""
+
+    spec: Any
+    algorithm: str
+    robots: int
+    seed: int
+    case: SignalCase
+    t_max_s: float
+    comm_range_m: float | None
+
+
+def _mission(config: Mapping[str, Any], run_seed: int) -> _Mission:
+    """The mission of one run of ``config`` with the study seed ``run_seed``."""
+    config = dict(config)
+    seed = run_seed + int(config.get('seed_offset', 0) or 0)
     case = _case(config)
     name = str(config.get('case', 'case1'))
     algorithm = str(config.get('algorithm', 'bayes_swarm_p'))
@@ -206,8 +231,96 @@ def run_bayes(spec: RunSpec) -> dict[str, Any]:
         gp = replace(mission.planner.gp, noise_std=max(mission.planner.gp.noise_std, fraction))
         mission = replace(mission, relative_noise=fraction, planner=replace(mission.planner, gp=gp))
     robots = int(config.get('robots', 0) or 0) or PAPER_ROBOTS[name]
+    return _Mission(mission, algorithm, robots, seed, case, t_max, comm)
+
+
+_CASES = tuple(PAPER_ROBOTS)
+_VARIANTS = ('p', 'o', 'alpha1')
+_SOURCES = ('paper', 'random')
+
+
+def check_config(config: Mapping[str, Any]) -> None:
+    """Check one configuration before anything runs: the study's own names, then the mission
+    built as :func:`run_bayes` builds it, with the checks of the spawner (``swarm_bayes_swarm``)
+    and of the planner settings (:class:`~bayes_swarm.settings.BayesSwarmConfig`).
+
+    Raises:
+        UsageError: an unknown name or choice, a value out of range, a planner setting the
+            settings reject (one line naming the parameter, the value and the rule).
+    """
+    from bayes_swarm.profiles import PROFILES
+    from bayes_swarm.settings import INNER_OPTIMIZERS, OUTER_OPTIMIZERS
+    from swarm_common.errors import SwarmError
+
+    from swarm_experiments.bayes_batch import ALGORITHMS
+
+    unknown = sorted(set(config) - _PLANNER_FIELDS - _RUN_KEYS)
+    if unknown:
+        raise UsageError(f'unknown Bayes-Swarm study parameters: {", ".join(unknown)}')
+    present = {name: config[name] for name in _RUN_KEYS if name in config}
+    if 'case' in present:
+        check_choice(present, 'case', _CASES)
+    if 'algorithm' in present:
+        check_choice(present, 'algorithm', (*ALGORITHMS, 'alpha1'))
+    if 'variant' in present:
+        check_choice(present, 'variant', _VARIANTS)
+    if 'source' in present:
+        check_choice(present, 'source', _SOURCES)
+    if 'profile' in present:
+        check_choice(present, 'profile', tuple(PROFILES))
+    if present.get('solvers') is not None:
+        solvers = present['solvers']
+        if not isinstance(solvers, str) or solvers.count('/') != 1:
+            raise UsageError(f"solvers={solvers!r}: must be 'OUTER/INNER' (e.g. cobyla/lbfgsb)")
+        outer, inner = solvers.split('/')
+        for part, choices in ((outer, OUTER_OPTIMIZERS), (inner, INNER_OPTIMIZERS)):
+            if part not in choices:
+                raise UsageError(
+                    f'solvers={solvers!r}: {part!r} is not one of {", ".join(choices)}'
+                )
+    for name in ('robots', 'seed_offset'):
+        if name in present:
+            check_whole(present, name, minimum=0, allow_none=True)
+    if 'comm_level' in present:
+        levels = COMM_RANGES_M.get(str(config.get('case', 'case1')), ())
+        check_whole(present, 'comm_level', minimum=0, maximum=len(levels), allow_none=True)
+    for name in ('noise_std', 'noise_fraction', 'alpha_t_max_s', 't_max_s', 'depth_m'):
+        if name in present:
+            check_number(present, name, minimum=0.0, allow_none=True)
+    for name in ('baseline_t_max_factor', 'glowworm_t_max_factor'):
+        if name in present:
+            check_number(present, name, minimum=0.0, above=True, allow_none=True)
+    try:
+        mission = _mission(config, 0)
+        if mission.algorithm not in ALGORITHMS:
+            msg = f'algorithm {mission.algorithm!r}: choose one of {", ".join(ALGORITHMS)}'
+            raise UsageError(msg)
+        # The spawner's checks of the same mission (it runs at most MAX_ROBOTS nodes).
+        check_settings(
+            SpawnSettings(
+                algorithm=mission.algorithm,
+                case=str(config.get('case', 'case1')),
+                robots=min(mission.robots, MAX_ROBOTS),
+                comm_range_m=math.inf if mission.comm_range_m is None else mission.comm_range_m,
+                noise_std=float(config.get('noise_std', 0.0) or 0.0),
+                relative_noise=float(config.get('noise_fraction', 0.0) or 0.0),
+                max_mission_time_s=mission.t_max_s,
+                profile=str(config.get('profile', 'paper')),
+            )
+        )
+    except UsageError:
+        raise
+    except (SwarmError, ValueError, TypeError, KeyError) as err:
+        raise settings_error(err) from err
+
+
+def run_bayes(spec: RunSpec) -> dict[str, Any]:
+    """One seeded mission of a Bayes-Swarm study (parameter names: module docstring)."""
+    check_config(spec.config)
+    planned = _mission(spec.config, spec.seed)
+    case, t_max, comm = planned.case, planned.t_max_s, planned.comm_range_m
     start = time.process_time()
-    result = run_mission(mission, algorithm, robots, seed)
+    result = run_mission(planned.spec, planned.algorithm, planned.robots, planned.seed)
     cpu = time.process_time() - start
     ideal_s = float(np.hypot(*(case.source_m - case.depots_m[0]))) / case.velocity_mps
     decisions = result.decisions[result.finder] if result.found else []
@@ -509,6 +622,7 @@ def studies() -> list[Study]:
             ),
             smoke=Smoke(runs=2, axes={'case': ('case1',), 'solvers': ('cobyla/lbfgsb',)}),
             report=_report_optimizers,
+            check=check_config,
         ),
         Study(
             name='bayes-table3-baselines',
@@ -528,6 +642,7 @@ def studies() -> list[Study]:
                 axes={'case': ('case1',), 'algorithm': ('bayes_swarm_p', 'exhaustive')},
             ),
             report=_report_baselines,
+            check=check_config,
         ),
         Study(
             name='bayes-table4-case3',
@@ -538,6 +653,7 @@ def studies() -> list[Study]:
             description='Table 4: Case 3 with 48 and 100 robots from the four corners.',
             smoke=Smoke(runs=1, axes={'robots': (48,)}, params={'t_max_s': 120.0}),
             report=_report_case3,
+            check=check_config,
         ),
         Study(
             name='bayes-table5-penalty',
@@ -556,6 +672,7 @@ def studies() -> list[Study]:
             ),
             smoke=Smoke(runs=2, axes={'case': ('case1',), 'source': ('paper',)}),
             report=_report_penalty,
+            check=check_config,
         ),
         Study(
             name='bayes-table6-comm',
@@ -566,6 +683,7 @@ def studies() -> list[Study]:
             description='Table 6: limited communication ranges.',
             smoke=Smoke(runs=1, axes={'case': ('case1',), 'comm_level': (0, 3)}),
             report=_report_comm,
+            check=check_config,
         ),
         Study(
             name='bayes-table7-noise',
@@ -583,6 +701,7 @@ def studies() -> list[Study]:
                 axes={'case': ('case1',), 'noise_fraction': (0.0, 0.1), 'alpha_t_max_s': (100.0,)},
             ),
             report=_report_noise,
+            check=check_config,
         ),
         Study(
             name='bayes-table8-avalanche',
@@ -605,6 +724,7 @@ def studies() -> list[Study]:
             ),
             smoke=Smoke(runs=1, axes={'algorithm': ('bayes_swarm_p',), 'noise_std': (0.47,)}),
             report=_report_avalanche,
+            check=check_config,
         ),
         Study(
             name='bayes-fig4-scaling',
@@ -621,5 +741,6 @@ def studies() -> list[Study]:
             ),
             smoke=Smoke(runs=1, axes={'solvers': ('cobyla/lbfgsb',), 'robots': (5, 10)}),
             report=_report_scaling,
+            check=check_config,
         ),
     ]

@@ -15,6 +15,11 @@ and ``series.first_heard_s`` (the k-th first hearing, ascending).
 Controller settings are the node's parameters (``msc_pf/config/msc_pf.yaml``) under
 ``controller``: ``swarm_study run msc_pf-fig4 --set controller.msc.leader_rule=pbest``. A
 variant's own settings apply first, ``--set`` values that differ from the defaults on top.
+
+Every configuration is checked before anything runs (:func:`check_config`): ``variant`` one
+of :data:`VARIANTS`, ``robots`` and ``targets`` >= 1, ``t_max_s`` > 0, ``loss`` a
+probability, as the spawner checks them (``swarm_msc_pf``), and the controller settings as
+the node checks its parameters.
 """
 
 from __future__ import annotations
@@ -29,8 +34,23 @@ from msc_pf.schemes import Scheme
 
 from swarm_experiments.msc_pf_batch import BatchScenario, run_batch
 from swarm_experiments.study import ReportPage, RunSpec, Smoke, Study, paired_differences
+from swarm_experiments.study.checks import (
+    check_choice,
+    check_number,
+    check_whole,
+    settings_error,
+)
+from swarm_experiments.study.errors import UsageError
 
-__all__ = ['BEYOND_VARIANTS', 'PAPER_FIG4', 'VARIANTS', 'best_msc', 'run_msc_pf', 'studies']
+__all__ = [
+    'BEYOND_VARIANTS',
+    'PAPER_FIG4',
+    'VARIANTS',
+    'best_msc',
+    'check_config',
+    'run_msc_pf',
+    'studies',
+]
 
 # The robots' own settings (ID, seed, steering) and those the variant decides stay out.
 _NOT_STUDY_PARAMETERS = ('scheme', 'robot_id', 'seed')
@@ -155,6 +175,50 @@ def controller_settings(variant: str, given: Mapping[str, Any]) -> dict[str, Any
     return settings
 
 
+def _controller(config: Mapping[str, Any]) -> Any:
+    """The controller configuration of a run (the variant's settings, then ``controller``)."""
+    settings = controller_settings(str(config['variant']), config.get('controller', {}))
+    return MSC_PF_PARAMETERS.build(settings).controller
+
+
+def check_config(config: Mapping[str, Any]) -> None:
+    """Check one configuration as the spawner and the node check theirs (nothing runs).
+
+    Raises:
+        UsageError: an unknown variant, a count or time out of range, a loss that is not a
+            probability, a controller setting the node rejects (named ``controller.<name>``).
+    """
+    from swarm_common.errors import SwarmError
+
+    from swarm_experiments.spawn_msc_pf import MAX_ROBOTS, SpawnSettings, check_settings
+
+    check_choice(config, 'variant', VARIANTS)
+    check_whole(config, 'robots', minimum=1)
+    check_whole(config, 'targets', minimum=1)
+    check_number(config, 't_max_s', minimum=0.0, above=True)
+    check_number(config, 'loss', minimum=0.0, maximum=1.0)
+    try:
+        _controller(config)
+    except (SwarmError, ValueError, TypeError) as err:
+        text = ' '.join(str(err).split())
+        if text.startswith('parameter '):
+            text = 'controller.' + text.removeprefix('parameter ')
+        raise UsageError(text) from err
+    try:
+        # The spawner's own check (it runs at most MAX_ROBOTS nodes; the batch path more).
+        check_settings(
+            SpawnSettings(
+                scheme=VARIANTS[str(config['variant'])][0],
+                robots=min(int(config['robots']), MAX_ROBOTS),
+                targets=int(config['targets']),
+                max_time_s=float(config['t_max_s']),
+                loss_probability=float(config['loss']),
+            )
+        )
+    except SwarmError as err:
+        raise settings_error(err) from err
+
+
 def _approach(result: Any, max_speed_m_s: float) -> tuple[float, float]:
     """Medians over the captured targets: first hearing to capture [s], and that over the
     straight drive at full speed from the nearest robot that first heard the target."""
@@ -172,10 +236,9 @@ def run_msc_pf(spec: RunSpec) -> dict[str, Any]:
     """One seeded mission of ``spec.config`` (variant, targets, robots, t_max_s, loss,
     controller); returns the CCT, its breakdown and the capture and hearing series."""
     config = spec.config
-    variant = str(config['variant'])
-    scheme = VARIANTS[variant][0] if variant in VARIANTS else ''
-    settings = controller_settings(variant, config.get('controller', {}))
-    controller = MSC_PF_PARAMETERS.build(settings).controller
+    check_config(config)
+    scheme = VARIANTS[str(config['variant'])][0]
+    controller = _controller(config)
     t_max = float(config['t_max_s'])
     result = run_batch(
         BatchScenario(
@@ -558,6 +621,7 @@ def studies() -> list[Study]:
             'at 10/15/20 targets, 15 robots (40 seeds: the paper gives no run count).',
             smoke=_SMOKE,
             report=report_fig4,
+            check=check_config,
         ),
         Study(
             name='msc_pf-beyond',
@@ -574,6 +638,7 @@ def studies() -> list[Study]:
             '(proposed-sweep) against the best MSC; the paper-faithful proposed scheme first.',
             smoke=_SMOKE,
             report=report_beyond,
+            check=check_config,
         ),
         Study(
             name='msc_pf-beyond-robots',
@@ -588,5 +653,6 @@ def studies() -> list[Study]:
             description='The comparison beyond the paper with 9 and 30 robots, 10 targets.',
             smoke=_SMOKE,
             report=report_beyond,
+            check=check_config,
         ),
     ]

@@ -39,8 +39,19 @@ from swarm_sim.sensor_profiles import apply_sensor_profile
 
 from swarm_experiments.cli_args import fault_config
 from swarm_experiments.study import ReportPage, RunSpec, Smoke, Study, paired_differences
+from swarm_experiments.study.checks import (
+    check_choice,
+    check_number,
+    check_whole,
+    settings_error,
+)
+from swarm_experiments.study.errors import UsageError
 
 __all__ = [
+    'check_bayes_fault',
+    'check_msc_fault',
+    'check_oabug_fault',
+    'check_oabug_sensors',
     'parse_fault',
     'run_bayes_fault',
     'run_msc_fault',
@@ -110,6 +121,135 @@ def parse_fault(scenario: str, onset_s: float) -> FaultConfig:
     items = [] if scenario == 'none' else [i.strip() for i in parts if i.strip()]
     items += [f'dropout_time_s={onset_s}', f'sensor_time_s={onset_s}']
     return fault_config(items)
+
+
+def _check_fault(config: Mapping[str, Any], robots: int) -> FaultConfig:
+    """The run's faults once ``fault_time_s`` and the ``fault`` scenario are checked (for a
+    swarm of ``robots``)."""
+    from swarm_common.errors import SwarmError
+
+    check_number(config, 'fault_time_s', minimum=0.0)
+    scenario = config['fault']
+    if not isinstance(scenario, str):
+        raise UsageError(f"fault={scenario!r}: must be --fault items (or 'none')")
+    try:
+        faults = parse_fault(scenario, float(config['fault_time_s']))
+        FaultPlan(faults, robots, 0)
+    except (SwarmError, ValueError) as err:
+        raise settings_error(err, f'fault={scenario!r}') from err
+    return faults
+
+
+def _check_oabug(config: Mapping[str, Any]) -> None:
+    """The OA-Bug run's settings as the Fig. 4 study (and the spawner) checks them."""
+    from swarm_experiments.oabug_study import _fixed_parameters
+    from swarm_experiments.oabug_study import check_config as check_oabug
+
+    check_whole(config, 'robots', minimum=1)
+    keys = ('site', 'variant', 'robots', 'departure', 'profile')
+    check_oabug({**_fixed_parameters(), **{key: config[key] for key in keys}})
+
+
+def check_oabug_fault(config: Mapping[str, Any]) -> None:
+    """Check one ``faults-oabug`` configuration before anything runs.
+
+    Raises:
+        UsageError: an OA-Bug setting the spawner rejects, a negative onset, a fault
+            scenario that does not parse or asks for more robots than the swarm has.
+    """
+    _check_oabug(config)
+    _check_fault(config, int(config['robots']))
+
+
+def check_oabug_sensors(config: Mapping[str, Any]) -> None:
+    """Check one ``sensors-oabug`` configuration before anything runs.
+
+    Raises:
+        UsageError: an OA-Bug setting the spawner rejects, an unknown sensor profile.
+    """
+    from swarm_sim.sensor_profiles import SENSOR_PROFILES
+
+    check_choice(config, 'sensors', SENSOR_PROFILES)
+    _check_oabug(config)
+
+
+def check_bayes_fault(config: Mapping[str, Any]) -> None:
+    """Check one ``faults-bayes`` configuration as the spawner and the batch runner would.
+
+    Raises:
+        UsageError: an unknown case, algorithm or profile, a value out of range, a fault
+            scenario that does not parse or that the batch runner does not simulate.
+    """
+    from bayes_swarm.profiles import PROFILES
+    from swarm_common.errors import SwarmError
+    from swarm_sim.faults import BODY_SENSOR_FAULTS
+    from swarm_sim.signal_fields import get_case
+
+    from swarm_experiments.bayes_batch import ALGORITHMS
+    from swarm_experiments.spawn_bayes_swarm import MAX_ROBOTS, SpawnSettings, check_settings
+
+    check_choice(config, 'algorithm', ALGORITHMS)
+    check_choice(config, 'profile', tuple(PROFILES))
+    check_whole(config, 'robots', minimum=0)
+    check_number(config, 'noise_std', minimum=0.0)
+    check_number(config, 'stop_time_s', minimum=0.0, above=True, allow_none=True)
+    try:
+        case = get_case(str(config['case']))
+        check_settings(
+            SpawnSettings(
+                algorithm=str(config['algorithm']),
+                case=str(config['case']),
+                robots=min(int(config['robots']) or case.default_robots, MAX_ROBOTS),
+                noise_std=float(config['noise_std']),
+                profile=str(config['profile']),
+            )
+        )
+    except SwarmError as err:
+        raise settings_error(err) from err
+    faults = _check_fault(config, int(config['robots']) or case.default_robots)
+    # What bayes_batch.run_mission refuses.
+    unsupported = faults.configured(BODY_SENSOR_FAULTS)
+    if unsupported:
+        raise UsageError(
+            f'fault={config["fault"]!r}: {", ".join(unsupported)} not simulated by the batch '
+            'runner (no such sensor)'
+        )
+    if config['algorithm'] == 'glowworm' and faults.active:
+        raise UsageError(f'fault={config["fault"]!r}: not simulated for glowworm')
+
+
+def check_msc_fault(config: Mapping[str, Any]) -> None:
+    """Check one ``faults-msc`` configuration as the spawner checks its settings.
+
+    Raises:
+        UsageError: an unknown scheme, a count or time out of range, a fault scenario that
+            does not parse or asks for more robots than the swarm has.
+    """
+    from swarm_common.errors import SwarmError
+
+    from swarm_experiments.spawn_msc_pf import (
+        MAX_ROBOTS,
+        SCHEMES,
+        SpawnSettings,
+        check_settings,
+    )
+
+    check_choice(config, 'scheme', SCHEMES)
+    check_whole(config, 'robots', minimum=1)
+    check_whole(config, 'targets', minimum=1)
+    check_number(config, 'max_time_s', minimum=0.0, above=True)
+    try:
+        check_settings(
+            SpawnSettings(
+                scheme=str(config['scheme']),
+                robots=min(int(config['robots']), MAX_ROBOTS),
+                targets=int(config['targets']),
+                max_time_s=float(config['max_time_s']),
+            )
+        )
+    except SwarmError as err:
+        raise settings_error(err) from err
+    _check_fault(config, int(config['robots']))
 
 
 def still_spell(
@@ -883,6 +1023,7 @@ def studies() -> list[Study]:
                 },
             ),
             report=_report_oabug_faults,
+            check=check_oabug_fault,
         ),
         Study(
             name='faults-bayes',
@@ -901,6 +1042,7 @@ def studies() -> list[Study]:
             description='Bayes-Swarm-P tau under injected faults (onset at 10 s).',
             smoke=Smoke(runs=1, axes={'fault': ('none', 'dropout_robots=2')}),
             report=_report_bayes_faults,
+            check=check_bayes_fault,
         ),
         Study(
             name='faults-msc',
@@ -921,6 +1063,7 @@ def studies() -> list[Study]:
                 params={'targets': 3, 'max_time_s': 3000.0},
             ),
             report=_report_msc_faults,
+            check=check_msc_fault,
         ),
         Study(
             name='faults-crash',
@@ -955,5 +1098,6 @@ def studies() -> list[Study]:
                 axes={'profile': ('paper',), 'variant': ('gas_sound',), 'departure': ('center',)},
             ),
             report=_report_sensors,
+            check=check_oabug_sensors,
         ),
     ]

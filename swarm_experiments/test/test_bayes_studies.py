@@ -4,7 +4,13 @@ import math
 
 import pytest
 from swarm_experiments.bayes_studies import PAPER, run_bayes, studies
-from swarm_experiments.study import RunSpec, load_registry
+from swarm_experiments.study import (
+    RunSpec,
+    UsageError,
+    load_registry,
+    make_specs,
+    parse_overrides,
+)
 
 EXPECTED = {
     'bayes-table1-2-optimizers',
@@ -229,3 +235,38 @@ def test_the_scaling_report_exports_tau_cost_and_pso_against_cobyla_per_size(tmp
     # PSO is paired with the paper's solvers once per swarm size.
     assert len(page.exports['paired']['rows']) == 2
     assert (tmp_path / 'figures' / 'fig4-scaling.png').is_file()
+
+
+@pytest.mark.parametrize(
+    ('name', 'setting', 'message'),
+    [
+        ('bayes-table4-case3', 't_max_s=-1', r'^t_max_s=-1\.0: must be >= 0$'),
+        ('bayes-table4-case3', 'robots=-4', r'^robots=-4: must be >= 0$'),
+        ('bayes-table6-comm', 'comm_level=5', r'^comm_level=5: must be <= 3$'),
+        (
+            'bayes-table1-2-optimizers',
+            'solvers=bogus/lbfgsb',
+            r"^solvers='bogus/lbfgsb': 'bogus' is not one of grid, cobyla, pso$",
+        ),
+        ('bayes-table1-2-optimizers', 'profile=x', r"^profile='x': choose one of paper"),
+        ('bayes-table3-baselines', 'algorithm=foo', r"^algorithm='foo': choose one of "),
+        ('bayes-table3-baselines', 'baseline_t_max_factor=-2', r'must be > 0$'),
+        ('bayes-table7-noise', 'noise_fraction=-0.1', r'^noise_fraction=-0\.1: must be >= 0$'),
+        ('bayes-table8-avalanche', 'noise_std=-1', r'^noise_std=-1\.0: must be >= 0$'),
+    ],
+)
+def test_a_bad_set_value_is_refused_before_anything_runs(name, setting, message):
+    (study,) = [s for s in studies() if s.name == name]
+    with pytest.raises(UsageError, match=message):
+        make_specs(study, smoke=True, overrides=parse_overrides([setting]))
+
+
+def test_every_bayes_study_has_a_check_its_own_configurations_pass():
+    for study in studies():
+        assert study.check is not None, study.name
+        make_specs(study)
+
+
+def test_run_bayes_refuses_a_negative_t_max_instead_of_running():
+    with pytest.raises(UsageError, match=r'^t_max_s=-5\.0: must be >= 0$'):
+        run_bayes(_spec({'case': 'case1', 'robots': 3, 't_max_s': -5.0}))

@@ -22,9 +22,11 @@ from swarm_experiments.msc_pf_studies import (
 from swarm_experiments.study import (
     RunSpec,
     StudyRegistry,
+    UsageError,
     load_registry,
     make_engine,
     make_specs,
+    parse_overrides,
     run_study,
     write_reports,
 )
@@ -176,3 +178,43 @@ def test_the_reports_compare_with_the_paper_and_the_best_msc(tmp_path: Path):
     assert not math.isnan(float(table.split('proposed-sweep |', 1)[1].split('|')[6]))
     results = json.loads((tmp_path / 'msc_pf-beyond' / 'results.json').read_text())
     assert {'bracket', 'cct', 'msc-screen', 'beyond', 'breakdown'} <= set(results['tables'])
+
+
+@pytest.mark.parametrize(
+    ('setting', 'message'),
+    [
+        ('t_max_s=-1', r'^t_max_s=-1\.0: must be > 0$'),
+        ('robots=-1', r'^robots=-1: must be >= 1$'),
+        ('targets=-3', r'^targets=-3: must be >= 1$'),
+        ('variant=bogus', r"^variant='bogus': choose one of proposed, msc_pf, msc, "),
+        ('loss=5', r'^loss=5\.0: must be <= 1$'),
+        ('controller.period_s=0', r'^controller\.period_s: must be > 0 s, got 0 s$'),
+        (
+            'controller.particle_filter.n_particles=0',
+            r'^controller\.particle_filter\.n_particles: must be >= 4, got 0$',
+        ),
+        (
+            'controller.particle_filter.resampling=bogus',
+            r"^controller\.particle_filter\.resampling: 'bogus' is not one of systematic",
+        ),
+    ],
+)
+@pytest.mark.parametrize('name', NAMES)
+def test_a_bad_set_value_is_refused_before_anything_runs(
+    name: str, setting: str, message: str
+) -> None:
+    (study,) = [s for s in studies() if s.name == name]
+    with pytest.raises(UsageError, match=message):
+        make_specs(study, smoke=True, overrides=parse_overrides([setting]))
+
+
+def test_a_negative_t_max_never_gives_an_ok_row(tmp_path: Path) -> None:
+    (study,) = [s for s in studies() if s.name == 'msc_pf-fig4']
+    plan = make_specs(study, smoke=True, runs=1)
+    config = {**plan.specs[0].config, 't_max_s': -1.0}
+    with pytest.raises(UsageError, match='t_max_s'):
+        run_msc_pf(RunSpec(study.name, config, 0, 'id', plan.specs[0].axes))
+    bad = replace(plan, specs=(replace(plan.specs[0], config=config),))
+    with make_engine('serial') as engine, pytest.raises(UsageError, match='t_max_s'):
+        run_study(bad, tmp_path, engine)
+    assert not list(tmp_path.iterdir())

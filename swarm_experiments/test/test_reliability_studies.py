@@ -3,7 +3,13 @@
 import numpy as np
 import pandas as pd
 import pytest
-from swarm_experiments.study import ReportPage, load_registry, make_specs
+from swarm_experiments.study import (
+    ReportPage,
+    UsageError,
+    load_registry,
+    make_specs,
+    parse_overrides,
+)
 
 from swarm_experiments import reliability
 
@@ -168,3 +174,35 @@ def test_the_sensor_table_leads_with_the_paper_profile_and_pairs_the_sites(tmp_p
     assert float(by_profile['paper'][mean_diff]) == pytest.approx(-5.0)
     assert float(by_profile['tuned'][mean_diff]) == pytest.approx(5.0)
     assert by_profile['tuned'][columns.index('wins')] == '2'
+
+
+@pytest.mark.parametrize(
+    ('name', 'setting', 'message'),
+    [
+        ('faults-msc', 'max_time_s=-1', r'^max_time_s=-1\.0: must be > 0$'),
+        ('faults-msc', 'scheme=x', r"^scheme='x': choose one of proposed, msc_pf, msc$"),
+        ('faults-msc', 'fault_time_s=-3', r'^fault_time_s=-3\.0: must be >= 0$'),
+        (
+            'faults-msc',
+            'fault=dropout_robots=40',
+            r"^fault='dropout_robots=40': 40 faulty robots asked for, but only 15 robots$",
+        ),
+        ('faults-bayes', 'stop_time_s=-1', r'^stop_time_s=-1: must be > 0$'),
+        ('faults-bayes', 'fault=bogus=1', r"^fault='bogus=1': unknown parameter 'bogus'$"),
+        ('faults-bayes', 'robots=-1', r'^robots=-1: must be >= 0$'),
+        ('faults-oabug', 'robots=0', r'^robots=0: must be >= 1$'),
+        ('faults-oabug', 'variant=zz', r"unknown variant 'zz'"),
+        ('sensors-oabug', 'sensors=magic', r"^sensors='magic': choose one of ideal, realistic$"),
+    ],
+)
+def test_a_bad_set_value_is_refused_before_anything_runs(name, setting, message):
+    (study,) = [s for s in reliability.studies() if s.name == name]
+    with pytest.raises(UsageError, match=message):
+        make_specs(study, smoke=True, overrides=parse_overrides([setting]))
+
+
+def test_every_reliability_study_but_the_crash_one_checks_its_configurations():
+    for study in reliability.studies():
+        assert study.check is not None, study.name
+        if study.name != 'faults-crash':  # needs rclpy
+            make_specs(study)

@@ -2,19 +2,23 @@
 
 Exit codes: 0 everything asked for is done; 1 some runs failed or were not run (a cluster
 lost, a report of an unfinished study); 2 a usage or input error (one line on stderr;
-``--debug`` shows the traceback); 130 interrupted by Ctrl-C (the finished runs are kept and
-the same command resumes).
+``--debug`` shows the traceback); 130 interrupted by Ctrl-C, 143 stopped by SIGTERM (what
+batch schedulers and ``timeout`` send): either way the finished runs are kept and the same
+command resumes.
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import logging
 import os
 import shlex
+import signal
 import sys
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from pathlib import Path
+from types import FrameType
 
 from swarm_common.cli import EXIT_INTERRUPTED, ToolParser, run_tool
 from swarm_common.outputs import check_output_directory
@@ -36,11 +40,41 @@ from .spec import StudyPlan, make_specs, parse_overrides
 
 PROG = 'swarm_study'
 EXIT_OK, EXIT_INCOMPLETE, EXIT_USAGE = 0, 1, 2
+#: Stopped by SIGTERM: 128 + the signal number, as a shell reports a process it ended.
+EXIT_TERMINATED = 128 + signal.SIGTERM
 EXIT_CODES = (
     'exit codes: 0 everything asked for is done; 1 some runs failed or were not run; 2 a usage '
     'or input error (one line on stderr, --debug adds the traceback); 130 interrupted by '
-    'Ctrl-C: finished runs are kept, the same command resumes'
+    'Ctrl-C, 143 stopped by SIGTERM: finished runs are kept, the same command resumes'
 )
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM arrived: raised where Ctrl-C raises KeyboardInterrupt, for the same clean stop
+    (the rows received so far are stored, the engine is stopped)."""
+
+
+@contextlib.contextmanager
+def sigterm_stops() -> Iterator[list[int]]:
+    """While entered, SIGTERM raises :class:`Terminated` in the main thread (once; a second
+    SIGTERM while the rows are being stored is ignored). Yields the signals received."""
+    received: list[int] = []
+
+    def handle(signum: int, frame: FrameType | None) -> None:
+        if received:
+            return
+        received.append(signum)
+        raise Terminated
+
+    try:
+        previous = signal.signal(signal.SIGTERM, handle)
+    except ValueError:  # not the main thread: the caller handles its own signals
+        yield received
+        return
+    try:
+        yield received
+    finally:
+        signal.signal(signal.SIGTERM, previous)
 
 
 def _add_plan_options(parser: argparse.ArgumentParser) -> None:
@@ -179,6 +213,18 @@ def _cmd_run(registry: StudyRegistry, args: argparse.Namespace) -> int:
         # Worker processes inherit this: no Dask log lines between the progress bar updates.
         os.environ.setdefault('DASK_LOGGING__DISTRIBUTED', 'error')
         logging.getLogger('distributed').setLevel(logging.ERROR)
+    with sigterm_stops() as terminated:
+        try:
+            return _run_plan(plan, args, terminated)
+        except Terminated:
+            # Arrived outside the loop over the rows (starting or closing the engine): the
+            # rows received so far are stored already.
+            pass
+    print(f'{PROG}: stopped by SIGTERM; run the same command again to resume', file=sys.stderr)
+    return EXIT_TERMINATED
+
+
+def _run_plan(plan: StudyPlan, args: argparse.Namespace, terminated: Sequence[int]) -> int:
     try:
         engine = make_engine(
             args.engine,
@@ -186,6 +232,8 @@ def _cmd_run(registry: StudyRegistry, args: argparse.Namespace) -> int:
             address=args.address,
             connect_timeout_s=args.connect_timeout_s,
         )
+    except Terminated:
+        raise
     except KeyboardInterrupt:
         print(f'{PROG}: interrupted while starting the engine', file=sys.stderr)
         return EXIT_INTERRUPTED
@@ -203,6 +251,9 @@ def _cmd_run(registry: StudyRegistry, args: argparse.Namespace) -> int:
         f'already stored, {summary.unfinished} not run of {summary.planned}; '
         f'rows in {summary.directory}'
     )
+    if summary.interrupted and terminated:
+        print(f'{PROG}: stopped by SIGTERM; run the same command again to resume', file=sys.stderr)
+        return EXIT_TERMINATED
     if summary.interrupted:
         print(f'{PROG}: interrupted; run the same command again to resume', file=sys.stderr)
         return EXIT_INTERRUPTED

@@ -208,9 +208,20 @@ def _parts(directory: Path) -> list[Path]:
     return sorted(directory.glob('part-*.parquet'))
 
 
+#: Columns every stored row has; a part file without them was not written by a study.
+REQUIRED_COLUMNS = ('run_id', 'status')
+
+
 def _read_part(part: Path, columns: list[str] | None = None) -> pa.Table:
-    """One part file; a damaged one is a :class:`ResultsError` that says what to do."""
+    """One part file; a damaged or foreign one is a :class:`ResultsError` that says what to do."""
     try:
+        names = pq.read_schema(part).names
+        missing = [name for name in REQUIRED_COLUMNS if name not in names]
+        if missing:
+            raise ResultsError(
+                f'{part}: not a part file of a study (no column {" or ".join(missing)}); '
+                'move it out of the study directory'
+            )
         return pq.read_table(part, columns=columns)
     except (OSError, pa.ArrowInvalid) as exc:
         raise ResultsError(
@@ -274,14 +285,68 @@ def write_manifest(directory: Path, manifest: Mapping[str, Any]) -> None:
     os.replace(temporary, path)
 
 
+#: The manifest's keys and the JSON types their values must have (others are kept as read).
+_MANIFEST_TYPES: dict[str, tuple[type, ...]] = {
+    'study': (str,),
+    'description': (str,),
+    'smoke': (bool,),
+    'seed_label': (str,),
+    'axes': (dict,),
+    'params': (dict,),
+    'seeds': (list,),
+    'runs': (int,),
+    'planned_run_ids': (list,),
+    'history': (list,),
+}
+_JSON_TYPE_NAMES = {str: 'a string', bool: 'true or false', dict: 'an object', list: 'a list'}
+
+
+def _check_manifest(path: Path, manifest: Any) -> dict[str, Any]:
+    """``manifest`` as read from ``path`` if it has the shape :func:`write_manifest` writes.
+
+    Raises:
+        ResultsError: not a JSON object, or a known key of the wrong type.
+    """
+    if not isinstance(manifest, dict):
+        raise ResultsError(
+            f'{path}: not a study manifest (a JSON object), found {type(manifest).__name__}'
+        )
+    for key, types in _MANIFEST_TYPES.items():
+        value = manifest.get(key)
+        if value is None:
+            continue
+        wrong = not isinstance(value, types) or (types == (int,) and isinstance(value, bool))
+        if wrong:
+            expected = _JSON_TYPE_NAMES.get(types[0], 'a whole number')
+            raise ResultsError(f'{path}: {key!r} must be {expected}, not {value!r}')
+    for key in ('seeds', 'planned_run_ids', 'history'):
+        items = manifest.get(key) or []
+        kind = {'seeds': int, 'planned_run_ids': str, 'history': dict}[key]
+        bad = [item for item in items if not isinstance(item, kind) or isinstance(item, bool)]
+        if bad:
+            raise ResultsError(f'{path}: {key!r} holds {bad[0]!r}, not {kind.__name__} items')
+    for axis, values in (manifest.get('axes') or {}).items():
+        if not isinstance(values, list):
+            raise ResultsError(f'{path}: axis {axis!r} must have a list of values, not {values!r}')
+    return manifest
+
+
 def read_manifest(directory: Path) -> dict[str, Any]:
+    """The study manifest (``study.json``) of ``directory``.
+
+    Raises:
+        ResultsError: missing, not JSON, or not shaped like a manifest (names the file).
+    """
     path = Path(directory) / MANIFEST_NAME
     try:
-        return json.loads(path.read_text())
+        manifest = json.loads(path.read_text())
     except FileNotFoundError:
         raise ResultsError(f'{directory}: no {MANIFEST_NAME} (not a study directory)') from None
     except json.JSONDecodeError as exc:
         raise ResultsError(f'{path}: not valid JSON ({exc})') from exc
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ResultsError(f'{path}: cannot read ({exc})') from exc
+    return _check_manifest(path, manifest)
 
 
 @contextlib.contextmanager

@@ -12,7 +12,7 @@ from typing import Any
 from .engines import Engine
 from .errors import ResultsError
 from .results import PartWriter, done_run_ids, read_manifest, study_lock, write_manifest
-from .spec import StudyPlan
+from .spec import StudyPlan, check_config
 from .version import code_version as current_code_version
 
 __all__ = ['RunSummary', 'merged_manifest', 'run_study']
@@ -125,7 +125,20 @@ def run_study(
     Rows are written in part files of up to ``batch_rows`` rows (or every ``batch_s``
     seconds); on Ctrl-C (KeyboardInterrupt) the rows received so far are written, the engine
     is stopped and the summary says ``interrupted``. Calling it again resumes.
+
+    Every configuration of the plan is checked by the study's ``check`` hook first (as
+    :func:`~.spec.make_specs` does), so a plan put together by hand with a bad value stops
+    here, before the directory is created or anything runs.
+
+    Raises:
+        UsageError: the study's check rejects a configuration.
+        ResultsError: the directory cannot be created, is locked or holds another study.
     """
+    checked: set[int] = set()  # make_specs gives a configuration's seeds one config object
+    for spec in plan.specs:
+        if id(spec.config) not in checked:
+            check_config(plan.study, spec.config)
+            checked.add(id(spec.config))
     directory = Path(out_dir) / plan.directory_name
     try:
         directory.mkdir(parents=True, exist_ok=True)

@@ -22,9 +22,17 @@ import yaml
 from swarm_common.params import kind_of_value
 
 from .definition import Study
-from .errors import StudyDefinitionError, UsageError
+from .errors import StudyDefinitionError, StudyError, UsageError
 
-__all__ = ['RunSpec', 'StudyPlan', 'flatten', 'make_specs', 'parse_overrides', 'run_id']
+__all__ = [
+    'RunSpec',
+    'StudyPlan',
+    'check_config',
+    'flatten',
+    'make_specs',
+    'parse_overrides',
+    'run_id',
+]
 
 
 @dataclass(frozen=True)
@@ -217,6 +225,24 @@ def _coerce(name: str, value: Any, text: str, declared: Sequence[Any]) -> Any:
     )
 
 
+def check_config(study: Study, config: Mapping[str, Any]) -> None:
+    """Run ``study``'s ``check`` hook on one configuration's parameters (if it has one).
+
+    Raises:
+        UsageError: the hook rejects a value (a hook's ``ValueError``, ``TypeError`` or
+            ``KeyError`` is one too, its message on one line).
+    """
+    if study.check is None:
+        return
+    try:
+        study.check(config)
+    except StudyError:
+        raise
+    except (ValueError, TypeError, KeyError) as exc:
+        text = ' '.join(str(exc).split()) or type(exc).__name__
+        raise UsageError(f'study {study.name}: {text}') from exc
+
+
 def make_specs(
     study: Study,
     *,
@@ -231,7 +257,12 @@ def make_specs(
     (e.g. held-out sites 300, 301, ...); ``overrides`` (``PARAM -> VALUE`` text,
     values read as YAML) set fixed parameters (dotted names reach nested ones) or restrict an
     axis to the given comma-separated values; ``smoke`` applies the study's :class:`Smoke`
-    first.
+    first. Every configuration is checked by the study's ``check`` hook
+    (:func:`check_config`) before a spec is made.
+
+    Raises:
+        UsageError: an unknown parameter, a value of the wrong type, or one the study's
+            check rejects.
     """
     axes: dict[str, tuple[Any, ...]] = {axis: tuple(values) for axis, values in study.axes.items()}
     params: dict[str, Any] = copy.deepcopy(dict(study.params))
@@ -261,8 +292,7 @@ def make_specs(
     specs = []
     for values in itertools.product(*(axes[name] for name in names)):
         config = {**copy.deepcopy(params), **dict(zip(names, values, strict=True))}
-        if study.check is not None:
-            study.check(config)
+        check_config(study, config)
         for seed in seeds:
             specs.append(
                 RunSpec(

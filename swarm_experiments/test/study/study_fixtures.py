@@ -7,6 +7,8 @@ robot count, a time series, and a few other metrics. Parameters used by the test
 * ``fail_seeds``: seeds whose run raises;
 * ``die_once_seeds``: seeds whose first execution kills its own process (worker death).
 
+The studies' check (:func:`check_synthetic`) refuses ``sim.steps`` < 1 and ``sleep_s`` < 0.
+
 With ``STUDY_TEST_MARKERS`` set to a directory, each execution leaves a marker file there
 named ``<run_id>.<node>.<pid>.<ns>`` (``STUDY_TEST_NODE`` names the node), so a test can
 see which runs started where and how often. With ``STUDY_TEST_HANG_NODE`` naming a node,
@@ -24,6 +26,7 @@ from typing import Any
 
 import numpy as np
 from swarm_experiments.study import RunSpec, Smoke, Study
+from swarm_experiments.study.checks import check_number, check_whole
 
 VARIANT_GAIN = {'gas': 1.0, 'sound': 0.8, 'random': 0.5}
 
@@ -73,6 +76,12 @@ def synthetic_run(spec: RunSpec) -> Mapping[str, Any]:
     }
 
 
+def check_synthetic(config: Mapping[str, Any]) -> None:
+    """The synthetic studies' check: at least one step, no negative sleep."""
+    check_whole(config, 'sim.steps', minimum=1)
+    check_number(config, 'sleep_s', minimum=0.0)
+
+
 def blas_threads_run(spec: RunSpec) -> Mapping[str, Any]:
     """The BLAS thread variables the worker that runs ``spec`` sees (0: unset)."""
     return {
@@ -101,6 +110,7 @@ def search_study(**changes: Any) -> Study:
         'seed_label': 'site',
         'description': 'Synthetic search (test fixture).',
         'smoke': Smoke(runs=2, axes={'robots': (2,)}, params={'sim': {'steps': 20}}),
+        'check': check_synthetic,
     }
     fields.update(changes)
     return Study(**fields)

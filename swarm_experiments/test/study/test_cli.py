@@ -8,6 +8,7 @@ import sys
 import time
 from pathlib import Path
 
+import pandas as pd
 import pytest
 from study_fixtures import studies
 from study_helpers import comparable
@@ -319,3 +320,88 @@ def test_the_module_runs_as_a_script(tmp_path: Path) -> None:
     stdout, _ = process.communicate(timeout=60)
     assert process.returncode == 0
     assert 'synthetic-slow' in stdout
+
+
+@pytest.mark.parametrize(
+    ('setting', 'message'),
+    [
+        ('sim.steps=-1', 'sim.steps=-1: must be >= 1'),
+        ('sleep_s=-0.5', 'sleep_s=-0.5: must be >= 0'),
+    ],
+)
+def test_a_value_the_study_rejects_is_exit_2_and_nothing_runs_or_is_written(
+    registry: StudyRegistry,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    setting: str,
+    message: str,
+) -> None:
+    out = tmp_path / 'out'
+    argv = ['run', 'synthetic-search', '--smoke', '--engine', 'serial', '--out', str(out)]
+    assert _run(registry, *argv, '--set', setting) == 2
+    captured = capsys.readouterr()
+    assert captured.err == f'swarm_study: {message}\n'
+    assert 'ok' not in captured.out
+    assert not out.exists()
+
+
+def test_report_of_a_manifest_that_is_not_an_object_is_exit_2_naming_the_file(
+    registry: StudyRegistry, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    (tmp_path / 'study.json').write_text('[1, 2]\n')
+    assert _run(registry, 'report', str(tmp_path)) == 2
+    err = capsys.readouterr().err
+    assert err == (
+        f'swarm_study: {tmp_path / "study.json"}: not a study manifest (a JSON object), '
+        'found list\n'
+    )
+
+
+def test_report_with_a_foreign_parquet_file_is_exit_2_naming_the_file(
+    registry: StudyRegistry, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    argv = ['run', 'synthetic-search', '--smoke', '--engine', 'serial', '--out', str(tmp_path)]
+    assert _run(registry, *argv, '--quiet') == 0
+    study_dir = tmp_path / 'synthetic-search-smoke'
+    foreign = study_dir / 'part-zzz-foreign.parquet'
+    pd.DataFrame({'x': [1.0]}).to_parquet(foreign)
+    capsys.readouterr()
+    assert _run(registry, 'report', str(study_dir)) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f'swarm_study: {foreign}: not a part file of a study')
+    assert err.count('\n') == 1
+    assert 'unexpected error' not in err
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize('engine', ['serial', 'pool'])
+def test_sigterm_keeps_the_finished_runs_exits_143_and_the_same_command_resumes(
+    tmp_path: Path, engine: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    out = tmp_path / 'out'
+    markers = tmp_path / 'markers'
+    markers.mkdir()
+    monkeypatch.setenv('STUDY_TEST_MARKERS', str(markers))
+    argv = ['run', 'synthetic-slow', '--set', 'sleep_s=0.4', '--engine', engine]
+    argv += ['--workers', '2'] if engine == 'pool' else []
+    argv += ['--out', str(out), '--quiet']
+    process = _cli(tmp_path, *argv)
+    study_dir = out / 'synthetic-slow'
+    # Three runs started: at least one finished (two workers at most). Its row is only in
+    # memory (a part is written every 50 rows or 30 s) until the stop writes it.
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline and len(list(markers.iterdir())) < 3:
+        time.sleep(0.05)
+    assert not list(study_dir.glob('part-*.parquet'))
+    process.send_signal(signal.SIGTERM)
+    stdout, err = process.communicate(timeout=60)
+    assert process.returncode == 143, err
+    assert 'stopped by SIGTERM; run the same command again to resume' in err
+    assert 'Traceback' not in err
+    kept = read_rows(study_dir)
+    assert 1 <= len(kept) < 24, stdout
+    assert set(kept['status']) == {'ok'}, 'runs cut short by SIGTERM leave no row'
+    resumed = _cli(tmp_path, *argv)
+    stdout, err = resumed.communicate(timeout=120)
+    assert resumed.returncode == 0, err
+    assert f'{24 - len(kept)} ok, 0 failed, {len(kept)} already stored' in stdout

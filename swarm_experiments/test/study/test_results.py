@@ -10,7 +10,13 @@ import pandas as pd
 import pytest
 from study_fixtures import search_study
 from swarm_experiments.study import ResultsError, RunSpec, make_specs, read_rows
-from swarm_experiments.study.results import PartWriter, done_run_ids, execute, study_lock
+from swarm_experiments.study.results import (
+    PartWriter,
+    done_run_ids,
+    execute,
+    read_manifest,
+    study_lock,
+)
 
 
 def _spec(**config_changes: object) -> RunSpec:
@@ -167,3 +173,39 @@ def test_parts_that_disagree_on_a_type_still_read(tmp_path: Path) -> None:
     rows = read_rows(tmp_path).set_index('run_id')
     assert rows.loc['d', 'metric.x'] == 'text'
     assert rows.loc['c', 'metric.x'] == 3.5
+
+
+def test_a_part_file_of_something_else_is_a_one_line_error_naming_it(tmp_path: Path) -> None:
+    writer = PartWriter(tmp_path, batch_rows=1)
+    writer.add({'study': 's', 'seed': 0, 'run_id': 'a', 'status': 'ok', 'metric.m': 1.0})
+    foreign = tmp_path / 'part-9-foreign.parquet'
+    pd.DataFrame({'x': [1, 2]}).to_parquet(foreign)
+    for read in (read_rows, done_run_ids):
+        with pytest.raises(ResultsError, match='not a part file of a study') as error:
+            read(tmp_path)
+        assert str(error.value).startswith(f'{foreign}: ')
+        assert 'no column run_id or status' in str(error.value)
+        assert '\n' not in str(error.value)
+
+
+@pytest.mark.parametrize(
+    ('text', 'message'),
+    [
+        ('[1, 2]', 'not a study manifest (a JSON object), found list'),
+        ('"study"', 'not a study manifest (a JSON object), found str'),
+        ('{"study": "s", "runs": "2"}', "'runs' must be a whole number, not '2'"),
+        ('{"study": "s", "axes": [1]}', "'axes' must be an object, not [1]"),
+        (
+            '{"study": "s", "axes": {"robots": 2}}',
+            "axis 'robots' must have a list of values, not 2",
+        ),
+        ('{"study": "s", "history": [1]}', "'history' holds 1, not dict items"),
+    ],
+)
+def test_a_manifest_of_the_wrong_shape_is_a_one_line_error_naming_the_file(
+    tmp_path: Path, text: str, message: str
+) -> None:
+    (tmp_path / 'study.json').write_text(text)
+    with pytest.raises(ResultsError) as error:
+        read_manifest(tmp_path)
+    assert str(error.value) == f'{tmp_path / "study.json"}: {message}'

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
@@ -10,6 +11,7 @@ from study_helpers import comparable
 from swarm_experiments.study import (
     EngineError,
     ResultsError,
+    UsageError,
     make_engine,
     make_specs,
     parse_overrides,
@@ -204,3 +206,11 @@ def test_pool_workers_get_one_blas_thread_unless_the_caller_chose(
     assert set(rows['metric.omp_num_threads']) == {1}
     assert set(rows['metric.openblas_num_threads']) == {1}
     assert set(rows['metric.mkl_num_threads']) == {3}
+
+
+def test_run_study_checks_a_plan_made_by_hand_before_it_writes_anything(tmp_path: Path) -> None:
+    plan = make_specs(search_study(), smoke=True)
+    bad = replace(plan.specs[0], config={**plan.specs[0].config, 'sleep_s': -1.0})
+    with pytest.raises(UsageError, match=r'^sleep_s=-1\.0: must be >= 0$'):
+        _serial(replace(plan, specs=(bad, *plan.specs[1:])), tmp_path)
+    assert not list(tmp_path.iterdir()), 'nothing is created, run or stored'

@@ -178,3 +178,32 @@ def test_manifest_is_json_and_keeps_the_declared_axis_order() -> None:
 def test_study_requires_a_callable_run() -> None:
     with pytest.raises(StudyDefinitionError, match='not callable'):
         Study(name='x', run='not a function')  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize(
+    ('items', 'message'),
+    [
+        (['sim.steps=0'], r'^sim\.steps=0: must be >= 1$'),
+        (['sleep_s=-1'], r'^sleep_s=-1\.0: must be >= 0$'),
+    ],
+)
+def test_a_value_the_study_check_rejects_stops_make_specs(items: list[str], message: str) -> None:
+    with pytest.raises(UsageError, match=message):
+        make_specs(search_study(), overrides=parse_overrides(items))
+
+
+def test_the_check_sees_every_configuration_with_its_fixed_parameters() -> None:
+    seen: list[dict] = []
+    plan = make_specs(search_study(check=lambda config: seen.append(dict(config))), smoke=True)
+    assert len(seen) == len(plan.specs) // len(plan.seeds) == 3
+    assert {c['variant'] for c in seen} == {'gas', 'sound', 'random'}
+    assert all(c['sim']['steps'] == 20 and c['robots'] == 2 for c in seen)
+
+
+def test_a_check_that_raises_value_error_is_a_one_line_usage_error() -> None:
+    def sloppy(config: dict) -> None:
+        if config['robots'] > 4:
+            raise ValueError('too many\nrobots')
+
+    with pytest.raises(UsageError, match=r'^study synthetic-search: too many robots$'):
+        make_specs(search_study(check=sloppy))
