@@ -28,7 +28,7 @@ import time
 import warnings
 from pathlib import Path
 
-from swarm_common.cli import ToolParser, run_tool
+from swarm_common.cli import EXIT_SUCCESS, EXIT_UNFINISHED, ToolParser, run_tool
 from swarm_common.errors import UsageError
 from swarm_runtime.bag.testing import message_record_ends
 
@@ -55,7 +55,11 @@ def record_mission(out: Path) -> Path:
         '--no-plots',
         '--quiet',
     ]
-    subprocess.run(command, check=True, stdout=subprocess.DEVNULL)
+    # Exit status 1: the budget ran out before every room was covered, a normal outcome
+    # whose bag is complete; anything else is a failure.
+    finished = subprocess.run(command, check=False, stdout=subprocess.DEVNULL)
+    if finished.returncode not in (EXIT_SUCCESS, EXIT_UNFINISHED):
+        raise subprocess.CalledProcessError(finished.returncode, command)
     return bag
 
 

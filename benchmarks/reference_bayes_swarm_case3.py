@@ -144,10 +144,13 @@ def main():
     # Imported by the authors' modules but unused in this mode (their GPy GP, pybullet view).
     for name in ('GPy', 'pybullet', 'pybullet_data'):
         sys.modules.setdefault(name, types.ModuleType(name))
-    import matplotlib
+    try:
+        import matplotlib
 
-    matplotlib.use('Agg')
-    from BayesSwarm.source import Source
+        matplotlib.use('Agg')
+        from BayesSwarm.source import Source
+    except ImportError as err:
+        parser.exit(2, f"{parser.prog}: cannot import the authors' code here: {err}\n")
 
     _select_source(Source, args)
     answers = sys.stdout

@@ -20,7 +20,9 @@ CPU time of that call alone. The authors' robot de-duplicates its samples with
 This file only drives the authors' code; none of it is copied here.
 """
 
+import argparse
 import json
+import os
 import sys
 import time
 import types
@@ -54,13 +56,22 @@ class _Robot:
 
 
 def main():
-    sys.path.insert(0, sys.argv[1])
+    # Plain argparse: this runs under the authors' interpreter, without this suite's packages.
+    parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
+    parser.add_argument('checkout', help="checkout of the authors' Bayes-Swarm-P code")
+    args = parser.parse_args()
+    if not os.path.isdir(os.path.join(args.checkout, 'BayesSwarm')):
+        parser.exit(2, f'{parser.prog}: {args.checkout}: no BayesSwarm package in it\n')
+    sys.path.insert(0, args.checkout)
     # GPy is imported by the authors' decision module but only used by a GP mode that the
     # default configuration does not select.
     sys.modules.setdefault('GPy', types.ModuleType('GPy'))
-    import numpy as np
-    from BayesSwarm.bayes_swarm import BayesSwarm
-    from BayesSwarm.source import Source
+    try:
+        import numpy as np
+        from BayesSwarm.bayes_swarm import BayesSwarm
+        from BayesSwarm.source import Source
+    except ImportError as err:
+        parser.exit(2, f"{parser.prog}: cannot import the authors' code here: {err}\n")
 
     answers = sys.stdout
     sys.stdout = sys.stderr  # anything the authors' code prints stays off the answers
