@@ -40,7 +40,7 @@ MARKER_TOPICS = (
     '/sim/markers/robots',
     '/sim/markers/paths',
 )
-# The viewer topics may make a bag at most this much bigger (the demo: 2.8 -> 4.9 MB).
+# The viewer topics may make a bag at most this much bigger (the demo: 4.3 -> 7.9 MB).
 MAX_GROWTH = 2.0
 # On DDS the mission runs this much faster than real time (as far as the nodes keep up), so
 # the two recordings take seconds, not minutes; the built-in runtime runs as fast as it can.
