@@ -117,6 +117,7 @@ def _check_outputs(
         if value is None:
             continue
         path = Path(value)
+        check_output_file(path, option=option)  # a directory, an unwritable place: say so
         if path.suffix.lower() not in suffixes:
             names = ', '.join(suffixes[:-1]) + ' or ' + suffixes[-1] if len(suffixes) > 1 else ''
             msg = (
@@ -124,7 +125,6 @@ def _check_outputs(
                 f'{repr(path.suffix) if path.suffix else "no suffix"}'
             )
             raise UsageError(msg)
-        check_output_file(path, option=option)
         for what, other in seen:
             if _same_file(path, other):
                 if what == 'the input':
