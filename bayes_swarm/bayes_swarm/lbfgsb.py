@@ -1,11 +1,10 @@
 """Box-constrained L-BFGS-B for small problems: scipy's routine without its per-call set-up.
 
 Eq. 5 (the argmax of the GP mean) runs scipy's L-BFGS-B from two to four starts at every
-decision, and in two dimensions the objective costs about 20 us while
-``scipy.optimize.minimize(method='L-BFGS-B')`` spends several hundred microseconds per call
-in its Python layers (option checks, bounds conversion, the ``ScalarFunction`` wrapper and
-its finite-difference machinery, which an analytic gradient never uses). That was three
-quarters of Eq. 5 and about a fifth of a Case 1 decision.
+decision. In two dimensions the objective is cheap, and
+``scipy.optimize.minimize(method='L-BFGS-B')`` spends most of each call in its Python layers
+(option checks, bounds conversion, the ``ScalarFunction`` wrapper and its finite-difference
+machinery, which an analytic gradient never uses); docs/bayes_swarm.md gives the cost.
 
 :func:`minimize_box` drives scipy's own compiled L-BFGS-B iteration (``setulb``) with the
 same options and the same evaluation rule as ``minimize`` (the objective is evaluated at the

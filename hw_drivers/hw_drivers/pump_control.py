@@ -108,7 +108,3 @@ class PumpController:
     def _turn_off(self, now_s: float) -> None:
         self.output = False
         self._off_since_s = now_s
-
-    def off_deadline_s(self) -> float | None:
-        """When the running pulse must end at the latest [s], or None when off."""
-        return self._on_since_s + self.limits.max_on_s if self.output else None

@@ -87,7 +87,9 @@ def test_accepted_clone_identity_is_configurable():
     clock = FakeClock()
     bus = FakeSMBus({0x68: FakeMpu6050(clock, who_am_i=0x70)})
     config = Mpu6050Config(accepted_who_am_i=(0x68, 0x70))
-    Mpu6050(bus, config, sleep=clock.sleep).initialise()
+    device = Mpu6050(bus, config, sleep=clock.sleep)
+    device.initialise()  # the clone's 0x70 is accepted: configured, not refused
+    assert device.config_intact()
 
 
 def test_missing_chip_nacks_as_device_unavailable():

@@ -17,12 +17,10 @@ from oabug_robot.fsm import Command, Event, FsmMemory
 from oabug_robot.heading import yaw_from_quaternion
 from oabug_robot.scan_features import LaserScanData
 from oabug_robot.settings import OABugConfig
-from oabug_robot.sound import PeerBearings
 
 __all__ = [
     'EVENT_NAMES',
     'STALE_EVENT',
-    'bearings_from_ros',
     'command_to_pump',
     'command_to_twist',
     'gas_from_ros',
@@ -89,21 +87,6 @@ def peer_arrays_from_ros(msg: Any, own_tag_id: str) -> tuple[np.ndarray, np.ndar
     return (
         np.array([b.azimuth for b in peers], dtype=float),
         np.array([b.distance for b in peers], dtype=float),
-    )
-
-
-def bearings_from_ros(msg: Any, own_tag_id: str, stamp_s: float, yaw_rad: float) -> PeerBearings:
-    """swarm_interfaces/PeerBearingArray -> :class:`PeerBearings` without the own tag.
-
-    Args:
-        msg: the bearing array.
-        own_tag_id: this robot's own tag id (case-insensitive); '' keeps every tag.
-        stamp_s: when the array was received [s, node clock].
-        yaw_rad: the robot's yaw at that time [rad].
-    """
-    azimuths, distances = peer_arrays_from_ros(msg, own_tag_id)
-    return PeerBearings(
-        azimuths_rad=azimuths, distances_m=distances, stamp_s=stamp_s, yaw_at_stamp_rad=yaw_rad
     )
 
 

@@ -8,10 +8,10 @@ import math
 import numpy as np
 import pytest
 from oabug_robot.conversions import (
-    bearings_from_ros,
     command_to_pump,
     command_to_twist,
     gas_from_ros,
+    peer_arrays_from_ros,
     scan_from_ros,
     state_to_ros,
     yaw_from_imu,
@@ -79,12 +79,10 @@ def test_own_tag_is_dropped_from_the_bearings() -> None:
             swarm.PeerBearing(tag_id='r1', azimuth=-0.5, distance=math.nan),
         ]
     )
-    peers = bearings_from_ros(msg, 'r0', stamp_s=3.0, yaw_rad=0.2)
-    assert peers.azimuths_rad.tolist() == pytest.approx([-0.5])
-    assert math.isnan(peers.distances_m[0])
-    assert peers.stamp_s == 3.0
-    assert peers.yaw_at_stamp_rad == 0.2
-    assert bearings_from_ros(msg, '', 0.0, 0.0).azimuths_rad.size == 2
+    azimuths, distances = peer_arrays_from_ros(msg, 'r0')
+    assert azimuths.tolist() == pytest.approx([-0.5])
+    assert math.isnan(distances[0])
+    assert peer_arrays_from_ros(msg, '')[0].size == 2
 
 
 def test_commands_become_twist_and_bool_messages() -> None:

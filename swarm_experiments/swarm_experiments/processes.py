@@ -319,7 +319,7 @@ def launch_entries(commands: Sequence[NodeCommand]) -> list[dict[str, Any]]:
 
 def _parent_death_signal() -> None:
     """In a child, before exec: SIGTERM when the supervisor dies (Linux), so no orphans."""
-    with contextlib.suppress(Exception):
+    with contextlib.suppress(OSError, AttributeError):  # no libc, or no prctl: not Linux
         libc = ctypes.CDLL(None, use_errno=True)
         pr_set_pdeathsig = 1
         libc.prctl(pr_set_pdeathsig, signal.SIGTERM)

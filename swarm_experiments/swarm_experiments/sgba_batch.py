@@ -232,7 +232,8 @@ def _deliver(engine: SimEngine, out: Any, robots: list[SgbaBatchRobot], tags: li
         for i, (robot, held) in enumerate(
             zip(robots, imu_message_yaw_kernel(yaws).tolist(), strict=True)
         ):
-            if out.published('imu', i):
+            # A message without orientation gives no yaw: the node drops it (yaw_from_imu).
+            if out.published('imu', i) and not math.isnan(held):
                 robot.loop.hold_yaw(held, now_s)
     if out.odometry is not None:
         odom_poses = out.odometry[0]

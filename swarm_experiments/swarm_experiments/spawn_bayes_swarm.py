@@ -33,6 +33,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from bayes_swarm.controller import robot_seed
 from bayes_swarm.profiles import PROFILES, profile_options
 from sim_bridge.mission_file import signal_entry
 from sim_bridge.signal_extension import SignalExtension
@@ -280,7 +281,7 @@ def node_parameters(case: SignalCase, settings: SpawnSettings, n: int, i: int) -
         'algorithm': settings.algorithm,
         'robot_index': i,
         'n_robots': n,
-        'seed': int(settings.seed * 1000 + i),
+        'seed': robot_seed(settings.seed, i),
         'arena_x_min_m': float(x0),
         'arena_x_max_m': float(x1),
         'arena_y_min_m': float(y0),

@@ -147,7 +147,9 @@ ROWS = [
     _row('validate a directory', 'site_tool', 'validate {inputs}', 'is a directory'),
     _row('validate missing', 'site_tool', 'validate {inputs}/missing.yaml', 'No such file'),
     _row('validate no argument', 'site_tool', 'validate', 'required: site'),
-    _row('generate 0 rooms', 'site_tool', 'generate --seed 1 --rooms 0 -o {work}/s.yaml', 'positive'),
+    _row(
+        'generate 0 rooms', 'site_tool', 'generate --seed 1 --rooms 0 -o {work}/s.yaml', 'positive'
+    ),
     _row('generate bad seed', 'site_tool', 'generate --seed -1 -o {work}/s.yaml', '--seed'),
     _row('generate -o dir', 'site_tool', 'generate --seed 1 -o {inputs}', 'is a directory'),
     _row(

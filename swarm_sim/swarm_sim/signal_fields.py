@@ -179,10 +179,6 @@ class SignalCase:
     dimensionless_acquisition: bool = False
     signal_scale: float = 1.0
 
-    def depot_of(self, robot_index: int) -> int:
-        """Index of the depot robot ``robot_index`` (0-based) starts from."""
-        return robot_index % self.depots_m.shape[0]
-
     def with_source_moved(self, offset_m: np.ndarray) -> SignalCase:
         """The case with its field and source moved by (2,) ``offset_m`` [m].
 
