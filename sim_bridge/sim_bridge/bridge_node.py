@@ -345,9 +345,7 @@ class SimBridgeNode(Node):
                     )
         if out.imu is not None:
             yaw, rate = out.imu
-            density = cfg.imu.noise_density_radps_per_sqrt_hz
-            bias = cfg.imu.residual_bias_std_radps
-            yaw_variance = density**2 * t + (bias * t) ** 2
+            yaw_variance = cfg.imu.yaw_variance_rad2(t)
             for i, name in enumerate(names):
                 if self._imu_pubs[i].get_subscription_count() and out.published('imu', i):
                     self._imu_pubs[i].publish(

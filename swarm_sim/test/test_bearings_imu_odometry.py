@@ -84,6 +84,23 @@ def test_gyro_bias_makes_the_yaw_drift_linearly():
     assert 2.5 < drift_deg.std() < 3.5
 
 
+@pytest.mark.parametrize(
+    'config',
+    [
+        ImuConfig(noise_density_radps_per_sqrt_hz=math.radians(0.05)),
+        ImuConfig(noise_density_radps_per_sqrt_hz=0.0, residual_bias_std_radps=math.radians(0.05)),
+    ],
+)
+def test_the_reported_yaw_variance_is_the_spread_the_model_makes(config):
+    # What the IMU message reports as its yaw variance: the spread across robots of the
+    # integrated yaw error after 60 s, for the white noise and for the residual bias.
+    imu = GyroYawModel(np.zeros(400), config, np.random.default_rng(7))
+    for _ in range(10 * 60):
+        yaw, _ = imu.update(np.zeros(400), 0.1)
+    assert config.yaw_variance_rad2(0.0) == 0.0
+    assert yaw.var() == pytest.approx(config.yaw_variance_rad2(60.0), rel=0.2)
+
+
 def test_exact_odometry_reproduces_the_true_path():
     start = np.array([[1.0, 2.0, 0.3]])
     odom = WheelOdometry(start, OdometryConfig(), np.random.default_rng(0))

@@ -64,6 +64,13 @@ class ImuConfig:
         if min(terms) < 0.0:
             raise ConfigurationError('IMU noise and bias terms must be >= 0')
 
+    def yaw_variance_rad2(self, elapsed_s: float) -> float:
+        """Variance of the integrated yaw after ``elapsed_s`` [rad^2]: the white noise's
+        random walk plus the residual bias's drift (what the IMU message reports)."""
+        density = self.noise_density_radps_per_sqrt_hz
+        bias = self.residual_bias_std_radps
+        return density**2 * elapsed_s + (bias * elapsed_s) ** 2
+
 
 class GyroYawModel:
     """Integrated gyro yaw of N robots."""
