@@ -257,14 +257,10 @@ class SimBridgeNode(Node):
         )
 
     def _setup_relay(self) -> RelayModel | None:
-        comm_range_m, loss = self.settings.comm_range_m, self.settings.peer_loss_probability
-        plan = self.engine.fault_plan  # injected link faults limit the relay further
-        if plan is not None:
-            comm_range_m, loss = min(comm_range_m, plan.comm_range_m), plan.combined_loss(loss)
         config = RelayConfig(
             msg_type=self.settings.peer_msg_type,
-            comm_range_m=comm_range_m,
-            loss_probability=loss,
+            comm_range_m=self.settings.comm_range_m,
+            loss_probability=self.settings.peer_loss_probability,
         )
         if not config.enabled:
             return None
@@ -274,8 +270,8 @@ class SimBridgeNode(Node):
         except (ImportError, AttributeError, LookupError) as err:
             msg = f'unknown peer message type {config.msg_type!r}'
             raise ConfigurationError(msg) from err
-        relay_rng = np.random.default_rng(np.random.SeedSequence([self.config.seed, 7]))
-        relay = RelayModel(config, relay_rng)
+        # Injected link faults limit the relay further.
+        relay = RelayModel.for_mission(config, self.config.seed, self.engine.fault_plan)
         self._peer_in_pubs = [
             self.create_publisher(msg_class, f'/{name}/peers/in', 10) for name in self.robot_names
         ]

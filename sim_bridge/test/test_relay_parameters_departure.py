@@ -8,6 +8,7 @@ from sim_bridge.bridge_parameters import BRIDGE_PARAMETERS, BridgeNodeConfig, co
 from swarm_sim.departure import departure_poses, preferred_directions
 from swarm_sim.engine import EngineConfig
 from swarm_sim.errors import ConfigurationError
+from swarm_sim.faults import FaultConfig, FaultPlan
 from swarm_sim.peer_relay import RelayConfig, RelayModel, parse_message_type
 
 
@@ -24,6 +25,22 @@ def test_relay_drops_about_the_configured_fraction():
     for _ in range(400):
         relay.receivers(0, positions)
     assert relay.dropped / (relay.dropped + relay.delivered) == pytest.approx(0.25, abs=0.03)
+
+
+def test_a_missions_relay_takes_the_link_faults_and_its_own_random_stream():
+    config = RelayConfig('pkg/msg/Peer', comm_range_m=150.0, loss_probability=0.1)
+    faults = FaultConfig(comm_range_m=120.0, comm_loss_probability=0.3)
+    relay = RelayModel.for_mission(config, seed=4, plan=FaultPlan(faults, 5, 4))
+    assert relay.config.comm_range_m == 120.0
+    assert relay.config.loss_probability == pytest.approx(1.0 - 0.9 * 0.7)
+    assert RelayModel.for_mission(config, seed=4).config == config  # no plan: as given
+    # The same seed drops the same deliveries (the bridge and the batch runners agree).
+    positions = np.zeros((8, 2))
+    first, again = RelayModel.for_mission(config, 4), RelayModel.for_mission(config, 4)
+    other = RelayModel.for_mission(config, 5)
+    runs = [[r.receivers(0, positions).tolist() for _ in range(50)] for r in (first, again, other)]
+    assert runs[0] == runs[1]
+    assert runs[0] != runs[2]
 
 
 def test_message_types_are_parsed_or_rejected():

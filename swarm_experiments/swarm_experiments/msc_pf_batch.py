@@ -225,17 +225,14 @@ def run_batch(
         if scenario.faults.active
         else None
     )
-    comm_range_m, comm_loss = config.swarm.comm_range_m, scenario.comm_loss
-    if plan is not None:
-        comm_range_m = min(comm_range_m, plan.comm_range_m)
-        comm_loss = plan.combined_loss(comm_loss)
-    relay = RelayModel(
+    relay = RelayModel.for_mission(
         RelayConfig(
             msg_type='swarm_interfaces/msg/MscPeer',
-            comm_range_m=comm_range_m,
-            loss_probability=comm_loss,
+            comm_range_m=config.swarm.comm_range_m,
+            loss_probability=scenario.comm_loss,
         ),
-        np.random.default_rng(np.random.SeedSequence([scenario.seed, 7])),
+        scenario.seed,
+        plan,
     )
     steering = scenario.steering
     loops = [

@@ -8,13 +8,21 @@ of every other robot within ``comm_range_m`` of the sender, dropping each delive
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from swarm_sim.errors import ConfigurationError
 
-__all__ = ['RelayConfig', 'RelayModel', 'parse_message_type']
+if TYPE_CHECKING:
+    from swarm_sim.faults import FaultPlan
+
+__all__ = ['RELAY_STREAM', 'RelayConfig', 'RelayModel', 'parse_message_type']
+
+#: The relay's random stream of a mission seeded ``seed``: ``SeedSequence([seed, 7])``, the
+#: same in the sim bridge and the batch runners, so they drop the same deliveries.
+RELAY_STREAM = 7
 
 
 @dataclass(frozen=True)
@@ -67,6 +75,27 @@ class RelayModel:
         self._rng = rng
         self.delivered = 0
         self.dropped = 0
+
+    @staticmethod
+    def mission_config(config: RelayConfig, plan: FaultPlan | None) -> RelayConfig:
+        """``config`` limited further by a fault plan's link faults (range, loss), if any."""
+        if plan is None:
+            return config
+        comm_range_m = plan.combined_range_m(config.comm_range_m)
+        return replace(
+            config,
+            comm_range_m=config.comm_range_m if comm_range_m is None else comm_range_m,
+            loss_probability=plan.combined_loss(config.loss_probability),
+        )
+
+    @classmethod
+    def for_mission(
+        cls, config: RelayConfig, seed: int, plan: FaultPlan | None = None
+    ) -> RelayModel:
+        """The relay of a mission seeded ``seed``: :meth:`mission_config` on the relay's
+        own random stream (:data:`RELAY_STREAM`)."""
+        rng = np.random.default_rng(np.random.SeedSequence([seed, RELAY_STREAM]))
+        return cls(cls.mission_config(config, plan), rng)
 
     def receivers(self, sender: int, positions: np.ndarray) -> np.ndarray:
         """Indices of the robots that receive ``sender``'s broadcast.
