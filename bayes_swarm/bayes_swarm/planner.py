@@ -42,7 +42,7 @@ from bayes_swarm.penalty import local_penalty, log_local_penalty
 from bayes_swarm.settings import Arena, BayesSwarmConfig
 from bayes_swarm.trust_region import projected_newton_step
 
-__all__ = ['BayesSwarmPlanner', 'ascend_mean', 'first_waypoint']
+__all__ = ['BayesSwarmPlanner', 'ascend_mean', 'first_heading_rad', 'first_waypoint']
 
 _MEAN_GRID_SIZE = 16
 # Added to the raw acquisition before its log (``penalty_log_space``): it is 0 only on a
@@ -53,6 +53,19 @@ _MAX_RAY_STEPS = 25
 _REFINE_LEVELS = 2
 # (radius, heading) multiples of the pattern search's 3 x 3 stencil, centre excluded.
 _POLAR_STENCIL = np.array([(a, b) for a in (-1, 0, 1) for b in (-1, 0, 1) if a or b], float)
+
+
+def first_heading_rad(
+    *, fan_index: int, fan_size: int, direction_range_deg: float, direction_offset_deg: float
+) -> float:
+    """TAKEFIRSTDECISION's heading [rad]: theta = r dtheta / m over a full circle, else
+    r dtheta / (m + 1), measured from ``direction_offset_deg`` (``fan_index`` r is 1-based,
+    ``fan_size`` m)."""
+    if math.isclose(direction_range_deg, 360.0):
+        theta_deg = fan_index * direction_range_deg / fan_size
+    else:
+        theta_deg = fan_index * direction_range_deg / (fan_size + 1)
+    return math.radians(theta_deg + direction_offset_deg)
 
 
 def first_waypoint(
@@ -69,11 +82,12 @@ def first_waypoint(
     ``fan_index`` is r (1-based) and ``fan_size`` m; the heading is measured from
     ``direction_offset_deg``. Returns the (2,) waypoint [m] (not clipped).
     """
-    if math.isclose(direction_range_deg, 360.0):
-        theta_deg = fan_index * direction_range_deg / fan_size
-    else:
-        theta_deg = fan_index * direction_range_deg / (fan_size + 1)
-    theta = math.radians(theta_deg + direction_offset_deg)
+    theta = first_heading_rad(
+        fan_index=fan_index,
+        fan_size=fan_size,
+        direction_range_deg=direction_range_deg,
+        direction_offset_deg=direction_offset_deg,
+    )
     return np.asarray(position_m, dtype=float) + leg_m * np.array(
         [math.cos(theta), math.sin(theta)]
     )

@@ -34,6 +34,7 @@ from typing import Any
 
 import numpy as np
 from bayes_swarm.controller import robot_seed
+from bayes_swarm.planner import first_heading_rad
 from bayes_swarm.profiles import PROFILES, profile_options
 from sim_bridge.mission_file import signal_entry
 from sim_bridge.signal_extension import SignalExtension
@@ -357,11 +358,13 @@ def batch_mission_spec(
 
 
 def _initial_yaw(case: SignalCase, fan_index: int, fan_size: int, offset: float) -> float:
-    if math.isclose(case.direction_range_deg, 360.0):
-        theta = fan_index * case.direction_range_deg / fan_size
-    else:
-        theta = fan_index * case.direction_range_deg / (fan_size + 1)
-    return math.radians(theta + offset)
+    """The robot starts facing its first leg (the planner's TAKEFIRSTDECISION heading)."""
+    return first_heading_rad(
+        fan_index=fan_index,
+        fan_size=fan_size,
+        direction_range_deg=case.direction_range_deg,
+        direction_offset_deg=offset,
+    )
 
 
 def check_settings(settings: SpawnSettings) -> SignalCase:
