@@ -357,6 +357,11 @@ def _label(columns: Sequence[str], values: Any) -> str:
 
 
 def _metric_plot(page: ReportPage, metric: str, table: pd.DataFrame) -> None:
+    # A configuration without a value (e.g. tau when no run found the source) stays in the
+    # table and out of the plot.
+    table = table[np.isfinite(table['mean'].to_numpy(dtype=float))]
+    if table.empty:
+        return
     axes = page.axes
     numeric_axes = [
         axis

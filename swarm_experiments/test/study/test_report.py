@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+import math
+import warnings
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 import pytest
-from study_fixtures import search_study
+from study_fixtures import search_study, synthetic_run
 from swarm_experiments.study import (
     ReportPage,
     StudyRegistry,
@@ -181,3 +183,24 @@ def test_markdown_tables_align_numbers_and_escape_pipes() -> None:
     frame = pd.DataFrame({'config.name': ['a|b'], 'mean': [0.12345]})
     assert markdown_table(frame) == '| name | mean |\n| --- | ---: |\n| a\\|b | 0.123 |'
     assert summary_table(frame.assign(v=[1.0]), 'v', [])['count'].tolist() == [1]
+
+
+def _unlimited_range_run(spec):
+    # A metric that is infinite in some configurations, as an unlimited radio range is.
+    row = dict(synthetic_run(spec))
+    row['range_m'] = math.inf if spec.config['variant'] == 'random' else 30.0
+    return row
+
+
+def test_a_configuration_without_a_finite_value_stays_in_the_table_and_out_of_the_plot(
+    tmp_path: Path,
+) -> None:
+    # One robot count: the metric is drawn as bars, one per variant.
+    axes = {'variant': ('gas', 'sound', 'random'), 'robots': (6,)}
+    directory = _study_dir(tmp_path, axes=axes, run=_unlimited_range_run)
+    with warnings.catch_warnings():
+        warnings.simplefilter('error', RuntimeWarning)  # matplotlib's, on an infinite bar
+        (page_path,) = write_reports(tmp_path)
+    assert (directory / 'figures' / 'metric-range_m.png').read_bytes().startswith(PNG)
+    table = _table_after(page_path.read_text(), 'range_m')
+    assert {row[0] for row in table} == {'gas', 'sound', 'random'}
