@@ -15,7 +15,7 @@ from swarm_runtime.ros import message_module
 
 from oabug_robot.fsm import Command, Event, FsmMemory
 from oabug_robot.heading import yaw_from_quaternion
-from oabug_robot.scan_features import LaserScanData
+from oabug_robot.scan_features import LaserScanData, check_scan_frame
 from oabug_robot.settings import OABugConfig
 
 __all__ = [
@@ -47,14 +47,21 @@ def _float_array(values: Any) -> np.ndarray:
 
 
 def scan_from_ros(msg: Any) -> LaserScanData:
-    """sensor_msgs/LaserScan -> :class:`LaserScanData` (ranges are not copied when possible)."""
-    return LaserScanData(
+    """sensor_msgs/LaserScan -> :class:`LaserScanData` (ranges are not copied when possible).
+
+    Raises:
+        ScanError: the scan's frame is unusable
+            (:func:`~oabug_robot.scan_features.check_scan_frame`).
+    """
+    scan = LaserScanData(
         ranges_m=_float_array(msg.ranges),
         angle_min_rad=float(msg.angle_min),
         angle_increment_rad=float(msg.angle_increment),
         range_min_m=float(msg.range_min),
         range_max_m=float(msg.range_max),
     )
+    check_scan_frame(scan, float(msg.angle_max))
+    return scan
 
 
 def yaw_from_imu(msg: Any) -> float:

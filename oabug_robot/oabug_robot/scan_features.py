@@ -24,7 +24,14 @@ import numpy as np
 from oabug_robot.errors import ScanError
 from oabug_robot.settings import PerceptionConfig
 
-__all__ = ['LaserScanData', 'ScanFeatureExtractor', 'ScanFeatures', 'SideWall']
+__all__ = [
+    'MIN_ANGLE_INCREMENT_RAD',
+    'LaserScanData',
+    'ScanFeatureExtractor',
+    'ScanFeatures',
+    'SideWall',
+    'check_scan_frame',
+]
 
 _NO_ANGLES = np.zeros(0)
 # Returns spread less than this along the robot [m] give no line fit: the side wall is then
@@ -49,6 +56,53 @@ class LaserScanData(NamedTuple):
     angle_increment_rad: float
     range_min_m: float
     range_max_m: float
+
+
+#: Finest angle step a scan may have [rad]: 62,832 rays a revolution (the RPLidar A1 gives
+#: about 1,450; its driver at most 4,096).
+MIN_ANGLE_INCREMENT_RAD = 1e-4
+
+
+def check_scan_frame(scan: LaserScanData, angle_max_rad: float) -> None:
+    """Check that a received scan describes (part of) one lidar revolution.
+
+    A scan whose limits cannot be read would otherwise pass as free space: with a NaN
+    ``range_max`` every return is filtered out, and no return reads as no wall.
+
+    Raises:
+        ScanError: no rays; an angle that is not finite; an increment finer than
+            :data:`MIN_ANGLE_INCREMENT_RAD` or rays spanning more than a revolution; a ray
+            count that disagrees with ``angle_max`` by more than one ray; range limits that
+            are not finite or not ``0 <= range_min < range_max``; every range NaN (no valid
+            sample, REP 117).
+    """
+    ranges = scan.ranges_m
+    count = len(ranges)
+    if count == 0:
+        raise ScanError('the scan has no ranges')
+    angle_min, increment = scan.angle_min_rad, scan.angle_increment_rad
+    if not all(math.isfinite(v) for v in (angle_min, angle_max_rad, increment)):
+        raise ScanError('scan angles must be finite')
+    step = abs(increment)
+    if count > 1 and step < MIN_ANGLE_INCREMENT_RAD:
+        msg = f'scan angle_increment {increment:g} rad is finer than {MIN_ANGLE_INCREMENT_RAD:g}'
+        raise ScanError(msg)
+    if count > 1 and (count - 1) * step > 2.0 * math.pi + 1e-6:
+        msg = f'{count} rays of {increment:g} rad span more than a revolution'
+        raise ScanError(msg)
+    implied = (angle_max_rad - angle_min) / increment + 1.0
+    if count > 1 and abs(implied - count) > 1.0 + 1e-6:
+        msg = (
+            f'{count} ranges, but angle_min {angle_min:g}, angle_max {angle_max_rad:g} and '
+            f'angle_increment {increment:g} rad give {implied:.0f}'
+        )
+        raise ScanError(msg)
+    low, high = scan.range_min_m, scan.range_max_m
+    if not (math.isfinite(low) and math.isfinite(high) and 0.0 <= low < high):
+        msg = f'scan range limits must be finite, 0 <= range_min < range_max: {low:g}, {high:g}'
+        raise ScanError(msg)
+    if np.isnan(ranges).all():
+        raise ScanError('every range of the scan is NaN (no valid sample)')
 
 
 class SideWall(NamedTuple):

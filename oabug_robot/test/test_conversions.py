@@ -16,6 +16,7 @@ from oabug_robot.conversions import (
     state_to_ros,
     yaw_from_imu,
 )
+from oabug_robot.errors import ScanError
 from oabug_robot.fsm import Command, Event, OABugFsm
 from oabug_robot.settings import OABugConfig, Variant
 from swarm_runtime.ros import message_module
@@ -29,6 +30,7 @@ builtin = message_module('builtin_interfaces')
 def test_scan_ranges_keep_nan_and_inf_and_their_geometry() -> None:
     msg = sensor.LaserScan(
         angle_min=-math.pi,
+        angle_max=-math.pi + 1.5,
         angle_increment=0.5,
         range_min=0.15,
         range_max=12.0,
@@ -46,10 +48,50 @@ def test_scan_ranges_keep_nan_and_inf_and_their_geometry() -> None:
 def test_scan_ranges_given_as_a_list_are_accepted() -> None:
     msg = type('Scan', (), {})()
     msg.ranges, msg.angle_min, msg.angle_increment = [1.0, 2.0], 0.0, 0.1
-    msg.range_min, msg.range_max = 0.1, 5.0
+    msg.angle_max, msg.range_min, msg.range_max = 0.1, 0.1, 5.0
     assert scan_from_ros(msg).ranges_m.tolist() == [1.0, 2.0]
     msg.ranges = array.array('f')
-    assert scan_from_ros(msg).ranges_m.size == 0
+    with pytest.raises(ScanError, match='no ranges'):
+        scan_from_ros(msg)
+
+
+def _full_scan(**changes: object) -> object:
+    # The sim bridge's and the RPLidar driver's convention: angle_max is the last ray's angle.
+    values = {
+        'angle_min': -math.pi,
+        'angle_max': math.pi - 2 * math.pi / 360,
+        'angle_increment': 2 * math.pi / 360,
+        'range_min': 0.15,
+        'range_max': 12.0,
+        'ranges': [0.18] * 360,
+        **changes,
+    }
+    return sensor.LaserScan(**values)
+
+
+def test_a_full_revolution_as_the_bridge_and_the_driver_publish_it_is_accepted() -> None:
+    assert scan_from_ros(cdr_roundtrip(_full_scan())).ranges_m.size == 360
+
+
+@pytest.mark.parametrize(
+    ('changes', 'problem'),
+    [
+        ({'angle_min': math.nan}, 'finite'),
+        ({'angle_max': math.inf}, 'finite'),
+        ({'angle_increment': 1e-30}, 'finer than'),
+        ({'angle_increment': 0.1, 'angle_max': -math.pi + 359 * 0.1}, 'more than a revolution'),
+        ({'ranges': [0.18] * 10}, '10 ranges, but'),
+        ({'range_max': math.nan}, 'range limits'),
+        ({'range_min': math.nan}, 'range limits'),
+        ({'range_min': 0.15, 'range_max': 0.1}, 'range limits'),
+        ({'range_min': -1.0}, 'range limits'),
+        ({'ranges': [math.nan] * 360}, 'every range'),
+    ],
+)
+def test_a_scan_whose_frame_cannot_be_read_is_refused(changes, problem) -> None:
+    # Read as it was, each of these would drop every return and look like free space.
+    with pytest.raises(ScanError, match=problem):
+        scan_from_ros(cdr_roundtrip(_full_scan(**changes)))
 
 
 def test_yaw_comes_from_the_imu_orientation() -> None:

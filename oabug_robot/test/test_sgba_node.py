@@ -109,3 +109,41 @@ def test_with_fresh_sensors_it_turns_to_its_heading_and_stops_when_odometry_is_l
     assert bed.spin_until(
         lambda: commands[-1].linear.x == 0.0 and commands[-1].angular.z == 0.0, 10.0
     )
+
+
+@pytest.mark.parametrize(
+    'damage',
+    [
+        {'angle_min': math.nan},
+        {'angle_min': math.inf},
+        {'angle_increment': 1e-30},
+        {'range_max': math.nan},
+    ],
+    ids=['angle_min NaN', 'angle_min inf', 'increment 1e-30', 'range_max NaN'],
+)
+def test_a_scan_it_cannot_read_is_dropped_and_the_robot_stops_until_good_ones_return(
+    harness, damage
+) -> None:
+    bed, _, commands, players = harness(robot_index=1, robot_count=4, own_tag_id='R1')
+    players['imu'].play(imu_msg(math.pi / 2))
+    players['odom'].play(odom_msg())
+    players['scan'].play(scan_msg())
+    assert bed.spin_until(lambda: bool(commands) and commands[-1].linear.x > 0.0, 10.0)
+    bad = scan_msg()
+    for field, value in damage.items():
+        setattr(bad, field, value)
+    players['scan'].play(bad)  # the node lives on (a callback error would end the spin)
+    assert bed.spin_until(lambda: commands[-1].linear.x == 0.0, 10.0), 'stale scan: stop'
+    players['scan'].play(scan_msg())
+    assert bed.spin_until(lambda: commands[-1].linear.x > 0.0, 10.0)
+
+
+def test_odometry_that_is_not_finite_is_dropped(harness) -> None:
+    bed, node, _, players = harness(robot_index=1, robot_count=4, own_tag_id='R1')
+    players['odom'].play(odom_msg())
+    bed.spin_for(0.3)
+    bad = odom_msg()
+    bad.pose.pose.position.x = math.nan
+    players['odom'].play(bad)
+    bed.spin_for(0.3)
+    assert all(math.isfinite(v) for v in node.loop._position)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
@@ -25,9 +26,17 @@ def peers_from_ros(msg: Any) -> tuple[list[str], np.ndarray, np.ndarray]:
 
 
 def position_from_odometry(msg: Any) -> tuple[float, float]:
-    """nav_msgs/Odometry -> (x, y) [m] of its pose."""
+    """nav_msgs/Odometry -> (x, y) [m] of its pose.
+
+    Raises:
+        ValueError: the position is not finite (the message is dropped; odometry goes stale).
+    """
     position = msg.pose.pose.position
-    return float(position.x), float(position.y)
+    x, y = float(position.x), float(position.y)
+    if not (math.isfinite(x) and math.isfinite(y)):
+        msg_text = f'odometry position ({x}, {y}) is not finite'
+        raise ValueError(msg_text)
+    return x, y
 
 
 def command_to_twist(command: SgbaCommand) -> Any:

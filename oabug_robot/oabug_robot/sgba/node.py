@@ -108,7 +108,12 @@ class SgbaNode(Node):
         self.loop.hold_yaw(yaw, self._now_s())
 
     def _on_odom(self, msg: Any) -> None:
-        self.loop.hold_position(*position_from_odometry(msg), self._now_s())
+        try:
+            position = position_from_odometry(msg)
+        except ValueError as err:
+            self._warn('odom', f'ignoring odometry: {err}')
+            return
+        self.loop.hold_position(*position, self._now_s())
 
     def _on_bearings(self, msg: Any) -> None:
         self.loop.hold_peers(*peers_from_ros(msg), self._now_s())
