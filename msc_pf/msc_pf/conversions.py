@@ -12,13 +12,15 @@ from collections.abc import Collection
 from typing import Any
 
 import numpy as np
-from swarm_common.angles import yaw_from_unit_quaternion
+from swarm_common.angles import yaw_from_quaternion, yaw_from_unit_quaternion
 from swarm_common.stamps import stamp_from_seconds, stamp_to_seconds
 
 from msc_pf.peers import PeerInfo, Phase, Role
 from msc_pf.robot import RobotStatus
 
 __all__ = [
+    'MAX_PEER_ARRAY_LENGTH',
+    'ODOM_QUATERNION_NORM_TOLERANCE',
     'captured_from_ros',
     'peer_from_ros',
     'peer_to_ros',
@@ -29,7 +31,22 @@ __all__ = [
     'stamp_to_ros',
     'status_to_ros',
     'twist_to_ros',
+    'yaw_from_odometry_quaternion',
 ]
+
+#: Longest ``reading_ids`` / ``reading_rssi_dbm`` / ``members`` / ``captured_ids`` array an
+#: MscPeer may carry; a longer one drops the message. Every real mission fits (the spawner
+#: places at most 100 targets and swarms hold a few robots); the cap bounds what one message
+#: can make a receiver allocate.
+MAX_PEER_ARRAY_LENGTH = 256
+
+#: Largest accepted deviation of an odometry quaternion's norm from 1. Within it the
+#: quaternion is normalised; beyond it (a zero, tiny, huge or non-finite quaternion: a broken
+#: publisher) the odometry message is dropped, so the pose goes stale and the robot stops.
+ODOM_QUATERNION_NORM_TOLERANCE = 0.1
+
+# Squared norms this close to 1 count as unit: their yaw keeps the unit formula's bits.
+_UNIT_NORM_SQ_TOLERANCE = 1e-9
 
 
 def robot_id_from_name(name: str) -> int:
@@ -50,11 +67,41 @@ def stamp_to_ros(time_s: float, builtin_interfaces: Any) -> Any:
     return stamp_from_seconds(time_s, builtin_interfaces.Time)
 
 
+def yaw_from_odometry_quaternion(x: float, y: float, z: float, w: float) -> float:
+    """Yaw [rad] of an odometry orientation (x, y, z, w), normalised when it is not unit.
+
+    A unit quaternion (squared norm within 1e-9 of 1) takes
+    :func:`swarm_common.angles.yaw_from_unit_quaternion`; one whose norm is within
+    :data:`ODOM_QUATERNION_NORM_TOLERANCE` of 1 takes the scale-free
+    :func:`swarm_common.angles.yaw_from_quaternion` (as the oabug IMU reader does).
+
+    Raises:
+        ValueError: the quaternion is zero or not finite, or its norm is further than
+            :data:`ODOM_QUATERNION_NORM_TOLERANCE` from 1.
+    """
+    x, y, z, w = float(x), float(y), float(z), float(w)
+    norm_sq = x * x + y * y + z * z + w * w
+    if abs(norm_sq - 1.0) <= _UNIT_NORM_SQ_TOLERANCE:
+        return yaw_from_unit_quaternion(x, y, z, w)
+    yaw = yaw_from_quaternion(x, y, z, w)  # raises for a zero or non-finite quaternion
+    norm = math.sqrt(norm_sq)
+    if not abs(norm - 1.0) <= ODOM_QUATERNION_NORM_TOLERANCE:
+        raise ValueError(
+            f'quaternion ({x}, {y}, {z}, {w}) has norm {norm:.6g}, '
+            f'not within {ODOM_QUATERNION_NORM_TOLERANCE:g} of 1'
+        )
+    return yaw
+
+
 def pose_from_odometry(msg: Any) -> tuple[float, float, float]:
-    """nav_msgs/Odometry -> (x [m], y [m], yaw [rad]) in the odometry (world) frame."""
+    """nav_msgs/Odometry -> (x [m], y [m], yaw [rad]) in the odometry (world) frame.
+
+    Raises:
+        ValueError: the orientation is no rotation (see :func:`yaw_from_odometry_quaternion`).
+    """
     p = msg.pose.pose.position
     q = msg.pose.pose.orientation
-    yaw = yaw_from_unit_quaternion(q.x, q.y, q.z, q.w)
+    yaw = yaw_from_odometry_quaternion(q.x, q.y, q.z, q.w)
     return float(p.x), float(p.y), yaw
 
 
@@ -106,8 +153,19 @@ def peer_to_ros(info: PeerInfo, robot_name: str, swarm_interfaces: Any, builtin:
     return msg
 
 
-def peer_from_ros(msg: Any) -> PeerInfo:
-    """swarm_interfaces/MscPeer -> PeerInfo; raises ValueError on inconsistent fields."""
+def peer_from_ros(msg: Any, accepted_ids: Collection[int] | None = None) -> PeerInfo:
+    """swarm_interfaces/MscPeer -> PeerInfo; raises ValueError on inconsistent fields.
+
+    When ``accepted_ids`` is given, readings of emitters outside it are left out (as
+    :func:`readings_from_ros` does for the own RSSI). A message with an array longer than
+    :data:`MAX_PEER_ARRAY_LENGTH` is rejected.
+    """
+    for field in ('reading_ids', 'reading_rssi_dbm', 'members', 'captured_ids'):
+        length = len(getattr(msg, field))
+        if length > MAX_PEER_ARRAY_LENGTH:
+            raise ValueError(
+                f'peer {msg.robot!r}: {length} {field}, more than {MAX_PEER_ARRAY_LENGTH}'
+            )
     if len(msg.reading_ids) != len(msg.reading_rssi_dbm):
         raise ValueError(
             f'peer {msg.robot!r}: {len(msg.reading_ids)} reading IDs but '
@@ -136,7 +194,9 @@ def peer_from_ros(msg: Any) -> PeerInfo:
         target_rssi_dbm=float(msg.target_rssi_dbm),
         evaluation=float(msg.evaluation),
         readings=tuple(
-            (int(t), float(v)) for t, v in zip(msg.reading_ids, msg.reading_rssi_dbm, strict=True)
+            (int(t), float(v))
+            for t, v in zip(msg.reading_ids, msg.reading_rssi_dbm, strict=True)
+            if accepted_ids is None or int(t) in accepted_ids
         ),
         captured_ids=tuple(int(t) for t in msg.captured_ids),
         visited_cell=int(msg.visited_cell),

@@ -7,8 +7,9 @@ two paths run one controller.
 
 * **Sample and hold.** :meth:`RobotLoop.receive_pose` keeps the newest pose and when it came;
   :meth:`~RobotLoop.receive_rssi` merges the RSSI samples of a period (the newest sample of
-  a target wins) and refuses out-of-order stamps; peer messages and capture notices are
-  queued until the next control step.
+  a target wins) and refuses out-of-order stamps and stamps more than
+  :data:`MAX_RSSI_STAMP_LEAD_S` ahead of the caller's clock; peer messages and capture
+  notices are queued until the next control step.
 * **Timing.** :meth:`~RobotLoop.control` runs once per control period (the caller's timer):
   it hands the held pose and the period's samples, peers and notices to the controller and
   turns the displacement it returns into a waypoint due one period later.
@@ -33,7 +34,12 @@ from msc_pf.errors import ObservationError
 from msc_pf.peers import PeerInfo
 from msc_pf.robot import RobotController, StepOutput
 
-__all__ = ['ControlResult', 'ControlStatus', 'RobotLoop', 'Steering']
+__all__ = ['MAX_RSSI_STAMP_LEAD_S', 'ControlResult', 'ControlStatus', 'RobotLoop', 'Steering']
+
+#: An RSSI batch stamped more than this ahead of the receiver's clock [s] is refused: it
+#: would otherwise become the newest stamp and make every correctly stamped batch after it
+#: look out of order.
+MAX_RSSI_STAMP_LEAD_S = 5.0
 
 
 @dataclass(frozen=True)
@@ -87,6 +93,7 @@ class RobotLoop:
         self._pose_time_s = -math.inf
         self._readings: dict[int, float] = {}
         self._rssi_stamp_s = -math.inf
+        self._rssi_refusal = ''
         self._inbox: list[PeerInfo] = []
         self._captured: list[int] = []
         self._waypoint: tuple[float, float] | None = None
@@ -114,10 +121,24 @@ class RobotLoop:
         self._pose_time_s = now_s
         return True
 
-    def receive_rssi(self, stamp_s: float, readings: Mapping[int, float]) -> bool:
-        """Merge one RSSI batch stamped ``stamp_s``; False (ignored) when it is older than the
-        previous batch. Later samples of a target replace earlier ones of the period."""
+    def receive_rssi(
+        self, stamp_s: float, readings: Mapping[int, float], now_s: float | None = None
+    ) -> bool:
+        """Merge one RSSI batch stamped ``stamp_s``; False (ignored, the reason in
+        :attr:`last_rssi_refusal`) when the stamp is not finite, older than the previous
+        batch's or, given the clock ``now_s``, more than :data:`MAX_RSSI_STAMP_LEAD_S` ahead
+        of it. Later samples of a target replace earlier ones of the period."""
+        if not math.isfinite(stamp_s):
+            self._rssi_refusal = 'its stamp is not finite'
+            return False
+        if now_s is not None and stamp_s - now_s > MAX_RSSI_STAMP_LEAD_S:
+            self._rssi_refusal = (
+                f'its stamp is more than {MAX_RSSI_STAMP_LEAD_S:g} s ahead of the clock '
+                f'({now_s:.3f} s)'
+            )
+            return False
         if stamp_s < self._rssi_stamp_s:
+            self._rssi_refusal = f'it arrived after {self._rssi_stamp_s:.3f} s'
             return False
         self._rssi_stamp_s = stamp_s
         self._readings.update(readings)
@@ -127,6 +148,11 @@ class RobotLoop:
     def last_rssi_stamp_s(self) -> float:
         """Stamp of the newest accepted RSSI batch [s] (-inf before the first)."""
         return self._rssi_stamp_s
+
+    @property
+    def last_rssi_refusal(self) -> str:
+        """Why :meth:`receive_rssi` last refused a batch ('' before the first refusal)."""
+        return self._rssi_refusal
 
     def receive_peer(self, peer: PeerInfo) -> None:
         """Queue a neighbour's broadcast for the next control step."""

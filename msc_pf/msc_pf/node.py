@@ -14,8 +14,10 @@ The node only translates messages: every input goes to :class:`msc_pf.loop.Robot
 the loop the batch runner runs too). Every ``period_s`` the loop steps the controller and
 the node publishes its broadcast and state; at ``drive_rate_hz`` it publishes the loop's
 wheel command (a stop when odometry is older than ``odom_timeout_s`` or the controller has
-not run for two periods). Bad input (unknown or non-finite RSSI, out-of-order stamps, malformed
-peer messages) is ignored and logged; invalid parameters stop the node at start.
+not run for two periods). Bad input (unknown or non-finite RSSI, out-of-order stamps or stamps
+far ahead of the clock, odometry without a valid orientation, malformed or oversized peer
+messages, peers' readings of emitters outside ``target_ids``) is ignored and logged; invalid
+parameters stop the node at start.
 
 Run on a robot: ``ros2 run msc_pf msc_pf_node --ros-args -r __ns:=/r3 -p scheme:=proposed``
 (with ``-r peers/out:=/swarm/peers -r peers/in:=/swarm/peers`` when no relay exists).
@@ -112,16 +114,20 @@ class MscPfNode(Node):
 
     # ------------------------------------------------------------------ inputs
     def _on_odom(self, msg: Any) -> None:
-        if not self.loop.receive_pose(conversions.pose_from_odometry(msg), self._now_s()):
+        try:
+            pose = conversions.pose_from_odometry(msg)
+        except ValueError as err:
+            self.get_logger().warning(f'odometry ignored: {err}', throttle_duration_sec=5.0)
+            return
+        if not self.loop.receive_pose(pose, self._now_s()):
             self.get_logger().warning('non-finite odometry ignored', throttle_duration_sec=5.0)
 
     def _on_rssi(self, msg: Any) -> None:
         stamp = conversions.stamp_from_ros(msg.header.stamp)
         readings, ignored = conversions.readings_from_ros(msg, self._accepted)
-        previous = self.loop.last_rssi_stamp_s
-        if not self.loop.receive_rssi(stamp, readings):
+        if not self.loop.receive_rssi(stamp, readings, self._now_s()):
             self.get_logger().warning(
-                f'RSSI stamped {stamp:.3f} s arrived after {previous:.3f} s: ignored',
+                f'RSSI stamped {stamp:.3f} s ignored: {self.loop.last_rssi_refusal}',
                 throttle_duration_sec=5.0,
             )
             return
@@ -133,9 +139,14 @@ class MscPfNode(Node):
 
     def _on_peer(self, msg: Any) -> None:
         try:
-            self.loop.receive_peer(conversions.peer_from_ros(msg))
+            peer = conversions.peer_from_ros(msg, self._accepted)
         except ValueError as err:
             self.get_logger().warning(f'peer message ignored: {err}', throttle_duration_sec=5.0)
+            return
+        self.loop.receive_peer(peer)
+        ignored = len(msg.reading_ids) - len(peer.readings)
+        if ignored:
+            self.get_logger().debug(f'{ignored} peer readings ignored (not targets)')
 
     # ------------------------------------------------------------------ control
     def _on_control(self) -> None:

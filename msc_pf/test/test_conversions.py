@@ -7,6 +7,7 @@ import pytest
 from msc_pf.particle_filter import TargetEstimate
 from msc_pf.peers import PeerInfo, Phase, Role
 from msc_pf.robot import RobotStatus
+from swarm_common.angles import yaw_from_unit_quaternion, yaw_to_quaternion
 from swarm_runtime.ros import message_module
 
 from msc_pf import conversions
@@ -55,6 +56,34 @@ def test_peer_with_unknown_phase_or_bad_position_is_rejected():
     msg = conversions.peer_to_ros(PEER, 'r4', swarm, builtin)
     msg.position_x = math.inf
     with pytest.raises(ValueError, match='non-finite position'):
+        conversions.peer_from_ros(msg)
+
+
+def test_peer_readings_of_emitters_outside_the_accepted_ids_are_left_out():
+    msg = conversions.peer_to_ros(PEER, 'r4', swarm, builtin)
+    msg.reading_ids = [3, 1000, 7, 1001]
+    msg.reading_rssi_dbm = [-84.25, -70.0, -99.0, -70.0]
+    assert conversions.peer_from_ros(msg, accepted_ids=frozenset({3, 7})) == PEER
+    assert conversions.peer_from_ros(msg).readings == (
+        (3, -84.25),
+        (1000, -70.0),
+        (7, -99.0),
+        (1001, -70.0),
+    )
+
+
+@pytest.mark.parametrize('field', ['reading_ids', 'members', 'captured_ids'])
+def test_peer_with_an_array_longer_than_the_cap_is_rejected(field):
+    n = conversions.MAX_PEER_ARRAY_LENGTH
+    msg = conversions.peer_to_ros(PEER, 'r4', swarm, builtin)
+    setattr(msg, field, list(range(1000, 1000 + n)))
+    if field == 'reading_ids':
+        msg.reading_rssi_dbm = [-70.0] * n
+    conversions.peer_from_ros(msg)  # at the cap: accepted
+    setattr(msg, field, list(range(1000, 1001 + n)))
+    if field == 'reading_ids':
+        msg.reading_rssi_dbm = [-70.0] * (n + 1)
+    with pytest.raises(ValueError, match=f'{n + 1} {field}, more than {n}'):
         conversions.peer_from_ros(msg)
 
 
@@ -116,6 +145,47 @@ def test_stamp_round_trip_and_odometry_pose():
     x, y, yaw = conversions.pose_from_odometry(odom)
     assert (x, y) == (3.0, -2.0)
     assert yaw == pytest.approx(0.8)
+
+
+def odometry_with(x: float, y: float, z: float, w: float) -> object:
+    odom = nav.Odometry()
+    q = odom.pose.pose.orientation
+    q.x, q.y, q.z, q.w = x, y, z, w
+    return odom
+
+
+@pytest.mark.parametrize(
+    'quaternion',
+    [
+        (0.0, 0.0, 0.0, 0.0),
+        (0.0, 0.0, 1e-300, 1e-300),
+        (0.0, 0.0, math.nan, 1.0),
+        (0.0, 0.0, math.inf, 1.0),
+    ],
+)
+def test_odometry_with_a_zero_or_non_finite_quaternion_is_rejected(quaternion):
+    with pytest.raises(ValueError, match='no orientation'):
+        conversions.pose_from_odometry(odometry_with(*quaternion))
+
+
+def test_odometry_with_a_slightly_non_unit_quaternion_is_normalised():
+    for scale in (0.95, 1.05, 1.0 + 1e-7):
+        q = (0.0, 0.0, scale * math.sin(0.4), scale * math.cos(0.4))
+        assert conversions.pose_from_odometry(odometry_with(*q))[2] == pytest.approx(0.8)
+
+
+@pytest.mark.parametrize(
+    'quaternion', [(0.0, 0.0, 1.0, 1.0), (0.0, 0.0, 0.0, 5.0), (0.0, 0.0, 0.0, 0.8)]
+)
+def test_odometry_with_a_quaternion_far_from_unit_is_rejected(quaternion):
+    with pytest.raises(ValueError, match=r'not within 0\.1 of 1'):
+        conversions.pose_from_odometry(odometry_with(*quaternion))
+
+
+def test_odometry_yaw_of_unit_quaternions_keeps_the_unit_formulas_bits():
+    for yaw in np.linspace(-math.pi, math.pi, 2001):
+        q = yaw_to_quaternion(float(yaw))
+        assert conversions.pose_from_odometry(odometry_with(*q))[2] == yaw_from_unit_quaternion(*q)
 
 
 def test_robot_ids_come_from_names_and_bad_names_are_rejected():

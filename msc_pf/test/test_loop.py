@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 import pytest
-from msc_pf.loop import ControlStatus, RobotLoop, Steering
+from msc_pf.loop import MAX_RSSI_STAMP_LEAD_S, ControlStatus, RobotLoop, Steering
 from msc_pf.robot import RobotController
 from msc_pf.settings import MscPfConfig
 
@@ -49,6 +49,19 @@ def test_out_of_order_rssi_and_non_finite_poses_are_refused():
     assert not loop.receive_rssi(4.0, {1: -80.0})
     assert not loop.receive_pose((math.nan, 0.0, 0.0), 1.0)
     assert loop.pose is None
+
+
+def test_rssi_stamped_far_ahead_of_the_clock_is_refused_and_does_not_block_later_batches():
+    loop = make_loop()
+    assert loop.receive_rssi(5.0, {1: -90.0}, now_s=5.1)
+    assert not loop.receive_rssi(2.0**31 - 1.0, {1: -50.0}, now_s=5.2)
+    assert 'ahead of the clock' in loop.last_rssi_refusal
+    assert loop.last_rssi_stamp_s == 5.0
+    assert loop.receive_rssi(5.3, {1: -80.0}, now_s=5.3)
+    assert loop.receive_rssi(5.4 + MAX_RSSI_STAMP_LEAD_S, {1: -80.0}, now_s=5.4)
+    assert not loop.receive_rssi(math.nan, {1: -80.0}, now_s=5.5)
+    assert not loop.receive_rssi(5.0, {1: -80.0}, now_s=5.5)
+    assert 'arrived after' in loop.last_rssi_refusal
 
 
 def test_a_stale_pose_skips_the_step_and_stops_the_robot():

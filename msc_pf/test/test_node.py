@@ -10,8 +10,10 @@ from __future__ import annotations
 import math
 
 import pytest
+from msc_pf.conversions import stamp_to_ros
 from msc_pf.errors import ConfigError
 from msc_pf.node import MscPfNode
+from msc_pf.peers import Phase, Role
 from swarm_runtime.ros import Parameter, message_module, qos_profile_sensor_data
 from swarm_runtime.testing import NodeTestBed
 
@@ -135,6 +137,60 @@ def test_rssi_stamped_before_the_last_accepted_message_is_ignored(make_harness):
     assert h.spin_until(reported)
     h.spin_for(1.05)
     assert reported() == {(1,)}, 'the older message never counted'
+
+
+def test_rssi_stamped_far_in_the_future_does_not_block_later_messages(make_harness):
+    h = make_harness(scheme='msc_pf', target_ids=[5, 6])
+    future = swarm.RssiArray(readings=[swarm.EmitterRssi(emitter_id=5, rssi_dbm=-80.0)])
+    future.header.stamp = builtin.Time(sec=2**31 - 1, nanosec=0)
+    h.rssi.publish(future)
+    h.spin_for(0.5)
+    assert h.node.loop.last_rssi_stamp_s == -math.inf
+    good = swarm.RssiArray(readings=[swarm.EmitterRssi(emitter_id=6, rssi_dbm=-80.0)])
+    good.header.stamp = builtin.Time(sec=1, nanosec=0)
+    h.rssi.play(good)
+    assert h.spin_until(lambda: h.peers and list(h.peers[-1].reading_ids) == [6])
+    assert h.node.controller.filters.tracked_ids == (6,)
+
+
+def test_peer_readings_of_targets_outside_target_ids_are_ignored(make_harness):
+    h = make_harness(scheme='msc_pf', target_ids=[5, 6])
+    player = h.bed.probe.player('/r2/peers/in', swarm.MscPeer, 10)
+    h.bed.wait_for_graph()
+    n = 200
+    peer = swarm.MscPeer(
+        robot='r3',
+        robot_id=3,
+        position_x=1001.0,
+        position_y=1000.0,
+        role=int(Role.LEADER),
+        leader_id=3,
+        members=[3],
+        phase=int(Phase.SEARCH),
+        target_id=-1,
+        target_rssi_dbm=-100.0,
+        visited_cell=-1,
+        reading_ids=[6, *range(1000, 1000 + n)],
+        reading_rssi_dbm=[-75.0] + [-70.0] * n,
+    )
+    peer.header.stamp = stamp_to_ros(h.bed.probe.sim_time_s(), builtin)
+    player.publish(peer)
+    assert h.spin_until(lambda: h.node.controller.filters.tracked_ids)
+    h.spin_for(1.05)
+    assert h.node.controller.filters.tracked_ids == (6,)
+
+
+def test_odometry_with_a_zero_quaternion_is_dropped_and_the_robot_stops(make_harness):
+    h = make_harness(scheme='msc')
+    h.spin_for(7.0)
+    assert any(c.linear.x > 0.0 or c.angular.z != 0.0 for c in h.commands[-10:])
+    broken = odom_at(1000.0, 1000.0)
+    broken.pose.pose.orientation.w = 0.0
+    h.odom.play(broken)
+    timeout_s = h.node.get_parameter('odom_timeout_s').value
+    h.spin_for(timeout_s + 1.0)
+    last = h.commands[-1]
+    assert (last.linear.x, last.angular.z) == (0.0, 0.0)
 
 
 def test_invalid_parameters_stop_the_node_at_start(make_harness):
