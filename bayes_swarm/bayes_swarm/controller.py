@@ -154,14 +154,17 @@ class RobotController:
         if not math.isfinite(value) or self._pose is None:
             self.rejected_samples += 1
             return 'no pose yet' if self._pose is None else 'not finite'
-        self._last_signal = value
         if self._planner is not None:
             point = np.array([[self._pose[0], self._pose[1]]])
-            self._planner.add_observations(point, np.array([value]))
+            if not self._planner.add_observations(point, np.array([value])):
+                self.rejected_samples += 1
+                return 'implausible magnitude'
+        self._last_signal = value
         return ''
 
     def on_peer(self, update: PeerUpdate) -> bool:
-        """A peer's Bayes-Swarm broadcast; False if ignored (own, stale, not Bayes-Swarm)."""
+        """A peer's Bayes-Swarm broadcast; False if ignored (own, stale, malformed, not
+        Bayes-Swarm; see :meth:`~bayes_swarm.planner.BayesSwarmPlanner.receive`)."""
         if self._planner is None:
             return False
         return self._planner.receive(update)

@@ -10,7 +10,9 @@ Topics (relative to the robot's namespace, e.g. /r3):
 A control timer ticks the robot's loop (:class:`bayes_swarm.controller.RobotController`,
 shared with the batch runner): the waypoint follower, and on arrival the algorithm's next
 decision and its broadcast. Each signal sample is paired with the latest odometry pose. When
-odometry is older than ``odom_timeout_s`` the node commands zero velocity.
+odometry is older than ``odom_timeout_s`` the node commands zero velocity. Malformed input
+(odometry without an orientation, a peer message with absurd contents) is dropped, counted and
+logged (throttled); the rules are the conversions' and the controller's/planner's.
 
 Run: ``ros2 run bayes_swarm bayes_swarm_node --ros-args -r __ns:=/r0 -p robot_index:=0
 --params-file config/case1.yaml``. Without a relay, remap both peer topics to one shared topic.
@@ -57,6 +59,8 @@ class BayesSwarmNode(Node):
         namespace = self.get_namespace().strip('/')
         self.robot_name = namespace.split('/')[-1] if namespace else f'r{s.planner.robot_index}'
         self.controller = RobotController(s, self.robot_name)
+        self.rejected_odometry = 0
+        self.rejected_peer_messages = 0
         peers = self.controller.uses_peers
         peer_type = {'bayes': _swarm.BayesSwarmPeer, 'glowworm': _swarm.GlowwormPeer}.get(
             peers or ''
@@ -103,7 +107,18 @@ class BayesSwarmNode(Node):
         return self.get_clock().now().nanoseconds * 1e-9
 
     def _on_odom(self, msg: Any) -> None:
-        self.controller.on_pose(conversions.odometry_to_pose(msg), self._now_s())
+        try:
+            reason = ''
+            if self.controller.on_pose(conversions.odometry_to_pose(msg), self._now_s()):
+                return
+        except BayesSwarmError as err:
+            reason = str(err)
+        self.rejected_odometry += 1
+        self.get_logger().warning(
+            f'dropped odometry ({reason or "position or yaw not finite"}; '
+            f'{self.rejected_odometry} dropped so far)',
+            throttle_duration_sec=5.0,
+        )
 
     def _on_signal(self, msg: Any) -> None:
         value = float(msg.value)
@@ -120,9 +135,19 @@ class BayesSwarmNode(Node):
             try:
                 update = conversions.peer_update_from_ros(msg)
             except BayesSwarmError as err:
-                self.get_logger().warning(f'ignored peer message: {err}')
-                return
-            self.controller.on_peer(update)
+                reason = str(err)
+            else:
+                planner = self.controller.planner
+                if self.controller.on_peer(update) or planner is None:
+                    return
+                reason = planner.peer_update_defect(update)
+                if not reason:
+                    return  # own, stale or duplicated: ignored silently
+            self.rejected_peer_messages += 1
+            self.get_logger().warning(
+                f'ignored peer message: {reason} ({self.rejected_peer_messages} so far)',
+                throttle_duration_sec=5.0,
+            )
         else:
             self.controller.on_glowworm_peer(*conversions.glowworm_peer_from_ros(msg))
 

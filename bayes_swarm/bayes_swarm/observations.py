@@ -9,15 +9,25 @@ from bayes_swarm.errors import ObservationError
 __all__ = ['ObservationStore', 'finite_samples']
 
 
-def finite_samples(points_m: np.ndarray, values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Check shapes and drop rows with a non-finite coordinate or value.
+def finite_samples(
+    points_m: np.ndarray,
+    values: np.ndarray,
+    *,
+    max_abs_value: float = np.inf,
+    lower_m: np.ndarray | None = None,
+    upper_m: np.ndarray | None = None,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Check shapes and drop rows with a non-finite coordinate or value, or an implausible one.
 
     Args:
         points_m: (k, 2) sample locations [m].
         values: (k,) signal values.
+        max_abs_value: rows whose value exceeds it in magnitude are dropped too.
+        lower_m: (2,) lower-left corner [m]; rows with a location below it are dropped.
+        upper_m: (2,) upper-right corner [m]; rows with a location above it are dropped.
 
     Returns:
-        The finite rows as float arrays ((j, 2), (j,)).
+        The kept rows as float arrays ((j, 2), (j,)).
 
     Raises:
         ObservationError: if the shapes do not match.
@@ -30,6 +40,12 @@ def finite_samples(points_m: np.ndarray, values: np.ndarray) -> tuple[np.ndarray
         msg = f'{pts.shape[0]} sample locations but {vals.shape[0]} values'
         raise ObservationError(msg)
     keep = np.isfinite(vals) & np.all(np.isfinite(pts), axis=1)
+    if max_abs_value < np.inf:
+        keep &= np.abs(vals) <= max_abs_value
+    if lower_m is not None:
+        keep &= np.all(pts >= lower_m, axis=1)
+    if upper_m is not None:
+        keep &= np.all(pts <= upper_m, axis=1)
     return pts[keep], vals[keep]
 
 

@@ -42,7 +42,37 @@ from bayes_swarm.penalty import local_penalty, log_local_penalty
 from bayes_swarm.settings import Arena, BayesSwarmConfig
 from bayes_swarm.trust_region import projected_newton_step
 
-__all__ = ['BayesSwarmPlanner', 'ascend_mean', 'first_heading_rad', 'first_waypoint']
+__all__ = [
+    'MAX_SCALED_SIGNAL',
+    'PEER_ARENA_MARGIN_FRACTION',
+    'PEER_INDEX_REORDER_WINDOW',
+    'BayesSwarmPlanner',
+    'ascend_mean',
+    'first_heading_rad',
+    'first_waypoint',
+]
+
+# Largest plausible |signal sample| in units of ``signal_scale`` (own and peers' samples).
+# The belief is set up for values of a few scales: M and L are in these units (M = 1.2) and
+# the GP's signal-variance bound (1e5 by default) allows amplitudes of ~316 scales. 1e6
+# scales is far beyond any field the configuration describes, so no legitimate sample is
+# dropped, while squares of kept values (1e12 scales^2) stay finite and far from overflow.
+# A larger value is a corrupt reading or message (a -1e300 sample turned every later
+# decision into a random jump). Merely surprising values below the bound are kept: judging
+# them is the model's job, not the input check's.
+MAX_SCALED_SIGNAL = 1e6
+# A peer's position, waypoint, sample locations and weaker sources must lie in the arena
+# grown on every side by this fraction of its diagonal (a robot drifts or is pushed slightly
+# outside; waypoints are clipped into the arena). Points further away are a corrupt message:
+# a waypoint or position at 1e300 m made every later decision fail (Maximum allowed size
+# exceeded) because the planner samples paths between such points.
+PEER_ARENA_MARGIN_FRACTION = 0.5
+# A peer message whose decision index is not newer than the last one accepted from the same
+# sender, but at most this many decisions behind it, is a stale or duplicated delivery and is
+# ignored. One further behind means the sender restarted its count (or the last index was
+# corrupt, e.g. 2**32 - 1): it is accepted and the sender's sequence restarts from it, so a
+# far-ahead index cannot silence a sender forever.
+PEER_INDEX_REORDER_WINDOW = 16
 
 _MEAN_GRID_SIZE = 16
 # Added to the raw acquisition before its log (``penalty_log_space``): it is 0 only on a
@@ -115,6 +145,7 @@ class BayesSwarmPlanner:
         self._own_unsent_values: list[np.ndarray] = []
         self._peer_plans: dict[str, tuple[np.ndarray, np.ndarray]] = {}
         self._peer_last_index: dict[str, int] = {}
+        self.rejected_peer_updates = 0
         self._weaker: list[np.ndarray] = []
         self._k = 0
         self._last_decision: Decision | None = None
@@ -167,36 +198,83 @@ class BayesSwarmPlanner:
     def add_observations(self, points_m: np.ndarray, values: np.ndarray) -> int:
         """Add the robot's own samples: (k, 2) locations [m] and (k,) values.
 
-        Non-finite rows are dropped. Returns the number of rows kept.
+        Non-finite rows and values above :data:`MAX_SCALED_SIGNAL` in magnitude are dropped.
+        Returns the number of rows kept.
         """
-        pts, vals = finite_samples(points_m, values)
+        pts, vals = finite_samples(points_m, values, max_abs_value=self._max_abs_signal)
         self._data.extend(pts, vals)
         if vals.shape[0]:
             self._own_unsent_points.append(pts)
             self._own_unsent_values.append(vals)
         return int(vals.shape[0])
 
+    @property
+    def _max_abs_signal(self) -> float:
+        return MAX_SCALED_SIGNAL * self._cfg.signal_scale
+
+    def _peer_region(self) -> tuple[np.ndarray, np.ndarray]:
+        """(lower, upper) corners [m] of the arena grown by the peer margin."""
+        arena = self._cfg.arena
+        margin = PEER_ARENA_MARGIN_FRACTION * arena.diagonal_m
+        return arena.lower - margin, arena.upper + margin
+
+    def peer_update_defect(self, update: PeerUpdate) -> str:
+        """Why ``update`` is malformed and would be dropped as a whole, or '' if it is not.
+
+        Its position and waypoint must be finite and within the arena grown by
+        :data:`PEER_ARENA_MARGIN_FRACTION` of its diagonal; the sample arrays must match.
+        (Single implausible samples and weaker sources are dropped by :meth:`receive`.)
+        """
+        try:
+            position = np.asarray(update.position_m, dtype=float).reshape(2)
+            waypoint = np.asarray(update.waypoint_m, dtype=float).reshape(2)
+            finite_samples(update.sample_points_m, update.sample_values)
+        except (ValueError, TypeError) as err:
+            return f'malformed arrays ({err})'
+        if not (np.all(np.isfinite(position)) and np.all(np.isfinite(waypoint))):
+            return 'position or waypoint not finite'
+        lower, upper = self._peer_region()
+        for name, point in (('position', position), ('waypoint', waypoint)):
+            if np.any(point < lower) or np.any(point > upper):
+                return f'{name} {point.tolist()} m far outside the arena'
+        return ''
+
     def receive(self, update: PeerUpdate) -> bool:
         """RECEIVEINFORMATION: merge a peer's broadcast; False if it was ignored.
 
         The robot's own broadcasts and messages not newer than the last accepted one from the
-        same sender (stale or duplicated deliveries) are ignored.
+        same sender, but at most :data:`PEER_INDEX_REORDER_WINDOW` decisions behind it (stale
+        or duplicated deliveries), are ignored; an index further behind restarts the sender's
+        sequence. A malformed update (:meth:`peer_update_defect`) is dropped as a whole and
+        counted in ``rejected_peer_updates``; of an accepted one, samples with a non-finite or
+        implausible value (above :data:`MAX_SCALED_SIGNAL` signal scales in magnitude) or a
+        location far outside the arena are dropped, and so are such weaker sources.
         """
         if update.sender == self._name:
             return False
+        index = int(update.decision_index)
         last = self._peer_last_index.get(update.sender)
-        if last is not None and update.decision_index <= last:
+        if last is not None and last - PEER_INDEX_REORDER_WINDOW <= index <= last:
+            return False
+        if self.peer_update_defect(update):
+            self.rejected_peer_updates += 1
             return False
         position = np.asarray(update.position_m, dtype=float).reshape(2)
         waypoint = np.asarray(update.waypoint_m, dtype=float).reshape(2)
-        if not (np.all(np.isfinite(position)) and np.all(np.isfinite(waypoint))):
-            return False
-        pts, vals = finite_samples(update.sample_points_m, update.sample_values)
-        self._peer_last_index[update.sender] = update.decision_index
+        lower, upper = self._peer_region()
+        pts, vals = finite_samples(
+            update.sample_points_m,
+            update.sample_values,
+            max_abs_value=self._max_abs_signal,
+            lower_m=lower,
+            upper_m=upper,
+        )
+        self._peer_last_index[update.sender] = index
         self._data.extend(pts, vals)
         self._peer_plans[update.sender] = (position, waypoint)
         for weak in np.asarray(update.weaker_sources_m, dtype=float).reshape(-1, 2):
-            self._add_weaker(weak)
+            if np.all(weak >= lower) and np.all(weak <= upper):
+                self._add_weaker(weak)
         return True
 
     def _add_weaker(self, point: np.ndarray) -> None:

@@ -19,6 +19,7 @@ from bayes_swarm.errors import ConfigError, ObservationError
 from bayes_swarm.follower import FollowerConfig, WaypointFollower
 from bayes_swarm.messages import Decision, DecisionKind, PeerUpdate
 from bayes_swarm.node_settings import settings_from_values
+from swarm_common.angles import yaw_from_unit_quaternion
 from swarm_runtime.ros import message_module
 from swarm_runtime.testing import cdr_roundtrip
 
@@ -136,3 +137,27 @@ def test_parameter_defaults_give_the_papers_case_1_settings():
 def test_invalid_parameters_are_rejected_at_start(values, match):
     with pytest.raises(ConfigError, match=match):
         settings_from_values(values)
+
+
+@pytest.mark.parametrize(
+    'quaternion',
+    [(0, 0, 0, 0), (0, 0, 1e-300, 1e-300), (math.nan, 0, 0, 1), (0, 0, math.inf, 1)],
+)
+def test_odometry_without_an_orientation_is_rejected(quaternion):
+    msg = message_module('nav_msgs').Odometry()
+    o = msg.pose.pose.orientation
+    o.x, o.y, o.z, o.w = (float(v) for v in quaternion)
+    with pytest.raises(ObservationError):
+        odometry_to_pose(msg)
+
+
+def test_a_non_unit_odometry_quaternion_is_read_as_if_normalised_and_a_unit_one_as_before():
+    msg = message_module('nav_msgs').Odometry()
+    o = msg.pose.pose.orientation
+    o.z, o.w = 1.0, 1.0
+    assert odometry_to_pose(msg)[2] == pytest.approx(math.pi / 2)
+    o.z, o.w = 0.0, 5.0
+    assert odometry_to_pose(msg)[2] == 0.0
+    for yaw in np.linspace(-3.1, 3.1, 41):
+        o.z, o.w = math.sin(yaw / 2), math.cos(yaw / 2)
+        assert odometry_to_pose(msg)[2] == yaw_from_unit_quaternion(0.0, 0.0, o.z, o.w)

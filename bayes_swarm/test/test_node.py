@@ -82,3 +82,36 @@ def test_duplicated_and_stale_peer_messages_are_ignored(graph):
     bed.spin_for(0.2)
     assert node.planner.n_observations == 1
     assert node.planner.peer_waypoints['r1'] == pytest.approx([1.0, 1.0])
+
+
+def test_odometry_with_a_zero_quaternion_is_dropped_so_the_robot_stops(graph):
+    node, pubs, commands, bed = graph
+    pubs['odom'].publish(odom())
+    assert bed.spin_until(lambda: node.decisions)
+    assert bed.spin_until(lambda: any(c.linear.x > 0.0 or c.angular.z != 0.0 for c in commands))
+    bad = odom()
+    bad.pose.pose.orientation.w = 0.0
+    deadline_s = node.settings.odom_timeout_s + 2.0
+    stopped = False
+    while not stopped and deadline_s > 0.0:
+        pubs['odom'].publish(bad)
+        bed.spin_for(0.1)
+        deadline_s -= 0.1
+        stopped = commands[-1].linear.x == 0.0 and commands[-1].angular.z == 0.0
+    assert stopped, 'only orientation-less odometry arrives: it goes stale and the robot stops'
+    assert node.rejected_odometry >= 1
+
+
+def test_peer_messages_with_absurd_contents_are_dropped_and_counted(graph):
+    node, pubs, _, bed = graph
+    update = PeerUpdate('r1', 2, np.zeros(2), np.ones(2), np.array([[0.1, 0.1]]), np.array([0.3]))
+    far = peer_update_to_ros(update, 1.0)
+    far.waypoint_x = far.waypoint_y = 1e300
+    pubs['peers'].publish(far)
+    assert bed.spin_until(lambda: node.rejected_peer_messages == 1)
+    absurd = peer_update_to_ros(update, 1.0)
+    absurd.sample_value = [-1e300]
+    pubs['peers'].publish(absurd)
+    assert bed.spin_until(lambda: 'r1' in node.planner.peer_waypoints)
+    assert node.planner.n_observations == 0
+    assert node.planner.peer_waypoints['r1'] == pytest.approx([1.0, 1.0])

@@ -8,7 +8,13 @@ import pytest
 from bayes_swarm.acquisition import planned_path_points
 from bayes_swarm.errors import ConfigError, GpFitError
 from bayes_swarm.messages import DecisionKind, PeerUpdate
-from bayes_swarm.planner import BayesSwarmPlanner, _OuterProblem, first_waypoint
+from bayes_swarm.planner import (
+    MAX_SCALED_SIGNAL,
+    PEER_INDEX_REORDER_WINDOW,
+    BayesSwarmPlanner,
+    _OuterProblem,
+    first_waypoint,
+)
 from bayes_swarm.settings import Arena, BayesSwarmConfig, GlowwormConfig, GpConfig, LevyConfig
 
 
@@ -354,3 +360,73 @@ def test_the_single_point_acquisition_equals_the_batch_one(options):
     single = np.array([problem.value(p) for p in points])
     np.testing.assert_allclose(single, batch, rtol=1e-12, atol=1e-15)
     assert np.ptp(batch) > 0.01  # the points see different values
+
+
+def test_peer_updates_with_a_position_or_waypoint_far_outside_the_arena_are_dropped():
+    planner = BayesSwarmPlanner(BayesSwarmConfig(), 'r0')
+    pts, vals = np.array([[0.1, 0.1]]), np.array([0.3])
+    good = PeerUpdate('r1', 1, np.array([0.5, 0.5]), np.array([1.0, 1.0]), pts, vals)
+    far = 3.0 * planner.config.arena.diagonal_m
+    for bad in (
+        replace(good, waypoint_m=np.array([1e300, 1e300])),
+        replace(good, position_m=np.array([1e300, -1e300])),
+        replace(good, position_m=np.array([-far, 0.5])),
+    ):
+        assert planner.peer_update_defect(bad)
+        assert not planner.receive(bad)
+    assert planner.rejected_peer_updates == 3
+    assert planner.n_observations == 0
+    assert planner.peer_waypoints == {}
+    assert planner.peer_update_defect(good) == ''
+    assert planner.receive(good), 'the rejections did not latch the sender index'
+    # A robot slightly outside the arena (within the margin) is still heard.
+    assert planner.receive(replace(good, decision_index=2, position_m=np.array([-0.2, 2.5])))
+
+
+def test_peer_samples_with_absurd_values_or_locations_are_dropped_and_the_rest_kept():
+    planner = BayesSwarmPlanner(BayesSwarmConfig(), 'r0')
+    pts = np.array([[0.1, 0.1], [0.2, 0.2], [1e300, 1e300], [0.4, 0.4], [0.5, 0.5]])
+    vals = np.array([0.3, -1e300, 0.3, 1e7, -2.5])
+    weaker = np.array([[1e300, 1e300], [1.0, 1.0]])
+    assert planner.receive(PeerUpdate('r1', 1, np.zeros(2), np.ones(2), pts, vals, weaker))
+    assert planner.n_observations == 2
+    kept_pts, kept_vals = planner._data.arrays()
+    assert kept_vals.tolist() == [0.3, -2.5]
+    assert kept_pts.tolist() == [[0.1, 0.1], [0.5, 0.5]]
+    assert planner.weaker_sources.tolist() == [[1.0, 1.0]]
+
+
+def test_own_samples_beyond_the_plausible_magnitude_are_dropped_and_legitimate_ones_kept():
+    planner = BayesSwarmPlanner(BayesSwarmConfig(signal_scale=47.0), 'r0')
+    bound = MAX_SCALED_SIGNAL * 47.0
+    values = np.array([-bound, bound, 1.01 * bound, -1e300, 47.0])
+    assert planner.add_observations(np.zeros((5, 2)), values) == 3
+    assert planner._data.arrays()[1].tolist() == [-bound, bound, 47.0]
+
+
+def test_a_peer_update_with_an_absurd_sample_value_leaves_later_decisions_unchanged():
+    clean = planner_with_data()
+    poisoned = planner_with_data()
+    update = PeerUpdate('r1', 1, np.array([0.5, 0.87]), np.array([1.0, 1.0]))
+    clean.receive(update)
+    poisoned.receive(replace(update, sample_points_m=[[1.0, 1.0]], sample_values=[-1e300]))
+    for t in (50.0, 60.0):
+        expected = clean.decide([0.71, 0.71], t)
+        got = poisoned.decide([0.71, 0.71], t)
+        assert got.kind is expected.kind is DecisionKind.ACQUISITION
+        assert got.waypoint_m.tolist() == expected.waypoint_m.tolist()
+
+
+def test_a_far_ahead_decision_index_does_not_silence_its_sender():
+    planner = BayesSwarmPlanner(BayesSwarmConfig(), 'r0')
+    update = PeerUpdate('r1', 2**32 - 1, np.zeros(2), np.ones(2))
+    assert planner.receive(update)
+    # The sender's real count (or a restart) is far behind: accepted, and counted from there.
+    assert planner.receive(replace(update, decision_index=5, waypoint_m=np.array([2.0, 2.0])))
+    assert planner.peer_waypoints['r1'].tolist() == [2.0, 2.0]
+    assert planner.receive(replace(update, decision_index=6))
+    # Deliveries up to PEER_INDEX_REORDER_WINDOW behind the last accepted are still stale.
+    assert not planner.receive(replace(update, decision_index=6))
+    late = replace(update, decision_index=20 + PEER_INDEX_REORDER_WINDOW)
+    assert planner.receive(late)
+    assert not planner.receive(replace(late, decision_index=20))
