@@ -171,11 +171,18 @@ class RobotController:
 
     def on_glowworm_peer(
         self, sender: str, index: int, position_m: np.ndarray, luciferin: float
-    ) -> None:
-        """A peer's Glowworm broadcast (kept if newer than the last one from ``sender``)."""
+    ) -> bool:
+        """A peer's Glowworm broadcast, kept if newer than the last one from ``sender``;
+        False if ignored (own, older, or a position or luciferin that is not finite: an
+        infinite luciferin would make the leader draw's probabilities NaN)."""
+        position = np.asarray(position_m, dtype=float)
+        if not (np.all(np.isfinite(position)) and math.isfinite(luciferin)):
+            return False
         known = self._glow_peers.get(sender)
-        if sender != self.robot_name and (known is None or index > known[0]):
-            self._glow_peers[sender] = (index, np.asarray(position_m, dtype=float), luciferin)
+        if sender == self.robot_name or (known is not None and index <= known[0]):
+            return False
+        self._glow_peers[sender] = (index, position, luciferin)
+        return True
 
     # ---------------------------------------------------------------- control
     def control(self, time_s: float) -> ControlOutput:
