@@ -9,7 +9,7 @@ import math
 from typing import Any
 
 import numpy as np
-from swarm_common.angles import yaw_from_quaternion, yaw_from_unit_quaternion
+from swarm_common.angles import UNIT_QUATERNION_NORM_SQ_TOLERANCE, yaw_from_odometry_quaternion
 from swarm_common.stamps import stamp_from_seconds, stamp_to_seconds
 from swarm_runtime.ros import message_module
 
@@ -32,11 +32,6 @@ __all__ = [
 _builtin = message_module('builtin_interfaces')
 _geometry = message_module('geometry_msgs')
 _swarm = message_module('swarm_interfaces')
-
-# Within this distance of 1 the squared norm of an odometry quaternion counts as unit and the
-# unit-quaternion yaw formula is used (its yaw error is below ~1e-6 rad there); a quaternion
-# further from unit is read with the scale-invariant formula (as if normalised).
-UNIT_QUATERNION_NORM_SQ_TOLERANCE = 1e-6
 
 
 def seconds_to_stamp(time_s: float) -> Any:
@@ -157,13 +152,10 @@ def odometry_to_pose(msg: Any) -> tuple[float, float, float]:
     """
     p = msg.pose.pose.position
     q = msg.pose.pose.orientation
-    x, y, z, w = float(q.x), float(q.y), float(q.z), float(q.w)
     try:
-        yaw = yaw_from_quaternion(x, y, z, w)
+        yaw = yaw_from_odometry_quaternion(q.x, q.y, q.z, q.w)
     except ValueError as err:
         raise ObservationError(f'odometry {err}') from err
-    if abs(x * x + y * y + z * z + w * w - 1.0) <= UNIT_QUATERNION_NORM_SQ_TOLERANCE:
-        yaw = yaw_from_unit_quaternion(q.x, q.y, q.z, q.w)
     return float(p.x), float(p.y), yaw
 
 

@@ -12,7 +12,7 @@ from collections.abc import Collection
 from typing import Any
 
 import numpy as np
-from swarm_common.angles import yaw_from_quaternion, yaw_from_unit_quaternion
+from swarm_common.angles import yaw_from_odometry_quaternion as odometry_yaw
 from swarm_common.stamps import stamp_from_seconds, stamp_to_seconds
 
 from msc_pf.peers import PeerInfo, Phase, Role
@@ -45,9 +45,6 @@ MAX_PEER_ARRAY_LENGTH = 256
 #: publisher) the odometry message is dropped, so the pose goes stale and the robot stops.
 ODOM_QUATERNION_NORM_TOLERANCE = 0.1
 
-# Squared norms this close to 1 count as unit: their yaw keeps the unit formula's bits.
-_UNIT_NORM_SQ_TOLERANCE = 1e-9
-
 
 def robot_id_from_name(name: str) -> int:
     """Numeric ID of a robot name such as 'r3' (or '/r3'); raises ValueError otherwise."""
@@ -68,29 +65,14 @@ def stamp_to_ros(time_s: float, builtin_interfaces: Any) -> Any:
 
 
 def yaw_from_odometry_quaternion(x: float, y: float, z: float, w: float) -> float:
-    """Yaw [rad] of an odometry orientation (x, y, z, w), normalised when it is not unit.
-
-    A unit quaternion (squared norm within 1e-9 of 1) takes
-    :func:`swarm_common.angles.yaw_from_unit_quaternion`; one whose norm is within
-    :data:`ODOM_QUATERNION_NORM_TOLERANCE` of 1 takes the scale-free
-    :func:`swarm_common.angles.yaw_from_quaternion` (as the oabug IMU reader does).
+    """Yaw [rad] of an odometry orientation, normalised when it is not unit
+    (:func:`swarm_common.angles.yaw_from_odometry_quaternion`).
 
     Raises:
         ValueError: the quaternion is zero or not finite, or its norm is further than
             :data:`ODOM_QUATERNION_NORM_TOLERANCE` from 1.
     """
-    x, y, z, w = float(x), float(y), float(z), float(w)
-    norm_sq = x * x + y * y + z * z + w * w
-    if abs(norm_sq - 1.0) <= _UNIT_NORM_SQ_TOLERANCE:
-        return yaw_from_unit_quaternion(x, y, z, w)
-    yaw = yaw_from_quaternion(x, y, z, w)  # raises for a zero or non-finite quaternion
-    norm = math.sqrt(norm_sq)
-    if not abs(norm - 1.0) <= ODOM_QUATERNION_NORM_TOLERANCE:
-        raise ValueError(
-            f'quaternion ({x}, {y}, {z}, {w}) has norm {norm:.6g}, '
-            f'not within {ODOM_QUATERNION_NORM_TOLERANCE:g} of 1'
-        )
-    return yaw
+    return odometry_yaw(x, y, z, w, max_norm_error=ODOM_QUATERNION_NORM_TOLERANCE)
 
 
 def pose_from_odometry(msg: Any) -> tuple[float, float, float]:

@@ -9,13 +9,18 @@ import numpy as np
 
 __all__ = [
     'TWO_PI',
+    'UNIT_QUATERNION_NORM_SQ_TOLERANCE',
     'wrap_angle',
+    'yaw_from_odometry_quaternion',
     'yaw_from_quaternion',
     'yaw_from_unit_quaternion',
     'yaw_to_quaternion',
 ]
 
 TWO_PI = 2.0 * math.pi
+#: A quaternion whose squared norm is within this of 1 counts as unit (float32 fields hold
+#: about seven digits).
+UNIT_QUATERNION_NORM_SQ_TOLERANCE = 1e-6
 
 
 @overload
@@ -57,6 +62,32 @@ def yaw_from_quaternion(x: float, y: float, z: float, w: float) -> float:
         msg = f'quaternion ({x}, {y}, {z}, {w}) has no orientation'
         raise ValueError(msg)
     return math.atan2(2.0 * (w * z + x * y), w * w + x * x - y * y - z * z)
+
+
+def yaw_from_odometry_quaternion(
+    x: float, y: float, z: float, w: float, *, max_norm_error: float | None = None
+) -> float:
+    """Yaw [rad] of an odometry orientation (x, y, z, w), read as normalised if it is not unit.
+
+    A unit quaternion (:data:`UNIT_QUATERNION_NORM_SQ_TOLERANCE`) takes
+    :func:`yaw_from_unit_quaternion`, any other the scale-free :func:`yaw_from_quaternion`.
+
+    Raises:
+        ValueError: a zero or non-finite quaternion (no orientation), or, with
+            ``max_norm_error``, one whose norm is further than that from 1.
+    """
+    x, y, z, w = float(x), float(y), float(z), float(w)
+    norm_sq = x * x + y * y + z * z + w * w
+    if abs(norm_sq - 1.0) <= UNIT_QUATERNION_NORM_SQ_TOLERANCE:
+        return yaw_from_unit_quaternion(x, y, z, w)
+    yaw = yaw_from_quaternion(x, y, z, w)
+    if max_norm_error is not None and not abs(math.sqrt(norm_sq) - 1.0) <= max_norm_error:
+        msg = (
+            f'quaternion ({x}, {y}, {z}, {w}) has norm {math.sqrt(norm_sq):.6g}, '
+            f'not within {max_norm_error:g} of 1'
+        )
+        raise ValueError(msg)
+    return yaw
 
 
 def yaw_from_unit_quaternion(x: float, y: float, z: float, w: float) -> float:
