@@ -91,7 +91,8 @@ class RobotController:
         self._levy: LevyWalk | None = None
         self._sweep: list[np.ndarray] = []
         self._glow: GlowwormAgent | None = None
-        self._glow_peers: dict[str, tuple[int, np.ndarray, float]] = {}
+        # Per peer: its latest Glowworm broadcast as (index, x [m], y [m], luciferin).
+        self._glow_peers: dict[str, tuple[int, float, float, float]] = {}
         s = settings
         if s.algorithm in ('bayes_swarm_p', 'bayes_swarm_o'):
             self._planner = BayesSwarmPlanner(
@@ -175,13 +176,14 @@ class RobotController:
         """A peer's Glowworm broadcast, kept if newer than the last one from ``sender``;
         False if ignored (own, older, or a position or luciferin that is not finite: an
         infinite luciferin would make the leader draw's probabilities NaN)."""
-        position = np.asarray(position_m, dtype=float)
-        if not (np.all(np.isfinite(position)) and math.isfinite(luciferin)):
+        x, y = float(position_m[0]), float(position_m[1])
+        luciferin = float(luciferin)
+        if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(luciferin)):
             return False
         known = self._glow_peers.get(sender)
         if sender == self.robot_name or (known is not None and index <= known[0]):
             return False
-        self._glow_peers[sender] = (index, position, luciferin)
+        self._glow_peers[sender] = (index, x, y, luciferin)
         return True
 
     # ---------------------------------------------------------------- control
@@ -248,27 +250,25 @@ class RobotController:
 
     def glowworm_step(self) -> GlowwormBroadcast | None:
         """One Glowworm iteration (after the dispersal leg); None when there is nothing to do."""
-        s = self.settings
         if self._glow is None or self._pose is None or self._waypoint is None:
             return None
-        position = np.array(self._pose[:2])
+        x, y = self._pose[0], self._pose[1]
         follower = self.follower_config
-        if self._n_decisions == 1 and np.hypot(*(self._waypoint - position)) > (
+        if self._n_decisions == 1 and math.hypot(self._waypoint[0] - x, self._waypoint[1] - y) > (
             follower.arrival_tolerance_m
         ):
             return None  # still on the first dispersal leg
         if self._last_signal is None:
             return None
+        position = np.array([x, y])
         luciferin = self._glow.update_luciferin(self._last_signal)
         broadcast = GlowwormBroadcast(self._n_decisions, position, luciferin)
-        peers = list(self._glow_peers.values())
-        positions = np.array([p[1] for p in peers]).reshape(-1, 2)
-        lucs = np.array([p[2] for p in peers])
-        target = self._glow.next_waypoint(position, positions, lucs)
-        step = target - position
-        length = float(np.hypot(*step))
+        peers = [peer[1:] for peer in self._glow_peers.values()]
+        target = self._glow.next_waypoint(position, peers)
+        dx, dy = float(target[0]) - x, float(target[1]) - y
+        length = math.hypot(dx, dy)
         if length <= 0.0:
-            self._waypoint = position  # no brighter neighbour: stay
+            self._waypoint = position.copy()  # no brighter neighbour: stay
         else:
             # A GSO step (mm at 100 Hz) is below the follower's arrival tolerance: steer toward
             # a point a few control periods ahead on the same heading, so the robot moves at V.
@@ -276,6 +276,13 @@ class RobotController:
                 2.0 * follower.arrival_tolerance_m,
                 2.0 * follower.speed_mps / self.settings.control_rate_hz,
             )
-            self._waypoint = s.planner.arena.clip(position + step * (lookahead / length))
+            scale = lookahead / length
+            arena = self.settings.planner.arena
+            self._waypoint = np.array(
+                [
+                    min(max(x + dx * scale, arena.x_min_m), arena.x_max_m),
+                    min(max(y + dy * scale, arena.y_min_m), arena.y_max_m),
+                ]
+            )
         self._n_decisions += 1
         return broadcast

@@ -91,6 +91,13 @@ class Arena:
         """Clip (..., 2) points into the arena."""
         return np.clip(points, self.lower, self.upper)
 
+    def contains_point(self, x_m: float, y_m: float, tolerance_m: float = 1e-9) -> bool:
+        """One point inside the arena (boundary included); :meth:`contains` for one point."""
+        return (
+            self.x_min_m - tolerance_m <= x_m <= self.x_max_m + tolerance_m
+            and self.y_min_m - tolerance_m <= y_m <= self.y_max_m + tolerance_m
+        )
+
     def contains(self, points: np.ndarray, tolerance_m: float = 1e-9) -> np.ndarray:
         """Boolean mask (...,) of points inside the arena (boundary included)."""
         pts = np.asarray(points, dtype=float)

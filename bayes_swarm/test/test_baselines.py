@@ -5,58 +5,70 @@ import math
 import numpy as np
 import pytest
 from bayes_swarm.baselines.exhaustive import partition_arena, strip_sweep, sweep_paths
-from bayes_swarm.baselines.glowworm import GlowwormState, glowworm_step, select_leaders
+from bayes_swarm.baselines.glowworm import GlowwormAgent, select_leader
 from bayes_swarm.baselines.levy import LevyWalk, pareto_step, wrapped_cauchy
 from bayes_swarm.settings import Arena, GlowwormConfig, LevyConfig
 
 ARENA = Arena(0.0, 10.0, 0.0, 10.0)
 
 
+def _agent(**options) -> GlowwormAgent:
+    return GlowwormAgent(GlowwormConfig(**options), ARENA, velocity_mps=3.0, seed=0)
+
+
 def test_luciferin_decays_and_grows_with_the_measured_signal():
-    cfg = GlowwormConfig()
-    state = GlowwormState(np.array([[1.0, 1.0], [9.0, 9.0]]), np.array([5.0, 5.0]), np.ones(2))
-    new = glowworm_step(state, np.array([1.0, 0.0]), cfg, ARENA, 0.03, np.random.default_rng(0))
-    np.testing.assert_allclose(new.luciferin, [0.6 * 5 + 0.6 * 1.0, 0.6 * 5])
+    agent = _agent()
+    assert agent.update_luciferin(1.0) == pytest.approx(0.6 * 5.0 + 0.6 * 1.0)
+    assert agent.update_luciferin(0.0) == pytest.approx(0.6 * 3.6)
 
 
-def test_only_brighter_agents_within_the_decision_range_are_neighbours():
-    positions = np.array([[0.0, 0.0], [1.0, 0.0], [5.0, 0.0], [0.5, 0.0]])
-    luciferin = np.array([1.0, 2.0, 9.0, 0.5])
-    leaders, counts = select_leaders(
-        positions, luciferin, np.full(4, 2.0), np.random.default_rng(0)
-    )
-    assert leaders[0] == 1  # agent 2 is brighter but out of range
-    assert counts.tolist() == [1, 0, 0, 2]
-    assert leaders[1] == -1  # no brighter neighbour: stays
-    assert leaders[3] in (0, 1)
+def test_only_brighter_peers_within_the_decision_range_are_neighbours():
+    # Peers as (x, y, luciferin): brighter and near, brighter but far, dimmer and near.
+    peers = [(1.0, 0.0, 2.0), (5.0, 0.0, 9.0), (0.5, 0.0, 0.5)]
+    rng = np.random.default_rng(0)
+    assert select_leader((0.0, 0.0), 1.0, 2.0, peers, rng) == (0, 1)
+    assert select_leader((0.0, 0.0), 1.0, 6.0, peers, rng)[1] == 2
+    assert select_leader((0.0, 0.0), 10.0, 6.0, peers, rng) == (-1, 0)  # none brighter: stay
+    assert select_leader((0.0, 0.0), 1.0, 2.0, [], rng) == (-1, 0)
 
 
 def test_leader_is_drawn_in_proportion_to_the_luciferin_difference():
-    positions = np.zeros((3, 2))
-    positions[1:, 0] = [1.0, -1.0]
-    luciferin = np.array([1.0, 2.0, 4.0])  # gains 1 and 3 -> p = 0.25, 0.75
+    peers = [(1.0, 0.0, 2.0), (-1.0, 0.0, 4.0)]  # gains 1 and 3 -> p = 0.25, 0.75
     rng = np.random.default_rng(5)
-    picks = [select_leaders(positions, luciferin, np.full(3, 5.0), rng)[0][0] for _ in range(2000)]
-    assert np.mean(np.array(picks) == 2) == pytest.approx(0.75, abs=0.03)
-    det, _ = select_leaders(positions, luciferin, np.full(3, 5.0), rng, deterministic=True)
-    assert det[0] == 2
+    picks = [select_leader((0.0, 0.0), 1.0, 5.0, peers, rng)[0] for _ in range(4000)]
+    assert np.mean(np.array(picks) == 1) == pytest.approx(0.75, abs=0.03)
+    assert select_leader((0.0, 0.0), 1.0, 5.0, peers, rng, deterministic=True) == (1, 2)
 
 
-def test_agents_step_toward_their_leader_and_update_their_decision_range():
-    cfg = GlowwormConfig()
-    state = GlowwormState(np.array([[1.0, 1.0], [2.0, 1.0]]), np.array([1.0, 5.0]), np.full(2, 3.0))
-    new = glowworm_step(state, np.zeros(2), cfg, ARENA, 0.03, np.random.default_rng(0))
-    np.testing.assert_allclose(new.positions_m, [[1.03, 1.0], [2.0, 1.0]])
-    # r_d + beta (n_t - |N|): agent 0 has one neighbour, agent 1 none; capped at r_s = 20.
-    np.testing.assert_allclose(new.decision_range_m, [3.0 + 0.08 * 4, 3.0 + 0.08 * 5])
+def test_the_agent_steps_toward_its_leader_and_updates_its_decision_range():
+    agent = _agent(sensor_range_m=3.0)  # step min(0.03, 3.0 / 100) = 0.03 m
+    agent.luciferin = 1.0
+    target = agent.next_waypoint(np.array([1.0, 1.0]), [(2.0, 1.0, 5.0)])
+    np.testing.assert_allclose(target, [1.03, 1.0])
+    # r_d + beta (n_t - |N|) with one neighbour, capped at r_s = 3.
+    assert agent.decision_range_m == pytest.approx(3.0)
+    agent.decision_range_m = 1.5
+    agent.next_waypoint(np.array([1.0, 1.0]), [(2.0, 1.0, 5.0)])
+    assert agent.decision_range_m == pytest.approx(1.5 + 0.08 * 4)
+    # No brighter neighbour: the agent stays and its range grows by beta n_t.
+    agent.luciferin = 9.0
+    np.testing.assert_array_equal(
+        agent.next_waypoint(np.array([1.0, 1.0]), [(2.0, 1.0, 5.0)]), [1.0, 1.0]
+    )
+    assert agent.decision_range_m == pytest.approx(1.82 + 0.08 * 5)
 
 
 def test_a_move_leaving_the_arena_is_rejected():
-    state = GlowwormState(
-        np.array([[0.0, 5.0], [-1.0, 5.0]]), np.array([1.0, 5.0]), np.full(2, 3.0)
-    )
-    new = glowworm_step(state, np.zeros(2), GlowwormConfig(), ARENA, 0.03, np.random.default_rng(0))
-    np.testing.assert_allclose(new.positions_m[0], [0.0, 5.0])
+    agent = _agent()
+    agent.luciferin = 1.0
+    stay = agent.next_waypoint(np.array([0.0, 5.0]), [(-1.0, 5.0, 5.0)])
+    np.testing.assert_array_equal(stay, [0.0, 5.0])
+
+
+def test_the_step_is_what_the_robot_covers_in_one_decision_at_most():
+    assert _agent().step_m == pytest.approx(0.03)
+    slow = GlowwormAgent(GlowwormConfig(), ARENA, velocity_mps=0.1, seed=0)
+    assert slow.step_m == pytest.approx(0.001)
 
 
 def test_pareto_steps_follow_the_inverse_transform():

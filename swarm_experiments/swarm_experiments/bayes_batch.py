@@ -9,8 +9,9 @@ reaches its waypoint gets a control tick, which decides (so decisions are asynch
 its :class:`~bayes_swarm.messages.PeerUpdate` is delivered at once to every robot within
 ``comm_range_m`` unless dropped with probability ``loss_probability``. Detection is
 continuous: a mission succeeds at the first instant any robot comes within eps of the source
-along its straight leg. Glowworm runs after the first dispersal leg as a synchronous
-iteration at its own decision rate.
+along its straight leg. Glowworm robots take a sample and iterate at every tick of their
+decision clock (the observation clock runs at that rate for them, as the spawner sets it),
+one robot after the other, each broadcast delivered at once: the node's Glowworm loop.
 
 Decisions take no simulated time; their wall-clock duration is recorded per robot.
 """
@@ -23,12 +24,11 @@ from dataclasses import dataclass, field, replace
 from typing import Literal, Protocol
 
 import numpy as np
-from bayes_swarm.baselines.glowworm import GlowwormSwarm
-from bayes_swarm.controller import ControlOutput, RobotController, robot_seed
+from bayes_swarm.controller import ControlOutput, GlowwormBroadcast, RobotController, robot_seed
 from bayes_swarm.errors import ConfigError
-from bayes_swarm.messages import Decision, DecisionKind, PeerUpdate
+from bayes_swarm.messages import Decision, PeerUpdate
 from bayes_swarm.node_settings import NodeSettings
-from bayes_swarm.planner import BayesSwarmPlanner, first_waypoint
+from bayes_swarm.planner import BayesSwarmPlanner
 from bayes_swarm.settings import (
     Arena,
     BayesSwarmConfig,
@@ -119,7 +119,8 @@ class MissionResult:
         finder: index of the robot that found it (-1 if none).
         tau: relative completion time, Eq. 12 (NaN if not found).
         decisions: per robot, its decisions in order.
-        trajectories: per robot, (k, 2) positions at the start, waypoints and the end [m].
+        trajectories: per robot, (k, 2) positions at the start, waypoints and the end [m]
+            (Glowworm: the start, the first waypoint, the end of the dispersal leg and the end).
         planners: the Bayes-Swarm planners (empty for baselines), for plots.
         end_time_s: simulated time when the run stopped [s].
     """
@@ -190,8 +191,8 @@ def run_mission(
 ) -> MissionResult:
     """Simulate one mission of ``n_robots`` running ``algorithm`` (one of ALGORITHMS).
 
-    Every robot except Glowworm's is a :class:`~bayes_swarm.controller.RobotController` with
-    the settings a spawned node gets (:func:`robot_settings`).
+    Every robot is a :class:`~bayes_swarm.controller.RobotController` with the settings a
+    spawned node gets (:func:`robot_settings`).
     """
     if algorithm not in ALGORITHMS:
         msg = f'unknown algorithm {algorithm!r}; choose one of {", ".join(ALGORITHMS)}'
@@ -203,18 +204,17 @@ def run_mission(
     if unsupported:
         msg = f'faults {", ".join(unsupported)} are not simulated by this runner (no such sensor)'
         raise ConfigError(msg)
-    if algorithm == 'glowworm':
-        if spec.faults.active:
-            msg = 'faults are not simulated by this runner for glowworm (a synchronous swarm)'
-            raise ConfigError(msg)
-        seeds = np.random.SeedSequence(seed).spawn(n_robots + 1)
-        world = _world(spec, n_robots, np.random.default_rng(seeds[0]))
-        return _run_glowworm(spec, world, n_robots, seeds)
+    glowworm = algorithm == 'glowworm'
+    if glowworm:
+        # The spawner's rule: Glowworm robots sample at their decision rate.
+        rate_hz = spec.glowworm.decision_rate_hz
+        spec = replace(spec, planner=replace(spec.planner, observation_rate_hz=rate_hz))
     controllers = [
         RobotController(robot_settings(spec, algorithm, n_robots, i, seed), f'r{i}')
         for i in range(n_robots)
     ]
-    result = run_events(spec, n_robots, seed, [ControllerLink(c) for c in controllers])
+    links = [ControllerLink(c) for c in controllers]
+    result = run_events(spec, n_robots, seed, links, glowworm=glowworm)
     if keep_planners:
         result.planners = [c.planner for c in controllers if c.planner is not None]
     return result
@@ -241,6 +241,13 @@ class RobotLink(Protocol):
     def control(self, time_s: float) -> ControlOutput:
         """One control tick."""
 
+    def glowworm(self, time_s: float) -> tuple[GlowwormBroadcast, np.ndarray] | None:
+        """One Glowworm iteration: its broadcast and the robot's new waypoint (2,) [m];
+        None if the robot did not iterate (still dispersing, no sample yet)."""
+
+    def glowworm_peer(self, sender: str, broadcast: GlowwormBroadcast, time_s: float) -> None:
+        """A peer's Glowworm broadcast."""
+
 
 class ControllerLink:
     """A RobotController driven directly."""
@@ -259,6 +266,18 @@ class ControllerLink:
 
     def control(self, time_s: float) -> ControlOutput:
         return self.controller.control(time_s)
+
+    def glowworm(self, time_s: float) -> tuple[GlowwormBroadcast, np.ndarray] | None:
+        broadcast = self.controller.glowworm_step()
+        waypoint = self.controller.waypoint_m
+        if broadcast is None or waypoint is None:
+            return None
+        return broadcast, waypoint
+
+    def glowworm_peer(self, sender: str, broadcast: GlowwormBroadcast, time_s: float) -> None:
+        self.controller.on_glowworm_peer(
+            sender, broadcast.index, broadcast.position_m, broadcast.luciferin
+        )
 
 
 def robot_settings(
@@ -295,13 +314,15 @@ def _deliver(
     world: PointRobotField,
     robots: Sequence[RobotLink],
     sender: int,
-    update: PeerUpdate,
+    update: PeerUpdate | GlowwormBroadcast,
     time_s: float,
     links: tuple[float | None, float, np.ndarray | None] | None = None,
 ) -> None:
     """Deliver ``sender``'s update; ``links``: range [m] (None: unlimited), loss and the
-    dropped robots that receive nothing, when faults change them."""
+    dropped robots that receive nothing, when faults change them. Robot i is named
+    ``r{i}`` (:func:`run_mission`'s names)."""
     comm_range_m, loss, dropped = links or (spec.comm_range_m, spec.loss_probability, None)
+    name = f'r{sender}'
     for j, robot in enumerate(robots):
         if j == sender or (dropped is not None and dropped[j]):
             continue
@@ -311,17 +332,27 @@ def _deliver(
                 continue
         if loss > 0.0 and world.rng.uniform() < loss:
             continue
-        robot.peer(update, time_s)
+        if isinstance(update, PeerUpdate):
+            robot.peer(update, time_s)
+        else:
+            robot.glowworm_peer(name, update, time_s)
 
 
 def run_events(
-    spec: MissionSpec, n_robots: int, seed: int, robots: Sequence[RobotLink]
+    spec: MissionSpec,
+    n_robots: int,
+    seed: int,
+    robots: Sequence[RobotLink],
+    *,
+    glowworm: bool = False,
 ) -> MissionResult:
     """World stepping of one mission with the given robots (see :func:`run_mission`).
 
     Events: the observation clock (every robot gets its pose and a sample), and arrivals
     (the arrived robot gets its pose and a control tick, which decides; its broadcast is
-    delivered at once). Times passed to the robots are rounded to nanoseconds.
+    delivered at once). With ``glowworm``, every observation tick is also a Glowworm
+    iteration of every robot, in index order after the samples, each broadcast delivered at
+    once. Times passed to the robots are rounded to nanoseconds.
     """
     seeds = np.random.SeedSequence(seed).spawn(n_robots + 1)
     world = _world(spec, n_robots, np.random.default_rng(seeds[0]))
@@ -366,6 +397,24 @@ def run_events(
         dropped = plan.dropped(t).copy()
         waypoints[dropped] = world.positions[dropped]
 
+    def iterate_glowworm() -> None:
+        stamp = ros_time_s(t)
+        for i, robot in enumerate(robots):
+            if dropped[i]:
+                continue
+            step = robot.glowworm(stamp)
+            if step is None:
+                continue
+            broadcast, waypoint = step
+            position = world.positions[i]
+            if broadcast.index == 1:  # the end of the dispersal leg
+                world.trajectories[i].append(position.copy())
+            waypoints[i] = waypoint
+            dx, dy = float(waypoint[0] - position[0]), float(waypoint[1] - position[1])
+            if dx != 0.0 or dy != 0.0:
+                yaws[i] = math.atan2(dy, dx)
+            _deliver(spec, world, robots, i, broadcast, stamp, links())
+
     def tick_robot(i: int) -> None:
         stamp = ros_time_s(t)
         robots[i].pose(world.positions[i].copy(), float(yaws[i]), stamp)
@@ -406,61 +455,13 @@ def run_events(
         if abs(t - next_tick) <= _TIME_EPS:
             tick += 1
             sample_all()
+            if glowworm:
+                iterate_glowworm()
         arrived = np.flatnonzero(np.hypot(*(waypoints - world.positions).T) <= 1e-9)
         for i in arrived:
             if not dropped[i]:
                 tick_robot(int(i))
     for i in range(n):
-        world.trajectories[i].append(world.positions[i].copy())
-    return MissionResult(
-        found=world.finder >= 0,
-        found_time_s=world.found_time_s,
-        finder=world.finder,
-        tau=_tau(spec, world),
-        decisions=decisions,
-        trajectories=[np.array(tr) for tr in world.trajectories],
-        end_time_s=t,
-    )
-
-
-def _run_glowworm(
-    spec: MissionSpec, world: PointRobotField, n_robots: int, seeds: list[np.random.SeedSequence]
-) -> MissionResult:
-    cfg = spec.planner
-    speed = cfg.velocity_mps
-    decisions: list[list[Decision]] = [[] for _ in range(n_robots)]
-    targets = np.empty((n_robots, 2))
-    for i in range(n_robots):
-        start, fan_index, fan_size, offset = robot_start_and_fan(spec, n_robots, i)
-        targets[i] = cfg.arena.clip(
-            first_waypoint(
-                start,
-                fan_index=fan_index,
-                fan_size=fan_size,
-                direction_range_deg=cfg.initial_direction_range_deg,
-                direction_offset_deg=offset,
-                leg_m=cfg.max_leg_m,
-            )
-        )
-        decisions[i].append(Decision(targets[i].copy(), 0, DecisionKind.FIRST))
-    t_disperse = float(np.max(np.hypot(*(targets - world.starts).T))) / speed
-    t = min(t_disperse, cfg.max_mission_time_s)
-    if not world.move(targets, 0.0, t, speed):
-        for i in range(n_robots):
-            world.trajectories[i].append(world.positions[i].copy())
-        swarm = GlowwormSwarm(spec.glowworm, cfg.arena, world.positions, speed, seed=seeds[1])
-        period = swarm.period_s
-        k = 0
-        while t < cfg.max_mission_time_s - _TIME_EPS:
-            new_positions = swarm.step(world.sample(world.positions))
-            k += 1
-            t_next = t_disperse + k * period
-            if world.move(new_positions.copy(), t, t_next, speed):
-                t = world.found_time_s
-                break
-            world.positions = new_positions.copy()
-            t = t_next
-    for i in range(n_robots):
         world.trajectories[i].append(world.positions[i].copy())
     return MissionResult(
         found=world.finder >= 0,

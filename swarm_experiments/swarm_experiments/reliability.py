@@ -214,8 +214,6 @@ def check_bayes_fault(config: Mapping[str, Any]) -> None:
             f'fault={config["fault"]!r}: {", ".join(unsupported)} not simulated by the batch '
             'runner (no such sensor)'
         )
-    if config['algorithm'] == 'glowworm' and faults.active:
-        raise UsageError(f'fault={config["fault"]!r}: not simulated for glowworm')
 
 
 def check_msc_fault(config: Mapping[str, Any]) -> None:

@@ -15,11 +15,17 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
-from bayes_swarm.controller import ControlOutput
-from bayes_swarm.conversions import peer_update_from_ros, peer_update_to_ros
+from bayes_swarm.controller import ControlOutput, GlowwormBroadcast, RobotController
+from bayes_swarm.conversions import (
+    glowworm_peer_from_ros,
+    glowworm_peer_to_ros,
+    peer_update_from_ros,
+    peer_update_to_ros,
+)
 from bayes_swarm.node import BayesSwarmNode
 from bayes_swarm.node_settings import BAYES_SWARM_PARAMETERS, NodeSettings
 from swarm_experiments.bayes_batch import (
+    ControllerLink,
     MissionSpec,
     robot_settings,
     run_events,
@@ -44,12 +50,14 @@ class NodeLink:
         overrides.append(Parameter('use_sim_time', value=True))
         self.node = BayesSwarmNode(namespace=f'/{name}', parameter_overrides=overrides)
         self.subs = {s.topic_name: s.callback for s in self.node.subscriptions}
-        (self.timer,) = [t for t in self.node.timers]
+        # The control timer, and the Glowworm timer for a Glowworm robot (the faster one).
+        timers = sorted(self.node.timers, key=lambda t: -t.timer_period_ns)
+        self.timer = timers[0]
+        self.glowworm_timer = timers[1] if len(timers) > 1 else None
         self.name = name
         self.outbox: list = []
-        probe.create_subscription(
-            swarm.BayesSwarmPeer, f'/{name}/peers/out', self.outbox.append, 100
-        )
+        peer_type = swarm.GlowwormPeer if settings.algorithm == 'glowworm' else swarm.BayesSwarmPeer
+        probe.create_subscription(peer_type, f'/{name}/peers/out', self.outbox.append, 100)
         self.executor = executor
 
     def _clock(self, time_s: float) -> None:
@@ -85,6 +93,27 @@ class NodeLink:
         broadcast = peer_update_from_ros(self.outbox.pop()) if self.outbox else None
         return ControlOutput(0.0, 0.0, self.node.decisions[-1], broadcast)
 
+    def glowworm(self, time_s):
+        self._clock(time_s)
+        assert self.glowworm_timer is not None
+        self.glowworm_timer.callback()
+        for _ in range(10):
+            if self.outbox:
+                break
+            self.executor.spin_once(timeout_sec=0.0)
+        if not self.outbox:
+            return None
+        sender, index, position, luciferin = glowworm_peer_from_ros(self.outbox.pop())
+        assert sender == self.name
+        return GlowwormBroadcast(index, position, luciferin), self.node.controller.waypoint_m
+
+    def glowworm_peer(self, sender, broadcast, time_s) -> None:
+        self._clock(time_s)
+        msg = glowworm_peer_to_ros(
+            sender, broadcast.index, broadcast.position_m, broadcast.luciferin, time_s
+        )
+        self.subs[f'/{self.name}/peers/in'](msg)
+
 
 def _spec(case_name: str, **planner: object) -> MissionSpec:
     case = get_case(case_name)
@@ -94,7 +123,31 @@ def _spec(case_name: str, **planner: object) -> MissionSpec:
     return replace(spec, planner=replace(spec.planner, max_mission_time_s=60.0))
 
 
-def _node_run(spec: MissionSpec, algorithm: str, n: int, seed: int):
+class Recorder:
+    """Passes a link's calls through and records every Glowworm iteration it reports."""
+
+    def __init__(self, link) -> None:
+        self.link = link
+        self.steps: list = []
+
+    def __getattr__(self, name):
+        return getattr(self.link, name)
+
+    def glowworm(self, time_s):
+        out = self.link.glowworm(time_s)
+        if out is not None:
+            broadcast, waypoint = out
+            self.steps.append(
+                (time_s, broadcast.index, *broadcast.position_m, broadcast.luciferin, *waypoint)
+            )
+        return out
+
+
+def _node_run(spec: MissionSpec, algorithm: str, n: int, seed: int, wrap=lambda link: link):
+    glowworm = algorithm == 'glowworm'
+    if glowworm:  # run_mission's rule: the robots sample at their decision rate
+        rate_hz = spec.glowworm.decision_rate_hz
+        spec = replace(spec, planner=replace(spec.planner, observation_rate_hz=rate_hz))
     rclpy.init(args=[])
     probe = rclpy.create_node('probe')
     executor = SingleThreadedExecutor()
@@ -104,7 +157,7 @@ def _node_run(spec: MissionSpec, algorithm: str, n: int, seed: int):
         for i in range(n)
     ]
     try:
-        return run_events(spec, n, seed, links)
+        return run_events(spec, n, seed, [wrap(link) for link in links], glowworm=glowworm)
     finally:
         executor.shutdown()
         for link in links:
@@ -143,3 +196,45 @@ def test_node_and_batch_paths_take_identical_decisions_on_seeded_runs(
         batch.finder,
         batch.found_time_s,
     ) or (np.isnan(nodes.found_time_s) and np.isnan(batch.found_time_s))
+
+
+def test_glowworm_robots_iterate_identically_on_the_node_and_batch_paths():
+    # Glowworm robots iterate on their own 100 Hz clock, not on arrivals: every iteration's
+    # broadcast (index, position, luciferin) and the waypoint it sets must match.
+    spec = _spec('case1')
+    spec = replace(spec, planner=replace(spec.planner, max_mission_time_s=40.0))
+    batch_recorders: list[Recorder] = []
+    node_recorders: list[Recorder] = []
+
+    def recorded(into):
+        def wrap(link):
+            into.append(Recorder(link))
+            return into[-1]
+
+        return wrap
+
+    rate_hz = spec.glowworm.decision_rate_hz
+    glow_spec = replace(spec, planner=replace(spec.planner, observation_rate_hz=rate_hz))
+    controllers = [
+        RobotController(robot_settings(glow_spec, 'glowworm', 4, i, 11), f'r{i}') for i in range(4)
+    ]
+    wrap = recorded(batch_recorders)
+    batch = run_events(
+        glow_spec, 4, 11, [wrap(ControllerLink(c)) for c in controllers], glowworm=True
+    )
+    nodes = _node_run(spec, 'glowworm', 4, seed=11, wrap=recorded(node_recorders))
+    # The recorded batch run is run_mission's.
+    plain = run_mission(spec, 'glowworm', 4, seed=11)
+    assert (plain.end_time_s, plain.finder) == (batch.end_time_s, batch.finder)
+    for ours, theirs in zip(plain.trajectories, batch.trajectories, strict=True):
+        np.testing.assert_array_equal(ours, theirs)
+    for ours, theirs in zip(node_recorders, batch_recorders, strict=True):
+        assert len(theirs.steps) > 1000  # 100 Hz after a dispersal leg of at most 10 s
+        assert ours.steps == theirs.steps
+    for ours, theirs in zip(nodes.trajectories, batch.trajectories, strict=True):
+        np.testing.assert_array_equal(ours, theirs)
+    assert (nodes.found, nodes.finder, nodes.end_time_s) == (
+        batch.found,
+        batch.finder,
+        batch.end_time_s,
+    )

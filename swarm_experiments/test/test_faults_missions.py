@@ -241,9 +241,6 @@ def test_faults_of_sensors_the_point_robot_runners_lack_are_refused(case1_spec):
     lidar = dataclasses.replace(case1_spec, faults=FaultConfig(stale_lidar_robots=1))
     with pytest.raises(BayesConfigError, match='stale_lidar_robots are not simulated'):
         run_bayes(lidar, 'bayes_swarm_p', 3, seed=1)
-    glow = dataclasses.replace(case1_spec, faults=FaultConfig(dropout_robots=1))
-    with pytest.raises(BayesConfigError, match='not simulated by this runner'):
-        run_bayes(glow, 'glowworm', 3, seed=1)
     gas = BatchScenario(n_robots=3, n_targets=1, faults=FaultConfig(stuck_gas_robots=1))
     with pytest.raises(MscConfigError, match='stuck_gas_robots are not simulated'):
         run_batch(gas)
@@ -275,3 +272,26 @@ def test_fault_scenarios_and_options_parse_and_bad_ones_fail_in_one_line(capsys)
     assert 'comm_range_m' in err[1]
     assert 'lidar' in err[2]
     assert math.isinf(FaultConfig().comm_range_m)
+
+
+def test_glowworm_robots_run_under_faults(case1_spec):
+    spec = dataclasses.replace(
+        case1_spec,
+        planner=dataclasses.replace(case1_spec.planner, max_mission_time_s=30.0),
+    )
+    talking = run_bayes(spec, 'glowworm', 4, seed=2)
+    # Deaf robots have no brighter neighbour: each stays where its dispersal leg ended.
+    deaf = run_bayes(
+        dataclasses.replace(spec, faults=FaultConfig(comm_loss_probability=1.0)), 'glowworm', 4, 2
+    )
+    for path in deaf.trajectories:
+        np.testing.assert_array_equal(path[-1], path[-2])
+    assert any(np.hypot(*(path[-1] - path[-2])) > 0.1 for path in talking.trajectories)
+    # Robots dropped at 0 s never leave their depot; the others still iterate.
+    faults = FaultConfig(dropout_robots=2, dropout_time_s=0.0)
+    fewer = run_bayes(dataclasses.replace(spec, faults=faults), 'glowworm', 4, seed=2)
+    dropped = FaultPlan(faults, 4, 2).robots['dropout']
+    for robot in range(4):
+        path = fewer.trajectories[robot]
+        moved = np.hypot(*(path[-1] - path[0]))
+        assert (moved == 0.0) == (robot in dropped)

@@ -1,7 +1,7 @@
 """Comparison methods of the Bayes-Swarm-P study (docs/bayes_swarm.md)."""
 
 from bayes_swarm.baselines.exhaustive import sweep_paths
-from bayes_swarm.baselines.glowworm import GlowwormSwarm, glowworm_step
+from bayes_swarm.baselines.glowworm import GlowwormAgent, select_leader
 from bayes_swarm.baselines.levy import LevyWalk
 
-__all__ = ['GlowwormSwarm', 'LevyWalk', 'glowworm_step', 'sweep_paths']
+__all__ = ['GlowwormAgent', 'LevyWalk', 'select_leader', 'sweep_paths']

@@ -1,6 +1,7 @@
-"""Glowworm swarm optimisation for source search (paper Table 11).
+"""Glowworm swarm optimisation for source search (paper Table 11), one agent at a time.
 
-One synchronous iteration, for every agent i:
+One iteration of agent i, from its own signal J(x_i) and its peers' latest broadcasts
+(position and luciferin):
 
 1. luciferin  l_i <- (1 - rho) l_i + gamma J(x_i);
 2. neighbours N_i = {j != i : |x_j - x_i| <= r_d_i and l_i < l_j};
@@ -9,134 +10,63 @@ One synchronous iteration, for every agent i:
 4. move a step s toward the leader (a move leaving the arena is rejected);
 5. r_d_i <- min(r_s, max(0, r_d_i + beta (n_t - |N_i|))).
 
-Luciferins are all updated first, leaders are chosen from that snapshot, then everyone moves.
+Peers' luciferins are those they last broadcast, so the swarm's iterations are
+asynchronous: every robot runs this on its own timer, in the ROS node and in the batch
+runner alike (both through :class:`bayes_swarm.controller.RobotController`).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import bisect
+import math
+from collections.abc import Sequence
 
 import numpy as np
 
 from bayes_swarm.settings import Arena, GlowwormConfig
 
-__all__ = ['GlowwormAgent', 'GlowwormState', 'GlowwormSwarm', 'glowworm_step', 'select_leaders']
+__all__ = ['GlowwormAgent', 'select_leader']
 
 
-@dataclass(frozen=True)
-class GlowwormState:
-    """Swarm state: (m, 2) positions [m], (m,) luciferins, (m,) decision ranges [m]."""
-
-    positions_m: np.ndarray
-    luciferin: np.ndarray
-    decision_range_m: np.ndarray
-
-
-def select_leaders(
-    positions_m: np.ndarray,
-    luciferin: np.ndarray,
-    decision_range_m: np.ndarray,
+def select_leader(
+    position_m: tuple[float, float],
+    luciferin: float,
+    decision_range_m: float,
+    peers: Sequence[tuple[float, float, float]],
     rng: np.random.Generator,
     *,
     deterministic: bool = False,
-) -> tuple[np.ndarray, np.ndarray]:
-    """Leader index (m,) of every agent (-1: none) and its neighbour count (m,)."""
-    diff = positions_m[None, :, :] - positions_m[:, None, :]
-    dist = np.hypot(diff[..., 0], diff[..., 1])
-    gain = luciferin[None, :] - luciferin[:, None]
-    neighbours = (dist <= decision_range_m[:, None]) & (gain > 0.0)
-    np.fill_diagonal(neighbours, False)
-    counts = neighbours.sum(axis=1)
-    leaders = np.full(positions_m.shape[0], -1)
-    weights = np.where(neighbours, gain, 0.0)
-    totals = weights.sum(axis=1)
-    for i in np.flatnonzero(totals > 0.0):
-        if deterministic:
-            leaders[i] = int(np.argmax(np.where(neighbours[i], luciferin, -np.inf)))
-        else:
-            leaders[i] = int(rng.choice(weights.shape[1], p=weights[i] / totals[i]))
-    return leaders, counts
+) -> tuple[int, int]:
+    """Steps 2-3 for one agent: the index of its leader in ``peers`` (-1: none) and its
+    neighbour count |N_i|.
 
-
-def glowworm_step(
-    state: GlowwormState,
-    signal: np.ndarray,
-    config: GlowwormConfig,
-    arena: Arena,
-    step_m: float,
-    rng: np.random.Generator,
-) -> GlowwormState:
-    """One synchronous GSO iteration given the (m,) signal J measured at the positions."""
-    luciferin = (1.0 - config.luciferin_decay) * state.luciferin + (
-        config.luciferin_enhancement * np.asarray(signal, dtype=float)
-    )
-    leaders, counts = select_leaders(
-        state.positions_m,
-        luciferin,
-        state.decision_range_m,
-        rng,
-        deterministic=config.deterministic,
-    )
-    positions = state.positions_m.copy()
-    movers = np.flatnonzero(leaders >= 0)
-    if movers.size:
-        toward = state.positions_m[leaders[movers]] - state.positions_m[movers]
-        norm = np.hypot(toward[:, 0], toward[:, 1])
-        ok = norm > 0.0
-        target = state.positions_m[movers[ok]] + step_m * toward[ok] / norm[ok, None]
-        inside = arena.contains(target)
-        positions[movers[ok][inside]] = target[inside]
-    ranges = np.minimum(
-        config.sensor_range_m,
-        np.maximum(
-            0.0, state.decision_range_m + config.range_gain * (config.desired_neighbours - counts)
-        ),
-    )
-    return GlowwormState(positions, luciferin, ranges)
-
-
-class GlowwormSwarm:
-    """Synchronous GSO over a whole swarm (used by the batch simulator)."""
-
-    def __init__(
-        self,
-        config: GlowwormConfig,
-        arena: Arena,
-        positions_m: np.ndarray,
-        velocity_mps: float,
-        seed: int | None = None,
-    ) -> None:
-        pos = np.asarray(positions_m, dtype=float).reshape(-1, 2)
-        m = pos.shape[0]
-        self._cfg = config
-        self._arena = arena
-        self._rng = np.random.default_rng(seed)
-        self.step_m = min(config.step_m, velocity_mps / config.decision_rate_hz)
-        self.state = GlowwormState(
-            pos,
-            np.full(m, config.initial_luciferin),
-            np.full(m, config.sensor_range_m),
-        )
-
-    @property
-    def period_s(self) -> float:
-        """Time between two GSO iterations [s]."""
-        return 1.0 / self._cfg.decision_rate_hz
-
-    def step(self, signal: np.ndarray) -> np.ndarray:
-        """Advance one iteration with the (m,) measured signal; returns the new positions."""
-        self.state = glowworm_step(
-            self.state, signal, self._cfg, self._arena, self.step_m, self._rng
-        )
-        return self.state.positions_m
+    ``peers`` holds each peer's latest (x [m], y [m], luciferin). The draw uses one uniform
+    number from ``rng`` when there are neighbours (none in the deterministic variant, which
+    takes the brightest). A robot hears a handful of peers, so this is a plain loop: it costs
+    a few microseconds where numpy's per-call overhead would cost tens.
+    """
+    x, y = position_m
+    neighbours: list[int] = []
+    cumulative: list[float] = []
+    total = 0.0
+    for j, (px, py, lj) in enumerate(peers):
+        gain = lj - luciferin
+        if gain > 0.0 and math.hypot(px - x, py - y) <= decision_range_m:
+            neighbours.append(j)
+            total += gain
+            cumulative.append(total)
+    if not neighbours:
+        return -1, 0
+    if deterministic:
+        return max(neighbours, key=lambda j: peers[j][2]), len(neighbours)
+    draw = rng.random() * total
+    pick = bisect.bisect_right(cumulative, draw)
+    # A draw on the boundary of the last weight (draw == total in rounding) stays in range.
+    return neighbours[min(pick, len(neighbours) - 1)], len(neighbours)
 
 
 class GlowwormAgent:
-    """GSO decisions of one robot from its own signal and its neighbours' broadcasts.
-
-    The same update as :func:`glowworm_step`, seen from one agent: peers' luciferins are the
-    latest they broadcast, so decisions are asynchronous.
-    """
+    """GSO decisions of one robot from its own signal and its neighbours' broadcasts."""
 
     def __init__(
         self, config: GlowwormConfig, arena: Arena, velocity_mps: float, seed: int | None = None
@@ -157,29 +87,33 @@ class GlowwormAgent:
         return self.luciferin
 
     def next_waypoint(
-        self, position_m: np.ndarray, peer_positions_m: np.ndarray, peer_luciferin: np.ndarray
+        self, position_m: np.ndarray, peers: Sequence[tuple[float, float, float]]
     ) -> np.ndarray:
-        """Steps 2-5 for this agent; returns the (2,) next position [m]."""
-        own = np.asarray(position_m, dtype=float).reshape(1, 2)
-        positions = np.vstack([own, np.asarray(peer_positions_m, dtype=float).reshape(-1, 2)])
-        luciferin = np.concatenate([[self.luciferin], np.asarray(peer_luciferin, dtype=float)])
-        ranges = np.full(positions.shape[0], self.decision_range_m)
-        leaders, counts = select_leaders(
-            positions, luciferin, ranges, self._rng, deterministic=self._cfg.deterministic
-        )
+        """Steps 2-5 for this agent, given each peer's latest (x [m], y [m], luciferin);
+        returns the (2,) next position [m]."""
+        own = np.asarray(position_m, dtype=float).reshape(2)
+        x, y = float(own[0]), float(own[1])
         cfg = self._cfg
+        leader, count = select_leader(
+            (x, y),
+            self.luciferin,
+            self.decision_range_m,
+            peers,
+            self._rng,
+            deterministic=cfg.deterministic,
+        )
         self.decision_range_m = min(
             cfg.sensor_range_m,
-            max(
-                0.0,
-                self.decision_range_m + cfg.range_gain * (cfg.desired_neighbours - counts[0]),
-            ),
+            max(0.0, self.decision_range_m + cfg.range_gain * (cfg.desired_neighbours - count)),
         )
-        if leaders[0] < 0:
-            return own[0].copy()
-        toward = positions[leaders[0]] - own[0]
-        norm = float(np.hypot(*toward))
+        if leader < 0:
+            return own.copy()
+        dx, dy = peers[leader][0] - x, peers[leader][1] - y
+        norm = math.hypot(dx, dy)
         if norm <= 0.0:
-            return own[0].copy()
-        target = own[0] + self.step_m * toward / norm
-        return target if self._arena.contains(target) else own[0].copy()
+            return own.copy()
+        target_x = x + self.step_m * dx / norm
+        target_y = y + self.step_m * dy / norm
+        if not self._arena.contains_point(target_x, target_y):
+            return own.copy()
+        return np.array([target_x, target_y])
