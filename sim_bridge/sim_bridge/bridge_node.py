@@ -43,6 +43,7 @@ from swarm_runtime.ros import (
 from swarm_sim.departure import place_starts
 from swarm_sim.engine import EngineConfig, SimEngine, SiteGeometry, StepOutput
 from swarm_sim.errors import ConfigurationError, SimulationError
+from swarm_sim.mission_rules import TrajectorySampler, end_reason
 from swarm_sim.peer_relay import RelayConfig, RelayModel, parse_message_type
 from swarm_sim.site_geometry import geometry_from_site
 
@@ -157,9 +158,9 @@ class SimBridgeNode(Node):
             or math.isfinite(self.settings.max_sim_time_s)
         )
         self._outcome_written = False
-        self._trajectory_times: list[float] = [0.0]
-        self._trajectory_poses: list[np.ndarray] = [self.engine.world.poses]
-        self._next_sample_s = self.settings.trajectory_period_s
+        self._trajectory = TrajectorySampler.starting_at(
+            self.engine.world.poses, self.settings.trajectory_period_s
+        )
         self._timer: Any = None
         self._grace_until_ns: int | None = None
         if self.settings.start_after_clock_subscribers > 0:
@@ -369,23 +370,20 @@ class SimBridgeNode(Node):
                 ext.on_step(t, states)
         for listener in self.step_listeners:
             listener(out)
-        if self.settings.outcome_file and t + 1e-9 >= self._next_sample_s:
-            self._trajectory_times.append(t)
-            self._trajectory_poses.append(out.poses)
-            self._next_sample_s += self.settings.trajectory_period_s
+        if self.settings.outcome_file:
+            self._trajectory.offer(t, out.poses)
         reason = self._mission_end_reason() if self._ends_mission else ''
         if reason:
             self._end_mission(reason)
 
     def _mission_end_reason(self) -> str:
         """The stop reason once the mission's end condition holds ('' before)."""
-        if self.settings.stop_when_all_rooms_covered and self.engine.coverage.complete:
-            return 'all_rooms_covered'
-        if self.extensions and self.extensions_done():
-            return 'extension_done'
-        if self.engine.time_s + 1e-9 >= self.settings.max_sim_time_s:
-            return 'budget'
-        return ''
+        return end_reason(
+            self.engine,
+            stop_when_all_rooms_covered=self.settings.stop_when_all_rooms_covered,
+            max_sim_time_s=self.settings.max_sim_time_s,
+            extensions_done=self.extensions_done if self.extensions else None,
+        )
 
     def _end_mission(self, reason: str) -> None:
         """Stop stepping, write the outcome file and shut the context down (exit 0)."""
@@ -397,8 +395,8 @@ class SimBridgeNode(Node):
 
     def outcome(self) -> dict[str, Any]:
         """The mission's outcome so far as JSON values (see :mod:`sim_bridge.mission_file`)."""
-        times = list(self._trajectory_times)
-        poses = list(self._trajectory_poses)
+        times = list(self._trajectory.times_s)
+        poses = list(self._trajectory.poses)
         if times[-1] < self.engine.time_s:
             times.append(self.engine.time_s)
             poses.append(self.engine.world.poses)

@@ -47,6 +47,14 @@ from swarm_runtime.ros import (
 from swarm_sim.engine import EngineConfig, SimEngine, StepOutput
 from swarm_sim.errors import ConfigurationError
 from swarm_sim.ground_truth import RoomEntry
+from swarm_sim.mission_rules import (
+    ALL_ROOMS_COVERED,
+    BUDGET,
+    EXTENSION_DONE,
+    TIME_TOLERANCE_S,
+    TrajectorySampler,
+    end_reason,
+)
 
 from swarm_experiments.errors import MissionError
 
@@ -103,9 +111,9 @@ _DRAIN_CALLBACKS_PER_NODE = 20
 class StopReason:
     """Why a mission ended (string constants, also used in reports)."""
 
-    ALL_ROOMS_COVERED = 'all_rooms_covered'
-    BUDGET = 'budget'
-    EXTENSION_DONE = 'extension_done'
+    ALL_ROOMS_COVERED = ALL_ROOMS_COVERED
+    BUDGET = BUDGET
+    EXTENSION_DONE = EXTENSION_DONE
     PREDICATE = 'predicate'
     INTERRUPTED = 'interrupted'
 
@@ -328,16 +336,13 @@ class _Observer:
     def __init__(self, bridge: SimBridgeNode, spec: MissionSpec) -> None:
         self.bridge = bridge
         self.spec = spec
-        self.times: list[float] = [0.0]
-        self.poses: list[np.ndarray] = [bridge.engine.world.poses]
-        self._next_sample_s = spec.trajectory_period_s
+        self.trajectory = TrajectorySampler.starting_at(
+            bridge.engine.world.poses, spec.trajectory_period_s
+        )
         bridge.step_listeners.append(self.on_step)
 
     def on_step(self, out: StepOutput) -> None:
-        if out.time_s + 1e-9 >= self._next_sample_s:
-            self.times.append(out.time_s)
-            self.poses.append(out.poses)
-            self._next_sample_s += self.spec.trajectory_period_s
+        self.trajectory.offer(out.time_s, out.poses)
 
 
 def _spin_until(executor: Any, predicate: Callable[[], bool]) -> None:
@@ -467,16 +472,16 @@ def run_mission(
             if engine.step_index == state['checked_step']:
                 return False
             state['checked_step'] = engine.step_index
-            if spec.stop_when_all_rooms_covered and engine.coverage.complete:
-                state['reason'] = StopReason.ALL_ROOMS_COVERED
+            reason = end_reason(
+                engine,
+                stop_when_all_rooms_covered=spec.stop_when_all_rooms_covered,
+                max_sim_time_s=spec.max_sim_time_s,
+                extensions_done=bridge.extensions_done if bridge.extensions else None,
+            )
+            if reason:
+                state['reason'] = reason
                 return True
-            if bridge.extensions and bridge.extensions_done():
-                state['reason'] = StopReason.EXTENSION_DONE
-                return True
-            if engine.time_s + 1e-9 >= spec.max_sim_time_s:
-                state['reason'] = StopReason.BUDGET
-                return True
-            if engine.time_s + 1e-9 >= state['next_report_s']:
+            if engine.time_s + TIME_TOLERANCE_S >= state['next_report_s']:
                 state['next_report_s'] += spec.progress_period_s
                 report = snapshot()
                 if progress is not None:
@@ -507,8 +512,8 @@ def run_mission(
             site=spec.site,
             stop_reason=str(state['reason']),
             wall_time_s=final.wall_time_s,
-            times=observer.times,
-            poses=observer.poses,
+            times=observer.trajectory.times_s,
+            poses=observer.trajectory.poses,
             bag_path=spec.recording.path if spec.recording is not None else None,
         )
     finally:

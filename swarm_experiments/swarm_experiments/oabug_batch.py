@@ -49,6 +49,7 @@ from swarm_common.stamps import seconds_to_ns
 from swarm_runtime.builtin._messages import cdr_roundtrip_enabled
 from swarm_sim.engine import EngineConfig, SimEngine, SiteGeometry, StepOutput
 from swarm_sim.errors import ConfigurationError
+from swarm_sim.mission_rules import TIME_TOLERANCE_S, TrajectorySampler, end_reason
 from swarm_sim.sensors.bearings import BearingCycle
 from swarm_sim.sensors.bearings import PeerBearings as BearingReport
 from swarm_sim.sensors.lidar import LidarConfig
@@ -255,24 +256,20 @@ def run_site_loop(
     :func:`swarm_experiments.mission.run_mission`; the step that ends the mission is not
     delivered.
     """
-    times = [0.0]
-    poses = [engine.world.poses]
-    next_sample_s = spec.trajectory_period_s
+    trajectory = TrajectorySampler.starting_at(engine.world.poses, spec.trajectory_period_s)
     next_report_s = 0.0
     reports = progress is not None or stop is not None
-    reason = StopReason.BUDGET
     while True:
         out = engine.step()
-        if out.time_s + 1e-9 >= next_sample_s:
-            times.append(out.time_s)
-            poses.append(out.poses)
-            next_sample_s += spec.trajectory_period_s
-        if spec.stop_when_all_rooms_covered and engine.coverage.complete:
-            reason = StopReason.ALL_ROOMS_COVERED
+        trajectory.offer(out.time_s, out.poses)
+        reason = end_reason(
+            engine,
+            stop_when_all_rooms_covered=spec.stop_when_all_rooms_covered,
+            max_sim_time_s=spec.max_sim_time_s,
+        )
+        if reason:
             break
-        if engine.time_s + 1e-9 >= spec.max_sim_time_s:
-            break
-        if reports and engine.time_s + 1e-9 >= next_report_s:
+        if reports and engine.time_s + TIME_TOLERANCE_S >= next_report_s:
             next_report_s += spec.progress_period_s
             report = MissionProgress.of_engine(engine, wall_start)
             if progress is not None:
@@ -293,8 +290,8 @@ def run_site_loop(
         site=spec.site,
         stop_reason=reason,
         wall_time_s=final.wall_time_s,
-        times=times,
-        poses=poses,
+        times=trajectory.times_s,
+        poses=trajectory.poses,
     )
 
 
