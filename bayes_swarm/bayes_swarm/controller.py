@@ -11,7 +11,9 @@ One :class:`RobotController` is one robot of the Bayes-Swarm-P study, whatever d
   older than ``odom_timeout_s``; the first decision on the first tick with a pose; a new
   decision (and its broadcast) when the waypoint follower reports arrival; otherwise the
   follower's velocity command;
-* :meth:`~RobotController.glowworm_step` is one Glowworm iteration (its own timer).
+* :meth:`~RobotController.glowworm_step` is one Glowworm iteration (its own timer); its
+  halves :meth:`~RobotController.glowworm_broadcast` and :meth:`~RobotController.glowworm_move`
+  let the batch runner iterate a swarm in lockstep.
 
 The node (``bayes_swarm.node``) only converts messages to these calls and the returned
 records to messages; the batch runner (``swarm_experiments.bayes_batch``) calls the same
@@ -93,6 +95,7 @@ class RobotController:
         self._glow: GlowwormAgent | None = None
         # Per peer: its latest Glowworm broadcast as (index, x [m], y [m], luciferin).
         self._glow_peers: dict[str, tuple[int, float, float, float]] = {}
+        self._glow_sent: GlowwormBroadcast | None = None
         s = settings
         if s.algorithm in ('bayes_swarm_p', 'bayes_swarm_o'):
             self._planner = BayesSwarmPlanner(
@@ -248,8 +251,10 @@ class RobotController:
         self.decisions.append(decision)
         return decision, broadcast, waypoint
 
-    def glowworm_step(self) -> GlowwormBroadcast | None:
-        """One Glowworm iteration (after the dispersal leg); None when there is nothing to do."""
+    def glowworm_broadcast(self) -> GlowwormBroadcast | None:
+        """First half of a Glowworm iteration: the luciferin from the latest sample and the
+        broadcast that carries it. None when the robot does not iterate (not Glowworm, no pose
+        or sample yet, or still on its first dispersal leg)."""
         if self._glow is None or self._pose is None or self._waypoint is None:
             return None
         x, y = self._pose[0], self._pose[1]
@@ -260,9 +265,19 @@ class RobotController:
             return None  # still on the first dispersal leg
         if self._last_signal is None:
             return None
-        position = np.array([x, y])
         luciferin = self._glow.update_luciferin(self._last_signal)
-        broadcast = GlowwormBroadcast(self._n_decisions, position, luciferin)
+        self._glow_sent = GlowwormBroadcast(self._n_decisions, np.array([x, y]), luciferin)
+        return self._glow_sent
+
+    def glowworm_move(self) -> np.ndarray | None:
+        """Second half: the leader among the peers' latest broadcasts and the waypoint toward
+        it, from where the robot broadcast. Returns the new waypoint (2,) [m]; None without a
+        broadcast since the last move."""
+        sent, self._glow_sent = self._glow_sent, None
+        if sent is None or self._glow is None:
+            return None
+        position = sent.position_m
+        x, y = float(position[0]), float(position[1])
         peers = [peer[1:] for peer in self._glow_peers.values()]
         target = self._glow.next_waypoint(position, peers)
         dx, dy = float(target[0]) - x, float(target[1]) - y
@@ -272,6 +287,7 @@ class RobotController:
         else:
             # A GSO step (mm at 100 Hz) is below the follower's arrival tolerance: steer toward
             # a point a few control periods ahead on the same heading, so the robot moves at V.
+            follower = self.follower_config
             lookahead = max(
                 2.0 * follower.arrival_tolerance_m,
                 2.0 * follower.speed_mps / self.settings.control_rate_hz,
@@ -285,4 +301,12 @@ class RobotController:
                 ]
             )
         self._n_decisions += 1
+        return self._waypoint.copy()
+
+    def glowworm_step(self) -> GlowwormBroadcast | None:
+        """One whole Glowworm iteration, :meth:`glowworm_broadcast` then :meth:`glowworm_move`
+        with the broadcasts heard so far; returns the broadcast (None: no iteration)."""
+        broadcast = self.glowworm_broadcast()
+        if broadcast is not None:
+            self.glowworm_move()
         return broadcast

@@ -174,13 +174,22 @@ class BayesSwarmNode(Node):
         )
 
     def _on_glowworm(self) -> None:
-        out = self.controller.glowworm_step()
-        if out is not None and self._peer_pub is not None:
+        """One Glowworm iteration: broadcast the new luciferin, then pick a leader."""
+        if self._broadcast_glowworm():
+            self.controller.glowworm_move()
+
+    def _broadcast_glowworm(self) -> bool:
+        """The iteration's first half and its GlowwormPeer; False if the robot did not iterate."""
+        out = self.controller.glowworm_broadcast()
+        if out is None:
+            return False
+        if self._peer_pub is not None:
             self._peer_pub.publish(
                 conversions.glowworm_peer_to_ros(
                     self.robot_name, out.index, out.position_m, out.luciferin, self._now_s()
                 )
             )
+        return True
 
 
 def main(args: list[str] | None = None) -> int:

@@ -11,7 +11,8 @@ its :class:`~bayes_swarm.messages.PeerUpdate` is delivered at once to every robo
 continuous: a mission succeeds at the first instant any robot comes within eps of the source
 along its straight leg. Glowworm robots take a sample and iterate at every tick of their
 decision clock (the observation clock runs at that rate for them, as the spawner sets it),
-one robot after the other, each broadcast delivered at once: the node's Glowworm loop.
+in lockstep as GSO is defined: every robot broadcasts its new luciferin, then every robot
+picks its leader from this iteration's broadcasts (the two halves of the node's iteration).
 
 Decisions take no simulated time; their wall-clock duration is recorded per robot.
 """
@@ -241,9 +242,12 @@ class RobotLink(Protocol):
     def control(self, time_s: float) -> ControlOutput:
         """One control tick."""
 
-    def glowworm(self, time_s: float) -> tuple[GlowwormBroadcast, np.ndarray] | None:
-        """One Glowworm iteration: its broadcast and the robot's new waypoint (2,) [m];
-        None if the robot did not iterate (still dispersing, no sample yet)."""
+    def glowworm_broadcast(self, time_s: float) -> GlowwormBroadcast | None:
+        """The first half of a Glowworm iteration: the robot's broadcast (None: it does not
+        iterate, e.g. still dispersing)."""
+
+    def glowworm_move(self, time_s: float) -> np.ndarray | None:
+        """The second half: the robot's new waypoint (2,) [m] (None without a broadcast)."""
 
     def glowworm_peer(self, sender: str, broadcast: GlowwormBroadcast, time_s: float) -> None:
         """A peer's Glowworm broadcast."""
@@ -267,12 +271,11 @@ class ControllerLink:
     def control(self, time_s: float) -> ControlOutput:
         return self.controller.control(time_s)
 
-    def glowworm(self, time_s: float) -> tuple[GlowwormBroadcast, np.ndarray] | None:
-        broadcast = self.controller.glowworm_step()
-        waypoint = self.controller.waypoint_m
-        if broadcast is None or waypoint is None:
-            return None
-        return broadcast, waypoint
+    def glowworm_broadcast(self, time_s: float) -> GlowwormBroadcast | None:
+        return self.controller.glowworm_broadcast()
+
+    def glowworm_move(self, time_s: float) -> np.ndarray | None:
+        return self.controller.glowworm_move()
 
     def glowworm_peer(self, sender: str, broadcast: GlowwormBroadcast, time_s: float) -> None:
         self.controller.on_glowworm_peer(
@@ -351,8 +354,9 @@ def run_events(
     Events: the observation clock (every robot gets its pose and a sample), and arrivals
     (the arrived robot gets its pose and a control tick, which decides; its broadcast is
     delivered at once). With ``glowworm``, every observation tick is also a Glowworm
-    iteration of every robot, in index order after the samples, each broadcast delivered at
-    once. Times passed to the robots are rounded to nanoseconds.
+    iteration of the swarm after the samples, in lockstep: every robot broadcasts (delivered
+    at once), then every robot that broadcast moves. Times passed to the robots are rounded
+    to nanoseconds.
     """
     seeds = np.random.SeedSequence(seed).spawn(n_robots + 1)
     world = _world(spec, n_robots, np.random.default_rng(seeds[0]))
@@ -398,22 +402,29 @@ def run_events(
         waypoints[dropped] = world.positions[dropped]
 
     def iterate_glowworm() -> None:
+        # Lockstep, as GSO is defined: every robot broadcasts its new luciferin, then every
+        # robot picks its leader from the broadcasts of this iteration.
         stamp = ros_time_s(t)
+        moving: list[int] = []
         for i, robot in enumerate(robots):
             if dropped[i]:
                 continue
-            step = robot.glowworm(stamp)
-            if step is None:
+            broadcast = robot.glowworm_broadcast(stamp)
+            if broadcast is None:
                 continue
-            broadcast, waypoint = step
-            position = world.positions[i]
+            moving.append(i)
             if broadcast.index == 1:  # the end of the dispersal leg
-                world.trajectories[i].append(position.copy())
+                world.trajectories[i].append(world.positions[i].copy())
+            _deliver(spec, world, robots, i, broadcast, stamp, links())
+        for i in moving:
+            waypoint = robots[i].glowworm_move(stamp)
+            if waypoint is None:
+                continue
+            position = world.positions[i]
             waypoints[i] = waypoint
             dx, dy = float(waypoint[0] - position[0]), float(waypoint[1] - position[1])
             if dx != 0.0 or dy != 0.0:
                 yaws[i] = math.atan2(dy, dx)
-            _deliver(spec, world, robots, i, broadcast, stamp, links())
 
     def tick_robot(i: int) -> None:
         stamp = ros_time_s(t)

@@ -114,3 +114,40 @@ def test_cobyla_waypoints_on_the_leg_constraint_are_kept_not_replaced_by_random_
     assert kinds.count(DecisionKind.RANDOM_JUMP) <= 1
     assert result.found
     assert result.tau < 0.35
+
+
+def test_glowworm_swarms_iterate_in_lockstep(case1_spec):
+    # Every robot broadcasts before any robot of the same iteration picks its leader.
+    from bayes_swarm.controller import RobotController
+    from swarm_experiments.bayes_batch import ControllerLink, robot_settings, run_events
+
+    log: list[tuple[float, str]] = []
+
+    class Logged(ControllerLink):
+        def glowworm_broadcast(self, time_s):
+            out = super().glowworm_broadcast(time_s)
+            if out is not None:
+                log.append((time_s, 'broadcast'))
+            return out
+
+        def glowworm_move(self, time_s):
+            out = super().glowworm_move(time_s)
+            if out is not None:
+                log.append((time_s, 'move'))
+            return out
+
+    rate_hz = case1_spec.glowworm.decision_rate_hz
+    planner = replace(case1_spec.planner, observation_rate_hz=rate_hz, max_mission_time_s=15.0)
+    spec = replace(case1_spec, planner=planner)
+    links = [
+        Logged(RobotController(robot_settings(spec, 'glowworm', 3, i, 4), f'r{i}'))
+        for i in range(3)
+    ]
+    run_events(spec, 3, 4, links, glowworm=True)
+    ticks: dict[float, list[str]] = {}
+    for time_s, what in log:
+        ticks.setdefault(time_s, []).append(what)
+    assert len(ticks) > 100
+    for sequence in ticks.values():
+        assert sequence == sorted(sequence)  # 'broadcast' < 'move'
+        assert sequence.count('broadcast') == sequence.count('move')

@@ -93,19 +93,22 @@ class NodeLink:
         broadcast = peer_update_from_ros(self.outbox.pop()) if self.outbox else None
         return ControlOutput(0.0, 0.0, self.node.decisions[-1], broadcast)
 
-    def glowworm(self, time_s):
+    def glowworm_broadcast(self, time_s):
+        # The first half of the node's Glowworm timer tick: its GlowwormPeer on peers/out.
         self._clock(time_s)
-        assert self.glowworm_timer is not None
-        self.glowworm_timer.callback()
+        if not self.node._broadcast_glowworm():
+            return None
         for _ in range(10):
             if self.outbox:
                 break
             self.executor.spin_once(timeout_sec=0.0)
-        if not self.outbox:
-            return None
         sender, index, position, luciferin = glowworm_peer_from_ros(self.outbox.pop())
         assert sender == self.name
-        return GlowwormBroadcast(index, position, luciferin), self.node.controller.waypoint_m
+        return GlowwormBroadcast(index, position, luciferin)
+
+    def glowworm_move(self, time_s):
+        self._clock(time_s)
+        return self.node.controller.glowworm_move()
 
     def glowworm_peer(self, sender, broadcast, time_s) -> None:
         self._clock(time_s)
@@ -124,7 +127,7 @@ def _spec(case_name: str, **planner: object) -> MissionSpec:
 
 
 class Recorder:
-    """Passes a link's calls through and records every Glowworm iteration it reports."""
+    """Passes a link's calls through and records every Glowworm broadcast and move."""
 
     def __init__(self, link) -> None:
         self.link = link
@@ -133,13 +136,16 @@ class Recorder:
     def __getattr__(self, name):
         return getattr(self.link, name)
 
-    def glowworm(self, time_s):
-        out = self.link.glowworm(time_s)
+    def glowworm_broadcast(self, time_s):
+        out = self.link.glowworm_broadcast(time_s)
         if out is not None:
-            broadcast, waypoint = out
-            self.steps.append(
-                (time_s, broadcast.index, *broadcast.position_m, broadcast.luciferin, *waypoint)
-            )
+            self.steps.append((time_s, out.index, *out.position_m, out.luciferin))
+        return out
+
+    def glowworm_move(self, time_s):
+        out = self.link.glowworm_move(time_s)
+        if out is not None:
+            self.steps.append((time_s, *out))
         return out
 
 
@@ -200,7 +206,8 @@ def test_node_and_batch_paths_take_identical_decisions_on_seeded_runs(
 
 def test_glowworm_robots_iterate_identically_on_the_node_and_batch_paths():
     # Glowworm robots iterate on their own 100 Hz clock, not on arrivals: every iteration's
-    # broadcast (index, position, luciferin) and the waypoint it sets must match.
+    # broadcast (index, position, luciferin, through the node's GlowwormPeer messages) and the
+    # waypoint it sets must match.
     spec = _spec('case1')
     spec = replace(spec, planner=replace(spec.planner, max_mission_time_s=40.0))
     batch_recorders: list[Recorder] = []
@@ -229,7 +236,7 @@ def test_glowworm_robots_iterate_identically_on_the_node_and_batch_paths():
     for ours, theirs in zip(plain.trajectories, batch.trajectories, strict=True):
         np.testing.assert_array_equal(ours, theirs)
     for ours, theirs in zip(node_recorders, batch_recorders, strict=True):
-        assert len(theirs.steps) > 1000  # 100 Hz after a dispersal leg of at most 10 s
+        assert len(theirs.steps) > 2000  # 100 Hz, two records an iteration, after dispersal
         assert ours.steps == theirs.steps
     for ours, theirs in zip(nodes.trajectories, batch.trajectories, strict=True):
         np.testing.assert_array_equal(ours, theirs)
