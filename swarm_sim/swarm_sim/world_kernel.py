@@ -25,11 +25,11 @@ __all__ = ['world_step_kernel']
 def world_step_kernel(
     poses: np.ndarray,
     commands: np.ndarray,
-    max_speed: float,
-    max_yaw_rate: float,
-    dt: float,
-    wall_clearance: float,
-    contact: float,
+    max_speed_mps: float,
+    max_yaw_rate_radps: float,
+    dt_s: float,
+    wall_clearance_m: float,
+    contact_m: float,
     has_walls: bool,
     clearance: np.ndarray,
     has_clearance: bool,
@@ -43,10 +43,10 @@ def world_step_kernel(
     Args:
         poses: (N, 3) x [m], y [m], yaw [rad].
         commands: (N, 2) speed [m/s] and yaw rate [rad/s], not yet clipped.
-        max_speed, max_yaw_rate: the drive limits.
-        dt: step length [s].
-        wall_clearance: contact distance of a robot centre to a wall centre line [m].
-        contact: contact distance of two robot centres [m].
+        max_speed_mps, max_yaw_rate_radps: the drive limits [m/s, rad/s].
+        dt_s: step length [s].
+        wall_clearance_m: contact distance of a robot centre to a wall centre line [m].
+        contact_m: contact distance of two robot centres [m].
         has_walls: the world has walls.
         clearance: (N,) wall clearances of the current positions, if ``has_clearance``.
         has_clearance: ``clearance`` holds them (else they are computed when needed).
@@ -72,15 +72,15 @@ def world_step_kernel(
         wi = commands[i, 1]
         vi = vi if math.isfinite(vi) else 0.0
         wi = wi if math.isfinite(wi) else 0.0
-        vi = min(max(vi, -max_speed), max_speed)
-        wi = min(max(wi, -max_yaw_rate), max_yaw_rate)
+        vi = min(max(vi, -max_speed_mps), max_speed_mps)
+        wi = min(max(wi, -max_yaw_rate_radps), max_yaw_rate_radps)
         yaw = poses[i, 2]
-        new_yaw[i] = yaw + wi * dt
+        new_yaw[i] = yaw + wi * dt_s
         cos_yaw = math.cos(yaw)
         sin_yaw = math.sin(yaw)
         if abs(wi) < 1e-9:
-            dx[i] = vi * dt * cos_yaw
-            dy[i] = vi * dt * sin_yaw
+            dx[i] = vi * dt_s * cos_yaw
+            dy[i] = vi * dt_s * sin_yaw
         else:
             dx[i] = vi / wi * (math.sin(new_yaw[i]) - sin_yaw)
             dy[i] = -vi / wi * (math.cos(new_yaw[i]) - cos_yaw)
@@ -99,12 +99,12 @@ def world_step_kernel(
         if not has_clearance:
             old_clear = nearest_kernel(poses[:, :2].copy(), *grid)
         for i in range(n):
-            if new_clear[i] < wall_clearance and new_clear[i] < old_clear[i]:
+            if new_clear[i] < wall_clearance_m and new_clear[i] < old_clear[i]:
                 allowed[i] = False
     longest = -np.inf
     for i in range(n):
         longest = max(longest, math.hypot(dx[i], dy[i]))
-    threshold = contact + longest + 1e-9
+    threshold = contact_m + longest + 1e-9
     final = poses[:, :2].copy()
     close = np.zeros(n, dtype=np.bool_)
     for i in range(n):
@@ -126,7 +126,7 @@ def world_step_kernel(
                 continue
             new_min = min(new_min, math.hypot(final[j, 0] - cand[i, 0], final[j, 1] - cand[i, 1]))
             old_min = min(old_min, math.hypot(final[j, 0] - poses[i, 0], final[j, 1] - poses[i, 1]))
-        if new_min < contact and new_min < old_min:
+        if new_min < contact_m and new_min < old_min:
             allowed[i] = False
             continue
         final[i, 0] = cand[i, 0]
