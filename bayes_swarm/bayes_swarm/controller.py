@@ -11,9 +11,9 @@ One :class:`RobotController` is one robot of the Bayes-Swarm-P study, whatever d
   older than ``odom_timeout_s``; the first decision on the first tick with a pose; a new
   decision (and its broadcast) when the waypoint follower reports arrival; otherwise the
   follower's velocity command;
-* :meth:`~RobotController.glowworm_step` is one Glowworm iteration (its own timer); its
-  halves :meth:`~RobotController.glowworm_broadcast` and :meth:`~RobotController.glowworm_move`
-  let the batch runner iterate a swarm in lockstep.
+* :meth:`~RobotController.glowworm_broadcast` and :meth:`~RobotController.glowworm_move`
+  are the two halves of one Glowworm iteration: the node's own timer runs them back to back,
+  the batch runner runs a swarm's first halves and then its second halves (lockstep).
 
 The node (``bayes_swarm.node``) only converts messages to these calls and the returned
 records to messages; the batch runner (``swarm_experiments.bayes_batch``) calls the same
@@ -302,11 +302,3 @@ class RobotController:
             )
         self._n_decisions += 1
         return self._waypoint.copy()
-
-    def glowworm_step(self) -> GlowwormBroadcast | None:
-        """One whole Glowworm iteration, :meth:`glowworm_broadcast` then :meth:`glowworm_move`
-        with the broadcasts heard so far; returns the broadcast (None: no iteration)."""
-        broadcast = self.glowworm_broadcast()
-        if broadcast is not None:
-            self.glowworm_move()
-        return broadcast

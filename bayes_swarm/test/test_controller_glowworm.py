@@ -64,18 +64,3 @@ def test_an_iteration_is_a_broadcast_then_a_move_toward_a_brighter_peer() -> Non
     assert waypoint[0] > position[0]
     assert waypoint[1] == pytest.approx(position[1])
     assert controller.glowworm_move() is None  # one move per broadcast
-
-
-def test_a_whole_step_is_the_two_halves() -> None:
-    halves, whole = _arrived_controller(), _arrived_controller()
-    for controller in (halves, whole):
-        position = np.array(controller.pose_m)
-        controller.on_glowworm_peer('r1', 1, position + np.array([0.0, 0.5]), 100.0)
-    sent = halves.glowworm_broadcast()
-    moved = halves.glowworm_move()
-    step = whole.glowworm_step()
-    assert step is not None
-    assert sent is not None
-    assert (step.index, step.luciferin) == (sent.index, sent.luciferin)
-    np.testing.assert_array_equal(step.position_m, sent.position_m)
-    np.testing.assert_array_equal(whole.waypoint_m, moved)

@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 import pytest
-from bayes_swarm.conversions import peer_update_to_ros
+from bayes_swarm.conversions import glowworm_peer_to_ros, peer_update_to_ros
 from bayes_swarm.messages import PeerUpdate
 from bayes_swarm.node import BayesSwarmNode
 from swarm_runtime.ros import Parameter, message_module, qos_profile_sensor_data
@@ -115,3 +115,33 @@ def test_peer_messages_with_absurd_contents_are_dropped_and_counted(graph):
     assert bed.spin_until(lambda: 'r1' in node.planner.peer_waypoints)
     assert node.planner.n_observations == 0
     assert node.planner.peer_waypoints['r1'] == pytest.approx([1.0, 1.0])
+
+
+def test_a_glowworm_robot_broadcasts_and_steps_toward_a_brighter_peer():
+    # After its dispersal leg the node's Glowworm timer publishes its luciferin and heads
+    # for the brighter peer it heard.
+    overrides = [
+        Parameter('algorithm', value='glowworm'),
+        Parameter('robot_index', value=0),
+        Parameter('n_robots', value=2),
+    ]
+    with NodeTestBed() as bed:
+        node = bed.add_node(BayesSwarmNode, namespace='/r0', parameter_overrides=overrides)
+        sent = bed.probe.collect('/r0/peers/out', swarm.GlowwormPeer)
+        sensor_qos = qos_profile_sensor_data
+        odometry = bed.probe.player('/r0/odom', nav.Odometry, sensor_qos, period_s=0.05)
+        signal = bed.probe.player('/r0/signal', swarm.SignalSample, sensor_qos, period_s=0.05)
+        peers = bed.probe.player('/r0/peers/in', swarm.GlowwormPeer, 10, period_s=0.05)
+        bed.wait_for_graph()
+        odometry.play(odom(1.0, 1.0))
+        assert bed.spin_until(lambda: node.decisions)
+        x, y = node.controller.waypoint_m
+        odometry.play(odom(float(x), float(y)))  # arrived: the dispersal leg is over
+        peers.play(glowworm_peer_to_ros('r1', 1, np.array([x + 0.5, y]), 100.0, 1.0))
+        signal.play(swarm.SignalSample(value=1.0))
+        assert bed.spin_until(lambda: sent and node.controller.waypoint_m[0] > x + 0.01)
+        first = sent[0]
+        assert first.robot == 'r0'
+        assert (first.position_x, first.position_y) == pytest.approx((x, y))
+        assert first.luciferin == pytest.approx(0.6 * 5.0 + 0.6 * 1.0)
+        assert node.controller.waypoint_m[1] == pytest.approx(y)
