@@ -52,6 +52,7 @@ __all__ = [
     'ros_time_s',
     'run_events',
     'run_mission',
+    'with_glowworm_clock',
 ]
 
 Algorithm = Literal['bayes_swarm_p', 'bayes_swarm_o', 'glowworm', 'levy', 'exhaustive']
@@ -207,9 +208,7 @@ def run_mission(
         raise ConfigError(msg)
     glowworm = algorithm == 'glowworm'
     if glowworm:
-        # The spawner's rule: Glowworm robots sample at their decision rate.
-        rate_hz = spec.glowworm.decision_rate_hz
-        spec = replace(spec, planner=replace(spec.planner, observation_rate_hz=rate_hz))
+        spec = with_glowworm_clock(spec)
     controllers = [
         RobotController(robot_settings(spec, algorithm, n_robots, i, seed), f'r{i}')
         for i in range(n_robots)
@@ -219,6 +218,13 @@ def run_mission(
     if keep_planners:
         result.planners = [c.planner for c in controllers if c.planner is not None]
     return result
+
+
+def with_glowworm_clock(spec: MissionSpec) -> MissionSpec:
+    """``spec`` with the observation clock at the Glowworm decision rate: Glowworm robots
+    sample, and iterate, at that rate (the spawner's rule too)."""
+    rate_hz = spec.glowworm.decision_rate_hz
+    return replace(spec, planner=replace(spec.planner, observation_rate_hz=rate_hz))
 
 
 # --------------------------------------------------------------------------- robots
@@ -405,6 +411,7 @@ def run_events(
         # Lockstep, as GSO is defined: every robot broadcasts its new luciferin, then every
         # robot picks its leader from the broadcasts of this iteration.
         stamp = ros_time_s(t)
+        link_state = links()
         moving: list[int] = []
         for i, robot in enumerate(robots):
             if dropped[i]:
@@ -415,7 +422,7 @@ def run_events(
             moving.append(i)
             if broadcast.index == 1:  # the end of the dispersal leg
                 world.trajectories[i].append(world.positions[i].copy())
-            _deliver(spec, world, robots, i, broadcast, stamp, links())
+            _deliver(spec, world, robots, i, broadcast, stamp, link_state)
         for i in moving:
             waypoint = robots[i].glowworm_move(stamp)
             if waypoint is None:

@@ -36,6 +36,7 @@ import numpy as np
 from bayes_swarm.controller import robot_seed
 from bayes_swarm.planner import first_heading_rad
 from bayes_swarm.profiles import PROFILES, profile_options
+from bayes_swarm.settings import GlowwormConfig
 from sim_bridge.mission_file import signal_entry
 from sim_bridge.signal_extension import SignalExtension
 from swarm_common.cli import (
@@ -117,7 +118,6 @@ DEFAULT_RECORD_TOPICS = (
 #: The topics the robots' nodes subscribe to (bayes_swarm.node): what ``--record-topics sensors``
 #: adds so that a bag replays into a node.
 SENSOR_TOPICS = ('/r*/odom', '/r*/signal', '/r*/peers/in')
-GLOWWORM_RATE_HZ = 100.0
 #: Largest swarm the spawner runs: every robot is a node in this one process. The papers'
 #: largest swarm is 100 (Case 3); bayes_batch runs larger ones without nodes.
 MAX_ROBOTS = 100
@@ -393,8 +393,9 @@ def run(
 
     case = _check(settings)
     if settings.algorithm == 'glowworm':
-        # Glowworm decides at 100 Hz on fresh samples (the paper's observation frequency 100).
-        case = replace(case, observation_rate_hz=GLOWWORM_RATE_HZ)
+        # Glowworm nodes decide at their decision rate (100 Hz, the paper's observation
+        # frequency) on fresh samples: the signal is published at that rate.
+        case = replace(case, observation_rate_hz=GlowwormConfig().decision_rate_hz)
     n = settings.robots or case.default_robots
     layout = _robot_layout(case, n)
     poses = np.array(

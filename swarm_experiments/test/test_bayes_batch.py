@@ -119,7 +119,12 @@ def test_cobyla_waypoints_on_the_leg_constraint_are_kept_not_replaced_by_random_
 def test_glowworm_swarms_iterate_in_lockstep(case1_spec):
     # Every robot broadcasts before any robot of the same iteration picks its leader.
     from bayes_swarm.controller import RobotController
-    from swarm_experiments.bayes_batch import ControllerLink, robot_settings, run_events
+    from swarm_experiments.bayes_batch import (
+        ControllerLink,
+        robot_settings,
+        run_events,
+        with_glowworm_clock,
+    )
 
     log: list[tuple[float, str]] = []
 
@@ -136,9 +141,8 @@ def test_glowworm_swarms_iterate_in_lockstep(case1_spec):
                 log.append((time_s, 'move'))
             return out
 
-    rate_hz = case1_spec.glowworm.decision_rate_hz
-    planner = replace(case1_spec.planner, observation_rate_hz=rate_hz, max_mission_time_s=15.0)
-    spec = replace(case1_spec, planner=planner)
+    limited = replace(case1_spec.planner, max_mission_time_s=15.0)
+    spec = with_glowworm_clock(replace(case1_spec, planner=limited))
     links = [
         Logged(RobotController(robot_settings(spec, 'glowworm', 3, i, 4), f'r{i}'))
         for i in range(3)

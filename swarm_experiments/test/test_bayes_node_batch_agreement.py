@@ -30,6 +30,7 @@ from swarm_experiments.bayes_batch import (
     robot_settings,
     run_events,
     run_mission,
+    with_glowworm_clock,
 )
 from swarm_runtime.messages import get_message_module
 from swarm_runtime.ros import Parameter, SingleThreadedExecutor, Time, rclpy, using_real_rclpy
@@ -60,6 +61,13 @@ class NodeLink:
         probe.create_subscription(peer_type, f'/{name}/peers/out', self.outbox.append, 100)
         self.executor = executor
 
+    def _await_outbox(self) -> None:
+        """Spin until what the node published on peers/out has reached the probe."""
+        for _ in range(10):
+            if self.outbox:
+                break
+            self.executor.spin_once(timeout_sec=0.0)
+
     def _clock(self, time_s: float) -> None:
         self.node.get_clock().set_ros_time_override(Time(nanoseconds=round(time_s * 1e9)))
 
@@ -86,10 +94,7 @@ class NodeLink:
         self.timer.callback()
         if len(self.node.decisions) == before:
             return ControlOutput(0.0, 0.0)
-        for _ in range(10):
-            if self.outbox:
-                break
-            self.executor.spin_once(timeout_sec=0.0)
+        self._await_outbox()
         broadcast = peer_update_from_ros(self.outbox.pop()) if self.outbox else None
         return ControlOutput(0.0, 0.0, self.node.decisions[-1], broadcast)
 
@@ -98,10 +103,7 @@ class NodeLink:
         self._clock(time_s)
         if not self.node._broadcast_glowworm():
             return None
-        for _ in range(10):
-            if self.outbox:
-                break
-            self.executor.spin_once(timeout_sec=0.0)
+        self._await_outbox()
         sender, index, position, luciferin = glowworm_peer_from_ros(self.outbox.pop())
         assert sender == self.name
         return GlowwormBroadcast(index, position, luciferin)
@@ -151,9 +153,8 @@ class Recorder:
 
 def _node_run(spec: MissionSpec, algorithm: str, n: int, seed: int, wrap=lambda link: link):
     glowworm = algorithm == 'glowworm'
-    if glowworm:  # run_mission's rule: the robots sample at their decision rate
-        rate_hz = spec.glowworm.decision_rate_hz
-        spec = replace(spec, planner=replace(spec.planner, observation_rate_hz=rate_hz))
+    if glowworm:  # run_mission's rule
+        spec = with_glowworm_clock(spec)
     rclpy.init(args=[])
     probe = rclpy.create_node('probe')
     executor = SingleThreadedExecutor()
@@ -179,6 +180,20 @@ def _trace(result):
     ]
 
 
+def _assert_same_outcome(nodes, batch) -> None:
+    """Same trajectories, finder, detection and end time on both paths."""
+    for ours, theirs in zip(nodes.trajectories, batch.trajectories, strict=True):
+        np.testing.assert_array_equal(ours, theirs)
+    assert (nodes.found, nodes.finder, nodes.end_time_s) == (
+        batch.found,
+        batch.finder,
+        batch.end_time_s,
+    )
+    assert nodes.found_time_s == batch.found_time_s or (
+        np.isnan(nodes.found_time_s) and np.isnan(batch.found_time_s)
+    )
+
+
 @pytest.mark.parametrize(
     ('case_name', 'algorithm', 'robots', 'planner'),
     [
@@ -195,13 +210,7 @@ def test_node_and_batch_paths_take_identical_decisions_on_seeded_runs(
     nodes = _node_run(spec, algorithm, robots, seed=11)
     assert sum(len(d) for d in batch.decisions) > 3 * robots
     assert _trace(nodes) == _trace(batch)
-    for ours, theirs in zip(nodes.trajectories, batch.trajectories, strict=True):
-        np.testing.assert_array_equal(ours, theirs)
-    assert (nodes.found, nodes.finder, nodes.found_time_s) == (
-        batch.found,
-        batch.finder,
-        batch.found_time_s,
-    ) or (np.isnan(nodes.found_time_s) and np.isnan(batch.found_time_s))
+    _assert_same_outcome(nodes, batch)
 
 
 def test_glowworm_robots_iterate_identically_on_the_node_and_batch_paths():
@@ -220,8 +229,7 @@ def test_glowworm_robots_iterate_identically_on_the_node_and_batch_paths():
 
         return wrap
 
-    rate_hz = spec.glowworm.decision_rate_hz
-    glow_spec = replace(spec, planner=replace(spec.planner, observation_rate_hz=rate_hz))
+    glow_spec = with_glowworm_clock(spec)
     controllers = [
         RobotController(robot_settings(glow_spec, 'glowworm', 4, i, 11), f'r{i}') for i in range(4)
     ]
@@ -238,10 +246,4 @@ def test_glowworm_robots_iterate_identically_on_the_node_and_batch_paths():
     for ours, theirs in zip(node_recorders, batch_recorders, strict=True):
         assert len(theirs.steps) > 2000  # 100 Hz, two records an iteration, after dispersal
         assert ours.steps == theirs.steps
-    for ours, theirs in zip(nodes.trajectories, batch.trajectories, strict=True):
-        np.testing.assert_array_equal(ours, theirs)
-    assert (nodes.found, nodes.finder, nodes.end_time_s) == (
-        batch.found,
-        batch.finder,
-        batch.end_time_s,
-    )
+    _assert_same_outcome(nodes, batch)
