@@ -173,15 +173,16 @@ def test_compiled_scan_is_bit_identical_to_the_numpy_reference(thickness, num_bi
 
 
 def test_compiled_scan_is_bit_identical_on_a_generated_site():
-    from swarm_experiments.spawn import SpawnSettings, build_mission
+    from swarm_sim.departure import place_starts
     from swarm_sim.site_geometry import geometry_from_site
+    from swarm_sim.site_loading import load_site
 
-    spec, _ = build_mission(SpawnSettings(site='small', robots=10))
-    walls = geometry_from_site(spec.site).walls
+    site = load_site('small')
+    walls = geometry_from_site(site).walls
     caster = RayCaster(walls, wall_thickness_m=0.025, robot_radius_m=0.1, num_bins=360)
     rng = np.random.default_rng(7)
     lo, hi = walls.reshape(-1, 2).min(axis=0), walls.reshape(-1, 2).max(axis=0)
-    poses = np.asarray(spec.initial_poses, dtype=float)
+    poses = place_starts(site, 'center', 10).poses
     for _ in range(200):
         np.testing.assert_array_equal(caster.scan(poses, 12.0), caster.scan_reference(poses, 12.0))
         poses = np.column_stack(

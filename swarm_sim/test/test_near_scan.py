@@ -101,11 +101,11 @@ def test_near_scan_equals_the_full_scan_on_random_scenes(
 
 
 def test_near_scan_equals_the_full_scan_on_a_generated_site():
-    from swarm_experiments.spawn import SpawnSettings, build_mission
     from swarm_sim.site_geometry import geometry_from_site
+    from swarm_sim.site_loading import load_site
 
-    spec, _ = build_mission(SpawnSettings(site='medium', robots=10))
-    walls = geometry_from_site(spec.site).walls
+    site = load_site('medium')
+    walls = geometry_from_site(site).walls
     caster = RayCaster(walls, wall_thickness_m=0.025, robot_radius_m=0.1, num_bins=360)
     rng = np.random.default_rng(11)
     lo, hi = walls.reshape(-1, 2).min(axis=0), walls.reshape(-1, 2).max(axis=0)
