@@ -39,8 +39,9 @@ test-builtin: bootstrap
 # Test folders that never touch ROS (the layer test keeps them ROS-free): the real-rclpy leg
 # leaves them out, since they would only repeat the built-in leg. --ignore-glob, because
 # pytest's --ignore does not drop a folder that is itself one of the testpaths.
+# Tests elsewhere that cannot see the runtime are marked runtime_independent (conftest.py).
 ROS_FREE_TESTS := swarm_common/test swarm_sim/test swarm_experiments/test/study
-RCLPY_IGNORE := $(foreach d,$(ROS_FREE_TESTS),--ignore-glob='$(d)/*')
+RCLPY_IGNORE := $(foreach d,$(ROS_FREE_TESTS),--ignore-glob='$(d)/*') -m 'not runtime_independent'
 
 test-rclpy: bootstrap
 	@if $(PY) -c 'import rclpy' 2>/dev/null; then \

@@ -13,7 +13,11 @@ number, or the next id no other test process on the machine holds) and discovery
 this host (``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST``); both are set before rclpy is
 imported, and child processes that tests start inherit them (swarm_runtime.dds_isolation).
 Tests marked ``builtin_only(reason)`` hold only on the built-in runtime (bit-exact
-determinism, virtual wall time) and are skipped on real rclpy with their reason.
+determinism, virtual wall time) and are skipped on real rclpy with their reason. Tests
+marked ``runtime_independent(reason)`` cannot see which runtime is in use (batch runners,
+protocol parsers, processes that choose their runtime themselves); ``make test-rclpy``
+deselects them (``-m 'not runtime_independent'``), since they would only repeat the
+built-in leg, and such a test that starts a ROS node fails.
 
 The workspace's Python packages are imported here, from wherever they are installed (the
 development virtualenv or a colcon overlay), before pytest collects anything: pytest's
@@ -77,6 +81,11 @@ def pytest_configure(config: pytest.Config) -> None:
         'builtin_only(reason): holds only on the built-in runtime (bit-exact determinism, '
         'virtual wall time); skipped on real rclpy',
     )
+    config.addinivalue_line(
+        'markers',
+        'runtime_independent(reason): cannot see which ROS runtime is in use and starts no '
+        'node; make test-rclpy leaves it to the built-in leg',
+    )
     # rosidl's parser (imported by rclpy's type support) uses an old lark.
     config.addinivalue_line('filterwarnings', "ignore:module 'sre_:DeprecationWarning:lark")
     if os.environ.get('CI', '').lower() != 'true':
@@ -87,19 +96,45 @@ def pytest_configure(config: pytest.Config) -> None:
     settings.load_profile('ci')
 
 
+def _marker_reason(item: pytest.Item, name: str) -> str | None:
+    """The reason string of ``item``'s ``name`` marker; None without the marker."""
+    marker = item.get_closest_marker(name)
+    if marker is None:
+        return None
+    reason = marker.kwargs.get('reason') or (marker.args[0] if marker.args else '')
+    if not isinstance(reason, str) or not reason:
+        msg = f'{item.nodeid}: {name} needs a reason string'
+        raise pytest.UsageError(msg)
+    return reason
+
+
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
-    """On real rclpy, skip ``builtin_only`` tests, with their reason."""
-    marked = [(item, item.get_closest_marker('builtin_only')) for item in items]
-    marked = [(item, marker) for item, marker in marked if marker is not None]
-    for item, marker in marked:
-        reason = marker.kwargs.get('reason') or (marker.args[0] if marker.args else '')
-        if not isinstance(reason, str) or not reason:
-            msg = f'{item.nodeid}: builtin_only needs a reason string'
-            raise pytest.UsageError(msg)
+    """Check the markers' reasons; on real rclpy, skip ``builtin_only`` tests with theirs."""
+    for item in items:
+        _marker_reason(item, 'runtime_independent')
+    marked = [(item, _marker_reason(item, 'builtin_only')) for item in items]
     from swarm_runtime.ros import using_real_rclpy
 
     if not using_real_rclpy():
         return
-    for item, marker in marked:
-        reason = marker.kwargs.get('reason') or marker.args[0]
-        item.add_marker(pytest.mark.skip(reason=f'built-in runtime only: {reason}'))
+    for item, reason in marked:
+        if reason is not None:
+            item.add_marker(pytest.mark.skip(reason=f'built-in runtime only: {reason}'))
+
+
+@pytest.fixture(autouse=True)
+def _runtime_independent_starts_no_node(
+    request: pytest.FixtureRequest, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Fail a ``runtime_independent`` test that constructs a ROS node (of either runtime)."""
+    if request.node.get_closest_marker('runtime_independent') is None:
+        return
+    from swarm_runtime.ros import Node
+
+    nodeid = request.node.nodeid
+
+    def refuse(self: object, *args: object, **kwargs: object) -> None:
+        msg = f'{nodeid} is marked runtime_independent but starts a ROS node'
+        raise AssertionError(msg)
+
+    monkeypatch.setattr(Node, '__init__', refuse)

@@ -15,6 +15,8 @@ from urllib.parse import unquote
 
 import pytest
 
+pytestmark = pytest.mark.runtime_independent(reason='reads docs')
+
 ROOT = Path(__file__).resolve().parents[1]
 
 # Spelt in pieces so that this file does not name them itself.

@@ -15,7 +15,8 @@ imports, including those inside functions, are checked against the layer table:
 
 Nothing but swarm_experiments itself (and the scripts in benchmarks/, which are not a
 package) imports swarm_experiments. Each package's package.xml also declares every project
-package it imports.
+package it imports. The test folders that ``make test-rclpy`` leaves out (``ROS_FREE_TESTS``
+in the Makefile) reach no ROS module through any chain of project imports.
 """
 
 from __future__ import annotations
@@ -25,6 +26,8 @@ import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import pytest
+
+pytestmark = pytest.mark.runtime_independent(reason='reads source files')
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -86,6 +89,80 @@ def _imports(path: Path) -> set[str]:
         elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
             names.add(node.module)
     return names
+
+
+def _module_file(name: str) -> Path | None:
+    """The source file of the project module ``name``; None for anything else."""
+    parts = name.split('.')
+    root = PACKAGE_DIRS.get(parts[0])
+    if root is None:
+        return None
+    base = root.joinpath(*parts)
+    for candidate in (base / '__init__.py', base.with_suffix('.py')):
+        if candidate.is_file():
+            return candidate
+    return None
+
+
+def _module_name(path: Path) -> str | None:
+    """The dotted name of a project module's file; None for a file outside the packages."""
+    for package, root in PACKAGE_DIRS.items():
+        if path.is_relative_to(root / package):
+            parts = path.relative_to(root).with_suffix('').parts
+            return '.'.join(parts[:-1] if parts[-1] == '__init__' else parts)
+    return None
+
+
+def _imported_names(path: Path) -> set[str]:
+    """Modules ``path`` imports, with ``from a import b`` also as ``a.b`` and relative
+    imports of project modules resolved."""
+    own = _module_name(path)
+    package = (own if path.name == '__init__.py' else own.rpartition('.')[0]) if own else None
+    names: set[str] = set()
+    for node in ast.walk(ast.parse(path.read_text(), filename=str(path))):
+        if isinstance(node, ast.Import):
+            names.update(alias.name for alias in node.names)
+        elif isinstance(node, ast.ImportFrom):
+            if node.level == 0:
+                base = node.module or ''
+            elif package:
+                anchor = package.split('.')[: len(package.split('.')) - node.level + 1]
+                base = '.'.join([*anchor, *([node.module] if node.module else [])])
+            else:
+                continue
+            names.add(base)
+            names.update(f'{base}.{alias.name}' for alias in node.names)
+    return names
+
+
+def _reachable_imports(path: Path) -> set[str]:
+    """Every module imported by ``path`` or, at any depth, by the project modules it imports
+    (inside functions too: what a call could import)."""
+    reached: set[str] = set()
+    seen: set[Path] = set()
+    pending = [path]
+    while pending:
+        current = pending.pop()
+        if current in seen:
+            continue
+        seen.add(current)
+        for name in _imported_names(current):
+            reached.add(name)
+            parts = name.split('.')
+            for depth in range(1, len(parts) + 1):
+                found = _module_file('.'.join(parts[:depth]))
+                if found is not None:
+                    pending.append(found)
+    return reached
+
+
+def _make_variable(name: str) -> list[str]:
+    """The words of a ``NAME := ...`` line of the Makefile."""
+    for line in (REPO / 'Makefile').read_text().splitlines():
+        if line.startswith(f'{name} :='):
+            return line.split(':=', 1)[1].split()
+    msg = f'the Makefile sets no {name}'
+    raise AssertionError(msg)
 
 
 def _top_levels(path: Path) -> set[str]:
@@ -184,3 +261,32 @@ def test_package_xml_declares_every_project_package_imported(package: str) -> No
     imported = set().union(*(_top_levels(path) for path in _modules(package)))
     missing = sorted((imported & set(PACKAGE_DIRS)) - {package} - declared)
     assert not missing, f'{package}/package.xml lacks exec_depend {missing}'
+
+
+def test_reachable_imports_follow_the_project_modules_and_resolve_relative_ones(
+    tmp_path: Path,
+) -> None:
+    test_file = tmp_path / 'test_example.py'
+    test_file.write_text('def test_it():\n    from swarm_experiments import mission\n')
+    reached = _reachable_imports(test_file)
+    # mission imports the sim bridge, whose node imports the ROS indirection.
+    assert 'sim_bridge.bridge_node' in reached
+    assert 'swarm_runtime.ros' in reached
+    builtin_node = REPO / 'src' / 'swarm_runtime' / 'swarm_runtime' / 'builtin' / 'node.py'
+    assert _module_name(builtin_node) == 'swarm_runtime.builtin.node'
+    assert any(name.startswith('swarm_runtime.builtin.') for name in _imported_names(builtin_node))
+
+
+def test_the_test_folders_the_rclpy_leg_leaves_out_reach_no_ros() -> None:
+    folders = _make_variable('ROS_FREE_TESTS')
+    assert folders
+    wrong = []
+    for folder in folders:
+        files = sorted((REPO / folder).rglob('*.py'))
+        assert files, folder
+        for path in files:
+            reached = _reachable_imports(path)
+            ros = sorted(name for name in reached if name.split('.')[0] in ROS_MODULES)
+            if ros:
+                wrong.append(f'{_relative(path)} reaches {", ".join(ros[:3])}')
+    assert not wrong, '\n'.join(wrong)

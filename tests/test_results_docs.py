@@ -13,6 +13,10 @@ import re
 import sys
 from pathlib import Path
 
+import pytest
+
+pytestmark = pytest.mark.runtime_independent(reason='reads result files and docs')
+
 REPO = Path(__file__).resolve().parents[1]
 
 

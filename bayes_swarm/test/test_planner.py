@@ -17,6 +17,8 @@ from bayes_swarm.planner import (
 )
 from bayes_swarm.settings import Arena, BayesSwarmConfig, GlowwormConfig, GpConfig, LevyConfig
 
+pytestmark = pytest.mark.runtime_independent(reason='the algorithm core')
+
 
 def case1_field(points):
     """Appendix C, Eq. 19 (source at (1, 2), weaker bump at (2, 0.5))."""

@@ -27,6 +27,10 @@ from pathlib import Path
 import pytest
 from hw_drivers.robot_bringup import cli
 
+pytestmark = pytest.mark.runtime_independent(
+    reason='every driver process is started with the runtime it asks for'
+)
+
 DRIVER_MODULES = {
     'rplidar_node': 'hw_drivers.rplidar_node',
     'gas_adc_node': 'hw_drivers.gas_node',

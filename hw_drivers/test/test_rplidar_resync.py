@@ -22,6 +22,8 @@ from hw_drivers.rplidar_protocol import (
 from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
+pytestmark = pytest.mark.runtime_independent(reason='protocol parser on recorded bytes')
+
 PROPERTY = settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 MIN_RUN = ResyncConfig().min_run
 # Samples one stray run in junk can give: junk that happens to pass the check bits, the angle

@@ -20,6 +20,8 @@ from msc_pf.settings import ParticleFilterConfig, RadioConfig
 
 from msc_pf import particle_filter
 
+pytestmark = pytest.mark.runtime_independent(reason='the algorithm core')
+
 RADIO = RadioConfig()
 FIELD_M = 2000.0
 

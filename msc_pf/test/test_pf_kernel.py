@@ -12,6 +12,8 @@ import pytest
 from msc_pf.particle_filter import ParticleFilterBank, systematic_index
 from msc_pf.settings import ParticleFilterConfig, RadioConfig
 
+pytestmark = pytest.mark.runtime_independent(reason='the algorithm core')
+
 pf_kernel = pytest.importorskip('msc_pf.pf_kernel')
 
 RADIO = RadioConfig()

@@ -9,6 +9,8 @@ from msc_pf.peers import NO_TARGET, PeerInfo, Phase, Role
 from msc_pf.robot import RobotController
 from msc_pf.settings import MscPfConfig, PhaseConfig, RadioConfig
 
+pytestmark = pytest.mark.runtime_independent(reason='the algorithm core')
+
 RADIO = RadioConfig()
 HOME = np.array([1000.0, 1000.0])
 

@@ -23,6 +23,8 @@ from oabug_robot.scan_features_kernel import (
 from oabug_robot.settings import PerceptionConfig
 from oabug_robot.sound import PeerBearings
 
+pytestmark = pytest.mark.runtime_independent(reason='the algorithm core')
+
 
 def _scan(
     ranges: np.ndarray, *, angle_min: float = -math.pi, range_min: float = 0.15

@@ -9,6 +9,8 @@ from bayes_swarm.messages import DecisionKind
 from swarm_common.segments import first_entry_fraction
 from swarm_experiments.bayes_batch import run_mission
 
+pytestmark = pytest.mark.runtime_independent(reason='the batch runner, no node')
+
 
 def test_detection_happens_at_the_first_entry_into_the_epsilon_disc():
     frac = first_entry_fraction(

@@ -12,6 +12,8 @@ from swarm_experiments.study import (
     parse_overrides,
 )
 
+pytestmark = pytest.mark.runtime_independent(reason='batch runs and reports, no node')
+
 EXPECTED = {
     'bayes-table1-2-optimizers',
     'bayes-table3-baselines',

@@ -22,6 +22,8 @@ from swarm_sim.faults import FaultConfig, FaultPlan
 from swarm_sim.sensor_profiles import apply_sensor_profile
 from swarm_sim.site_geometry import geometry_from_site
 
+NO_NODE = pytest.mark.runtime_independent(reason='batch runs, no node')
+
 FIVE_ROOMS = Path(__file__).parent / 'data' / 'five_rooms.lay'
 
 
@@ -88,6 +90,7 @@ class PushWatch:
         self.longest_s = np.fmax(self.longest_s, now - self.since)
 
 
+@NO_NODE
 @pytest.mark.slow
 def test_survivors_never_push_into_a_wall_and_lidarless_robots_stop_with_the_pump_off():
     onset = 20.0
@@ -127,6 +130,7 @@ def test_survivors_never_push_into_a_wall_and_lidarless_robots_stop_with_the_pum
     assert engine.distance_travelled_m[working].min() > 10.0
 
 
+@NO_NODE
 @pytest.mark.slow
 def test_robots_touching_side_by_side_do_not_push_for_ever():
     # Site 5 from the edge: at 14 s two robots touch, each beside the other's front outside
@@ -162,6 +166,7 @@ def test_robots_touching_side_by_side_do_not_push_for_ever():
     assert longest_push(0.0) > 20.0  # the rule off: the old dead lock
 
 
+@NO_NODE
 def test_a_bayes_swarm_without_some_robots_still_finds_the_source(case1_spec):
     full = run_bayes(case1_spec, 'bayes_swarm_p', 5, seed=3)
     faults = FaultConfig(dropout_robots=2, dropout_time_s=5.0)
@@ -187,6 +192,7 @@ def test_a_bayes_swarm_without_some_robots_still_finds_the_source(case1_spec):
     assert alone.found_time_s != full.found_time_s
 
 
+@NO_NODE
 @pytest.mark.slow
 def test_dropped_msc_robots_stand_still_and_capture_nothing():
     targets = np.array([[1150.0, 1080.0], [820.0, 900.0]])
@@ -213,6 +219,7 @@ def test_dropped_msc_robots_stand_still_and_capture_nothing():
     assert driven.min() > 50.0
 
 
+@NO_NODE
 def test_msc_link_faults_act_in_the_relay_and_dropped_robots_go_silent():
     base = BatchScenario(scheme=Scheme.PROPOSED, n_robots=4, n_targets=2, seed=5, max_time_s=150.0)
     deaf = run_batch(
@@ -234,6 +241,7 @@ def test_msc_link_faults_act_in_the_relay_and_dropped_robots_go_silent():
     assert np.array_equal(alone.paths_m[:, survivor], solo.paths_m[:, survivor])
 
 
+@NO_NODE
 def test_faults_of_sensors_the_point_robot_runners_lack_are_refused(case1_spec):
     from bayes_swarm.errors import ConfigError as BayesConfigError
     from msc_pf.errors import ConfigError as MscConfigError
@@ -246,6 +254,7 @@ def test_faults_of_sensors_the_point_robot_runners_lack_are_refused(case1_spec):
         run_batch(gas)
 
 
+@NO_NODE
 def test_still_time_measures_the_longest_stop():
     times = np.arange(6.0)
     positions = np.array([[0, 0], [1, 0], [1, 0], [1, 0.01], [2, 0], [3, 0]], dtype=float)
@@ -254,6 +263,7 @@ def test_still_time_measures_the_longest_stop():
     assert still_time_s(times, driving) == 0.0
 
 
+@NO_NODE
 def test_fault_scenarios_and_options_parse_and_bad_ones_fail_in_one_line(capsys):
     config = parse_fault('dropout_robots=2,comm_loss_probability=0.5', 30.0)
     assert (config.dropout_robots, config.dropout_time_s) == (2, 30.0)
@@ -274,6 +284,7 @@ def test_fault_scenarios_and_options_parse_and_bad_ones_fail_in_one_line(capsys)
     assert math.isinf(FaultConfig().comm_range_m)
 
 
+@NO_NODE
 def test_glowworm_robots_run_under_faults(case1_spec):
     spec = dataclasses.replace(
         case1_spec,

@@ -7,6 +7,8 @@ import pytest
 from msc_pf.schemes import Scheme
 from swarm_experiments.msc_pf_batch import BatchScenario, run_batch
 
+pytestmark = pytest.mark.runtime_independent(reason='the batch runner, no node')
+
 TARGETS = np.array([[1150.0, 1080.0], [820.0, 900.0]])
 
 

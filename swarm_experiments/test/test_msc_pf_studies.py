@@ -31,6 +31,8 @@ from swarm_experiments.study import (
     write_reports,
 )
 
+pytestmark = pytest.mark.runtime_independent(reason='batch runs and reports, no node')
+
 NAMES = ('msc_pf-fig4', 'msc_pf-beyond', 'msc_pf-beyond-robots')
 
 

@@ -15,6 +15,8 @@ from swarm_experiments.study.errors import UsageError
 from swarm_experiments.study.report import write_reports
 from swarm_experiments.study.runner import run_study
 
+pytestmark = pytest.mark.runtime_independent(reason='batch runs and reports, no node')
+
 
 def test_the_study_is_registered_with_the_papers_design():
     study = load_registry().get(FIG4)

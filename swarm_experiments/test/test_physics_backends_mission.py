@@ -14,6 +14,8 @@ from swarm_sim.geometry import point_segment_distance
 from swarm_sim.site_geometry import geometry_from_site
 from swarm_sim.site_loading import load_site
 
+NO_NODE = pytest.mark.runtime_independent(reason='batch runs and refused options, no node')
+
 # Robot radius plus half the wall thickness: a robot centre closer than this to a wall's
 # centre line would be inside the wall (1 mm allowed for pybullet's contact tolerance).
 CONTACT_M = 0.1 + 0.0125 - 1e-3
@@ -29,6 +31,7 @@ POSITION_M = 1.0
 ENTRY_TIME_S = 1.0
 
 
+@NO_NODE
 @pytest.mark.slow
 def test_one_mission_on_both_backends_agrees_within_the_documented_tolerances():
     pytest.importorskip('pybullet', reason='pybullet is not installed (Python > 3.11?)')
@@ -76,6 +79,7 @@ def test_one_mission_on_both_backends_agrees_within_the_documented_tolerances():
         assert abs(a.time_s - b.time_s) <= ENTRY_TIME_S
 
 
+@NO_NODE
 def test_spawner_refuses_rendering_without_pybullet_physics_in_one_line(capsys):
     from swarm_experiments.spawn import main
 
@@ -85,6 +89,7 @@ def test_spawner_refuses_rendering_without_pybullet_physics_in_one_line(capsys):
     assert err.count('\n') == 1
 
 
+@NO_NODE
 def test_spawner_refuses_a_malformed_render_option(capsys):
     from swarm_experiments.spawn import main
 
@@ -107,6 +112,7 @@ def test_spawner_runs_on_pybullet_and_writes_frames(tmp_path, capsys):
     assert (frames / 'run.gif').stat().st_size > 0
 
 
+@NO_NODE
 @pytest.mark.parametrize('spawner', ['spawn', 'spawn_bayes_swarm', 'spawn_msc_pf'])
 def test_spawners_refuse_pybullet_physics_without_pybullet_in_one_line(
     spawner, monkeypatch, capsys, tmp_path

@@ -9,6 +9,8 @@ import pytest
 from swarm_sim.engine import EngineConfig
 from swarm_sim.sensor_profiles import RealisticSensors, apply_sensor_profile
 
+pytestmark = pytest.mark.runtime_independent(reason='batch runs, no node')
+
 
 @pytest.fixture
 def effects(benchmark_script):

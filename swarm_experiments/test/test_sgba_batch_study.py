@@ -23,6 +23,8 @@ from swarm_experiments.study.report import write_reports
 from swarm_experiments.study.runner import run_study
 from swarm_sim.errors import ConfigurationError
 
+NO_NODE = pytest.mark.runtime_independent(reason='batch runs and reports, no node')
+
 
 @pytest.mark.builtin_only(reason='bit-exact determinism of the in-process ROS path')
 def test_batch_and_ros_paths_give_the_same_poses_and_first_entries():
@@ -37,6 +39,7 @@ def test_batch_and_ros_paths_give_the_same_poses_and_first_entries():
     assert batch.room_entries == ros.room_entries
 
 
+@NO_NODE
 def test_the_same_seed_gives_the_same_run_and_another_seed_another():
     def run(seed: int):
         spec, _ = build_sgba_mission(SgbaSettings(robots=3, seed=seed, site_seed=0, actions=60))
@@ -46,6 +49,7 @@ def test_the_same_seed_gives_the_same_run_and_another_seed_another():
     assert not np.array_equal(run(1), run(2))
 
 
+@NO_NODE
 def test_the_mission_sets_its_own_parameters_and_refuses_them_from_users():
     spec, _ = build_sgba_mission(SgbaSettings(robots=3, departure='edge', seed=4))
     params = [robot.parameters for robot in spec.robots]
@@ -59,6 +63,7 @@ def test_the_mission_sets_its_own_parameters_and_refuses_them_from_users():
         run_sgba_batch(spec)
 
 
+@NO_NODE
 def test_the_study_is_registered_with_oabug_rows_first():
     study = load_registry().get(SGBA_VS_OABUG)
     plan = make_specs(study)
@@ -74,6 +79,7 @@ def test_the_study_is_registered_with_oabug_rows_first():
     assert _sgba_overrides(scaled.config) == {'geometry_scale': 0.7}, 'a setting wins'
 
 
+@NO_NODE
 @pytest.mark.parametrize(
     ('name', 'value', 'message'),
     [
@@ -88,6 +94,7 @@ def test_bad_parameters_are_refused_before_any_run(name, value, message):
         make_specs(study, overrides={name: value}, smoke=True)
 
 
+@NO_NODE
 def test_a_named_choice_is_accepted_as_the_spawner_accepts_it():
     (study,) = studies()
     plan = make_specs(study, overrides={'sgba.heading_scheme': 'authors'}, smoke=True)
@@ -96,6 +103,7 @@ def test_a_named_choice_is_accepted_as_the_spawner_accepts_it():
     assert all(_sgba_overrides(spec.config)['heading_scheme'] == 'authors' for spec in sgba)
 
 
+@NO_NODE
 def test_smoke_runs_both_methods_and_reports_the_paired_comparison(tmp_path):
     import matplotlib
 
@@ -118,6 +126,7 @@ def test_smoke_runs_both_methods_and_reports_the_paired_comparison(tmp_path):
     assert methods.index('gas_sound') < methods.index('sgba_scaled')  # OA-Bug leads
 
 
+@NO_NODE
 def test_an_sgba_run_records_the_coverage_curve():
     (study,) = studies()
     plan = make_specs(
