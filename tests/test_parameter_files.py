@@ -81,6 +81,7 @@ ADDED = {
         'penalty_log_space': False,
         'cobyla_library': 'nlopt',
         'signal_scale': 1.0,
+        'weaker_source_within_eps': False,
     },
 }
 # Defaults changed on purpose since the recording (name -> new default): the Bayes-Swarm

@@ -2,7 +2,8 @@
 
 Algorithm 2 compares squared distances with 2 * l_robot:
 
-* a known weaker source within reach of the expected source x_star -> alpha = 0.1;
+* a known weaker source within reach of the expected source x_star -> alpha = 0.1 (with
+  ``weaker_source_radius_m`` set: within that distance instead, not in the paper);
 * otherwise, no peer heading to x_star -> alpha = 0.8;
 * otherwise the time schedule alpha = 1 / (1 + exp(-10 (t / T_max - 1/3))).
 
@@ -64,10 +65,16 @@ def exploitation_weight(
     time_s: float,
     max_mission_time_s: float,
     time_scale: float = 1.0,
+    weaker_source_radius_m: float | None = None,
 ) -> AlphaDecision:
-    """Algorithm 2: alpha for the expected source (2,), peers' waypoints (p, 2), weaker (w, 2)."""
+    """Algorithm 2: alpha for the expected source (2,), peers' waypoints (p, 2), weaker (w, 2).
+
+    ``weaker_source_radius_m`` replaces the weaker-source test's squared distance
+    < 2 l_robot (the paper's) by distance < the radius.
+    """
     threshold = 2.0 * robot_size_m
-    if _min_squared_distance(weaker_sources_m, expected_source_m) < threshold:
+    weak_threshold = threshold if weaker_source_radius_m is None else weaker_source_radius_m**2
+    if _min_squared_distance(weaker_sources_m, expected_source_m) < weak_threshold:
         return AlphaDecision(WEAKER_SOURCE_ALPHA, AlphaBranch.WEAKER_SOURCE)
     if _min_squared_distance(peer_waypoints_m, expected_source_m) >= threshold:
         return AlphaDecision(NO_PEER_ALPHA, AlphaBranch.NO_PEER_NEAR)

@@ -422,6 +422,9 @@ class BayesSwarmPlanner:
                 peer_waypoints,
                 self.weaker_sources,
                 robot_size_m=cfg.robot_size_m,
+                weaker_source_radius_m=(
+                    cfg.detection_radius_m if cfg.weaker_source_within_eps else None
+                ),
                 time_s=time_s,
                 max_mission_time_s=cfg.max_mission_time_s,
                 time_scale=cfg.alpha_time_scale,

@@ -14,6 +14,10 @@ profiles are this project's departures, each listed in docs/bayes_swarm.md.
   robot's belief at every decision as in Gonzalez et al.'s local penalization (M the largest
   observation, L the largest gradient norm of the GP mean over the arena), instead of the
   fixed values.
+* ``weaker-within-eps``: the paper's solvers, L, M and T_max; Algorithm 2 lowers alpha to
+  0.1 only when the expected source lies within eps of a known weaker source (the disc its
+  robot searched and found empty), instead of within a squared distance of 2 l_robot
+  (0.45 m for l_robot = 0.1 m, three times the avalanche's eps).
 """
 
 from __future__ import annotations
@@ -49,6 +53,11 @@ PROFILES: dict[str, Profile] = {
             'estimated-penalty',
             "the paper's solvers; L and M estimated from the belief GP (local penalization)",
             {'penalty_estimate': True},
+        ),
+        Profile(
+            'weaker-within-eps',
+            "the paper's solvers, L, M, T_max; a weaker source holds alpha down within eps only",
+            {'weaker_source_within_eps': True},
         ),
     )
 }

@@ -191,6 +191,11 @@ class BayesSwarmConfig:
         'maximise log(acquisition) + sum log(penalty factors), as GPyOpt (not in the paper)',
     )
     robot_size_m: float = parameter(0.1, 'l_robot of Algorithm 2', unit='m', gt=0.0)
+    weaker_source_within_eps: bool = parameter(
+        False,
+        'alpha = 0.1 only when the expected source lies within eps of a known weaker source, '
+        'the disc its robot searched (not in the paper: squared distance < 2 l_robot)',
+    )
     n_max: int = parameter(1000, 'N_max: observations kept for the GP after downsampling', ge=1)
     alpha_time_scale: float = parameter(
         1.0, 'Factor on T_max in the alpha schedule (code: 0.1)', gt=0.0

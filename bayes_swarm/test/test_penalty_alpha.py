@@ -89,7 +89,7 @@ def test_time_scale_reproduces_the_authors_faster_schedule():
     assert scheduled_alpha(10.0, 100.0, time_scale=0.1) == pytest.approx(0.9987, abs=1e-4)
 
 
-def weight(peers, weaker, t=20.0):
+def weight(peers, weaker, t=20.0, weaker_radius=None):
     return exploitation_weight(
         np.array([1.0, 2.0]),
         np.asarray(peers, float).reshape(-1, 2),
@@ -97,12 +97,23 @@ def weight(peers, weaker, t=20.0):
         robot_size_m=0.1,
         time_s=t,
         max_mission_time_s=100.0,
+        weaker_source_radius_m=weaker_radius,
     )
 
 
 def test_alpha_is_low_when_the_expected_source_is_a_known_weaker_source():
     result = weight([[1.0, 2.0]], [[1.1, 2.0]])
     assert (result.value, result.branch) == (0.1, AlphaBranch.WEAKER_SOURCE)
+
+
+def test_a_weaker_source_radius_replaces_the_squared_distance_test():
+    # 0.3 m away: squared distance 0.09 < 2 l_robot = 0.2, so the paper's test holds it down.
+    assert weight([], [[1.3, 2.0]]).branch is AlphaBranch.WEAKER_SOURCE
+    assert weight([], [[1.3, 2.0]], weaker_radius=0.15).branch is AlphaBranch.NO_PEER_NEAR
+    assert weight([], [[1.1, 2.0]], weaker_radius=0.15).branch is AlphaBranch.WEAKER_SOURCE
+    # The peers' test keeps the paper's threshold.
+    peer = weight([[1.3, 2.0]], [], t=50.0, weaker_radius=0.15)
+    assert peer.branch is AlphaBranch.SCHEDULE
 
 
 def test_alpha_is_point_eight_when_no_peer_heads_to_the_expected_source():

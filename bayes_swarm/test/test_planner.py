@@ -154,6 +154,26 @@ def test_reaching_an_expected_source_that_is_not_the_source_marks_it_weaker_and_
     assert np.hypot(*(decision.waypoint_m - 2.0)) >= cfg.step_m
 
 
+@pytest.mark.parametrize(('within_eps', 'alpha'), [(False, 0.1), (True, 0.8)])
+def test_a_weaker_source_near_the_expected_one_holds_alpha_down_unless_only_eps_counts(
+    within_eps, alpha
+):
+    cfg = BayesSwarmConfig(
+        arena=Arena(0, 4, 0, 4), detection_radius_m=0.15, weaker_source_within_eps=within_eps
+    )
+    planner = BayesSwarmPlanner(cfg, 'r0', seed=0)
+    planner.decide([1, 1], 0.0)
+    rng = np.random.default_rng(0)
+    pts = rng.uniform(0, 4, size=(80, 2))
+    planner.add_observations(pts, np.exp(-((pts - 2.0) ** 2).sum(1)))  # peak at (2, 2)
+    # A peer searched 0.3 m from the peak: within 2 l_robot (squared), outside eps.
+    mark = np.array([[2.3, 2.0]])
+    planner.receive(PeerUpdate('r1', 1, np.zeros(2), np.ones(2), np.zeros((0, 2)), [], mark))
+    decision = planner.decide([1.0, 1.0], 20.0)
+    assert decision.expected_source_m == pytest.approx([2.0, 2.0], abs=0.05)
+    assert decision.alpha == alpha
+
+
 @pytest.mark.parametrize(
     ('factory', 'match'),
     [
