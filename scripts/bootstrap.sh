@@ -5,7 +5,8 @@
 # where they exist (scripts/install_ros_wheels.sh).
 #
 # Safe to run repeatedly: it does nothing when the virtualenv is already up to date.
-# Environment: PYTHON (interpreter for the virtualenv, default python3), VENV (default .venv).
+# Environment: PYTHON (interpreter for the virtualenv, default python3), VENV (default .venv),
+# INSTALLER=pip to install with pip instead of uv (scripts/venv_install.sh).
 set -euo pipefail
 
 cd "$(dirname "$0")/.."
@@ -46,10 +47,9 @@ install_python_packages() {
   fi
   [ -x "$VENV/bin/python" ] || { log "creating $VENV with $($PYTHON --version)"; "$PYTHON" -m venv "$VENV"; }
   log "installing Python packages (versions from constraints.txt)"
-  "$VENV/bin/python" -m pip install -q --upgrade pip
   local editable=()
   for pkg in "${PACKAGES[@]}"; do editable+=(-e "$pkg${EXTRAS[$pkg]:+[${EXTRAS[$pkg]}]}"); done
-  "$VENV/bin/python" -m pip install -q -c constraints.txt -r requirements-dev.txt "${editable[@]}"
+  scripts/venv_install.sh "$VENV" -c constraints.txt -r requirements-dev.txt "${editable[@]}"
   echo "$digest" > "$stamp"
 }
 

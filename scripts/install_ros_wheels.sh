@@ -70,9 +70,10 @@ rm -f "$STAMP"
 
 start=$SECONDS
 log "installing the ros-jazzy wheels into $VENV (versions from constraints-ros.txt)"
-if ! "$PY" -m pip install -q --disable-pip-version-check -c constraints.txt "${WHEELS[@]}"; then
+if ! scripts/venv_install.sh "$VENV" -c constraints.txt "${WHEELS[@]}"; then
   without_wheels "the ros-jazzy wheels could not be installed" fatal
 fi
+log "wheels installed in $((SECONDS - start)) s"
 
 need_tools=()
 command -v cmake >/dev/null || need_tools+=(cmake)
@@ -98,7 +99,7 @@ numpy_include=$("$PY" -c 'import numpy; print(numpy.get_include())')
 
 venv_abs=$(cd "$VENV" && pwd)
 build_interfaces() {
-  local src=$1 name
+  local src=$1 name began=$SECONDS
   name=$(basename "$src")
   log "generating $name with rosidl (cmake)"
   rm -rf "${BUILD:?}/$name"
@@ -114,6 +115,7 @@ build_interfaces() {
     exit 1
   fi
   rm -rf "${BUILD:?}/$name"
+  log "generated $name in $((SECONDS - began)) s"
 }
 
 mkdir -p "$BUILD"

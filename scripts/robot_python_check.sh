@@ -29,8 +29,7 @@ echo "[robot-python] $("$python" --version) in $VENV"
 [ -x "$VENV/bin/python" ] || "$python" -m venv "$VENV"
 editable=()
 for pkg in "${ROBOT_PACKAGES[@]}"; do editable+=(-e "$pkg"); done
-"$VENV/bin/python" -m pip install -q --upgrade pip
-"$VENV/bin/python" -m pip install -q -c constraints.txt pytest pytest-xdist hypothesis mcap mcap-ros2-support "${editable[@]}"
+scripts/venv_install.sh "$VENV" -c constraints.txt pytest pytest-xdist hypothesis mcap mcap-ros2-support "${editable[@]}"
 if "$VENV/bin/python" -c 'import pybullet' 2>/dev/null; then
   echo "[robot-python] pybullet must not be part of the robot install" >&2
   exit 1
