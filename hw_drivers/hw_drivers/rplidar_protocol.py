@@ -231,7 +231,10 @@ class ResyncConfig:
         edge_reference_samples: how far into the run that nearest return is looked for.
         compare_samples: after junk, the runs starting at ``compare_offsets`` consecutive
             offsets are compared over this many samples and the longest is taken...
-        compare_offsets: ...from the first offset where a run starts on.
+        compare_offsets: ...from the first offset where a run starts on...
+        min_turn_deg: ...and of runs as long, the one with the most links that turn by at
+            least this much [deg] (the A1 turns about 1 deg per sample; a run shifted
+            against the samples barely turns).
     """
 
     min_run: int = 4
@@ -242,6 +245,7 @@ class ResyncConfig:
     edge_reference_samples: int = 3
     compare_samples: int = 8
     compare_offsets: int = 15
+    min_turn_deg: float = 0.25
 
     def __post_init__(self) -> None:
         if self.min_run < 3:
@@ -256,6 +260,9 @@ class ResyncConfig:
             raise ConfigurationError(msg)
         if self.compare_samples < self.min_run:
             msg = f'compare_samples must be >= min_run, got {self.compare_samples}'
+            raise ConfigurationError(msg)
+        if not 0.0 <= self.min_turn_deg < self.max_angle_step_deg:
+            msg = f'min_turn_deg must be in [0, max_angle_step_deg), got {self.min_turn_deg}'
             raise ConfigurationError(msg)
         if self.edge_quality_step < 0 or self.edge_reference_samples < 1:
             raise ConfigurationError('edge_quality_step must be >= 0, edge_reference_samples >= 1')
@@ -321,6 +328,7 @@ class SampleStreamDecoder:
     def __init__(self, config: ResyncConfig | None = None) -> None:
         self.config = config or ResyncConfig()
         self._max_step_q6 = round(self.config.max_angle_step_deg * 64.0)
+        self._min_turn_q6 = round(self.config.min_turn_deg * 64.0)
         self._pending = _EMPTY
         self._last: npt.NDArray[np.uint8] | None = None  # last accepted sample while in a run
         self._recent: list[npt.NDArray[np.uint8]] = []  # the run's last accepted samples
@@ -383,23 +391,30 @@ class SampleStreamDecoder:
         Bytes where junk meets real samples can form a run shifted against the real samples
         by a few bytes, sometimes led in by a junk window or two. Its angles come from the
         samples' quality and distance bytes, which change slowly, so it barely turns; the
-        real samples form the longer run, or one as long that turns more. Runs are compared
-        over up to ``compare_samples`` samples by length, then by the angle they turn
-        through. None when the bytes needed to decide have not all arrived.
+        real samples form the longer run, or one as long in which more links turn. Runs are
+        compared over up to ``compare_samples`` samples by length, then by the number of
+        links that turn by at least ``min_turn_deg`` (not by the total angle: one junk link
+        that leads a shifted run in can turn further than the real run's links together),
+        then by the angle they turn through. None when the bytes needed to decide have not
+        all arrived.
         """
         cap = self.config.compare_samples - 1  # links
         width = self.config.compare_offsets
         if found + width - 1 + SAMPLE_SIZE * (cap - 1) >= n_links:
             return None
         lengths = np.zeros(width, dtype=np.int64)
+        turning = np.zeros(width, dtype=np.int64)
         turned = np.zeros(width, dtype=np.int64)
         alive = np.ones(width, dtype=bool)
         for k in range(cap):
             start = found + SAMPLE_SIZE * k
             alive &= link[start : start + width]
+            steps = step_q6[start : start + width]
             lengths += alive
-            turned += np.where(alive, step_q6[start : start + width], 0)
-        best = np.lexsort((-turned, -lengths))[0]  # longest first, then most turned
+            turning += alive & (steps >= self._min_turn_q6)
+            turned += np.where(alive, steps, 0)
+        # Longest first, then the most turning links, then the most turned.
+        best = np.lexsort((-turned, -turning, -lengths))[0]
         return found + int(best)
 
     def feed(self, data: bytes) -> ScanSamples:
