@@ -255,7 +255,12 @@ def _idle_drivers(tmp_path, runtime: str) -> dict[str, tuple[float, list[str]]]:
             args += ['--ros-args', '-p', 'listen_port:=0']
         running[driver] = _spawn(args, env)
     try:
-        time.sleep(5.0)  # imports, DDS discovery, the first failed attempts
+        # Start-up (imports, DDS discovery) ends with each driver's first report of its
+        # missing device; on a loaded machine that can take well over 5 s.
+        deadline = time.monotonic() + 60.0
+        while time.monotonic() < deadline and not all(out.lines for _, out in running.values()):
+            time.sleep(0.2)
+        time.sleep(1.0)
         start = {d: (_cpu_s(p.pid), len(out.lines)) for d, (p, out) in running.items()}
         time.sleep(10.0)
         result = {}
