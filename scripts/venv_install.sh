@@ -17,7 +17,9 @@ if [ "${INSTALLER:-uv}" != "pip" ] && [ ! -x "$venv/bin/uv" ]; then
     echo "[venv-install] uv could not be installed: using pip" >&2
 fi
 if [ "${INSTALLER:-uv}" != "pip" ] && [ -x "$venv/bin/uv" ]; then
-  exec "$venv/bin/uv" pip install -q --python "$py" "$@"
+  # Bytecode now, as pip does: uv skips it by default, and where PYTHONDONTWRITEBYTECODE is
+  # set every process would compile the modules it imports from source again.
+  exec "$venv/bin/uv" pip install -q --compile-bytecode --python "$py" "$@"
 fi
 "$py" -m pip install -q --disable-pip-version-check --upgrade pip
 exec "$py" -m pip install -q --disable-pip-version-check "$@"
