@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import ast
 import xml.etree.ElementTree as ET
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -80,15 +81,20 @@ def _modules(package: str) -> list[Path]:
     return sorted((PACKAGE_DIRS[package] / package).rglob('*.py'))
 
 
-def _imports(path: Path) -> set[str]:
-    """Absolute module names imported anywhere in ``path``."""
-    names: set[str] = set()
+def _import_statements(path: Path) -> Iterator[tuple[int, str, tuple[str, ...]]]:
+    """(level, module, imported names) of every import in ``path``, at any depth; level 0 is
+    an absolute import, and ``import a.b`` gives (0, 'a.b', ())."""
     for node in ast.walk(ast.parse(path.read_text(), filename=str(path))):
         if isinstance(node, ast.Import):
-            names.update(alias.name for alias in node.names)
-        elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
-            names.add(node.module)
-    return names
+            for alias in node.names:
+                yield 0, alias.name, ()
+        elif isinstance(node, ast.ImportFrom):
+            yield node.level, node.module or '', tuple(alias.name for alias in node.names)
+
+
+def _imports(path: Path) -> set[str]:
+    """Absolute module names imported anywhere in ``path``."""
+    return {module for level, module, _ in _import_statements(path) if level == 0 and module}
 
 
 def _module_file(name: str) -> Path | None:
@@ -119,19 +125,16 @@ def _imported_names(path: Path) -> set[str]:
     own = _module_name(path)
     package = (own if path.name == '__init__.py' else own.rpartition('.')[0]) if own else None
     names: set[str] = set()
-    for node in ast.walk(ast.parse(path.read_text(), filename=str(path))):
-        if isinstance(node, ast.Import):
-            names.update(alias.name for alias in node.names)
-        elif isinstance(node, ast.ImportFrom):
-            if node.level == 0:
-                base = node.module or ''
-            elif package:
-                anchor = package.split('.')[: len(package.split('.')) - node.level + 1]
-                base = '.'.join([*anchor, *([node.module] if node.module else [])])
-            else:
-                continue
-            names.add(base)
-            names.update(f'{base}.{alias.name}' for alias in node.names)
+    for level, module, imported in _import_statements(path):
+        if level == 0:
+            base = module
+        elif package:
+            anchor = package.split('.')[: len(package.split('.')) - level + 1]
+            base = '.'.join([*anchor, *([module] if module else [])])
+        else:
+            continue
+        names.add(base)
+        names.update(f'{base}.{name}' for name in imported)
     return names
 
 
