@@ -7,7 +7,8 @@ the planner), with the settings a spawned node gets. The world is the paper's mo
 gets its pose and a sample at every tick of the observation clock (t = k / f_Hz), a robot that
 reaches its waypoint gets a control tick, which decides (so decisions are asynchronous), and
 its :class:`~bayes_swarm.messages.PeerUpdate` is delivered at once to every robot within
-``comm_range_m`` unless dropped with probability ``loss_probability``. Detection is
+``comm_range_m`` unless dropped with probability ``loss_probability`` (the sim bridge's
+:class:`~swarm_sim.peer_relay.RelayModel`, seeded as the bridge seeds it). Detection is
 continuous: a mission succeeds at the first instant any robot comes within eps of the source
 along its straight leg. Glowworm robots take a sample and iterate at every tick of their
 decision clock (the observation clock runs at that rate for them, as the spawner sets it),
@@ -38,6 +39,7 @@ from bayes_swarm.settings import (
     LevyConfig,
 )
 from swarm_sim.faults import BODY_SENSOR_FAULTS, FaultConfig, FaultPlan
+from swarm_sim.peer_relay import RelayConfig, RelayModel
 from swarm_sim.point_robots import FieldFunction, PointRobotField
 
 __all__ = [
@@ -99,8 +101,8 @@ class MissionSpec:
         if self.noise_std < 0.0 or self.relative_noise < 0.0:
             msg = 'noise_std and relative_noise must be >= 0'
             raise ConfigError(msg)
-        if self.comm_range_m is not None and self.comm_range_m < 0.0:
-            msg = f'comm_range_m must be >= 0 or None, got {self.comm_range_m}'
+        if self.comm_range_m is not None and not self.comm_range_m > 0.0:
+            msg = f'comm_range_m must be > 0 or None, got {self.comm_range_m}'
             raise ConfigError(msg)
         if not 0.0 <= self.loss_probability <= 1.0:
             msg = f'loss_probability must be in [0, 1], got {self.loss_probability}'
@@ -319,32 +321,25 @@ def ros_time_s(time_s: float) -> float:
 
 # ----------------------------------------------------------------------- event loop
 def _deliver(
-    spec: MissionSpec,
+    relay: RelayModel,
     world: PointRobotField,
     robots: Sequence[RobotLink],
     sender: int,
     update: PeerUpdate | GlowwormBroadcast,
     time_s: float,
-    links: tuple[float | None, float, np.ndarray | None] | None = None,
+    dropped: np.ndarray,
 ) -> None:
-    """Deliver ``sender``'s update; ``links``: range [m] (None: unlimited), loss and the
-    dropped robots that receive nothing, when faults change them. Robot i is named
-    ``r{i}`` (:func:`run_mission`'s names)."""
-    comm_range_m, loss, dropped = links or (spec.comm_range_m, spec.loss_probability, None)
+    """Deliver ``sender``'s update to the receivers ``relay`` picks (range and loss, the
+    bridge's relay model), except the ``dropped`` robots, which receive nothing. Robot i is
+    named ``r{i}`` (:func:`run_mission`'s names)."""
     name = f'r{sender}'
-    for j, robot in enumerate(robots):
-        if j == sender or (dropped is not None and dropped[j]):
-            continue
-        if comm_range_m is not None:
-            gap = world.positions[j] - world.positions[sender]
-            if np.hypot(*gap) > comm_range_m:
-                continue
-        if loss > 0.0 and world.rng.uniform() < loss:
+    for j in relay.receivers(sender, world.positions).tolist():
+        if dropped[j]:
             continue
         if isinstance(update, PeerUpdate):
-            robot.peer(update, time_s)
+            robots[j].peer(update, time_s)
         else:
-            robot.glowworm_peer(name, update, time_s)
+            robots[j].glowworm_peer(name, update, time_s)
 
 
 def run_events(
@@ -377,17 +372,21 @@ def run_events(
     tick = 0
     t = 0.0
     plan = FaultPlan(spec.faults, n_robots, seed) if spec.faults.active else None
+    # The peer link as the sim bridge relays it: the same model on the same random stream,
+    # so a batch run and a spawned one drop the same deliveries.
+    relay = RelayModel.for_mission(
+        RelayConfig(
+            comm_range_m=math.inf if spec.comm_range_m is None else spec.comm_range_m,
+            loss_probability=spec.loss_probability,
+        ),
+        seed,
+        plan,
+    )
     # Faults: the dropout instant is an event; dropped robots stop, sample, decide and talk
     # no more; faulty sensors read what the plan says.
     dropout_s = math.inf if plan is None else plan.config.dropout_time_s
     dropped = np.zeros(n, dtype=bool)
     held: dict[int, float] = {}
-
-    def links() -> tuple[float | None, float, np.ndarray | None] | None:
-        if plan is None:
-            return None
-        comm_range_m = plan.combined_range_m(spec.comm_range_m)
-        return comm_range_m, plan.combined_loss(spec.loss_probability), dropped
 
     def sample_all() -> None:
         values = world.sample(world.positions)
@@ -411,7 +410,6 @@ def run_events(
         # Lockstep, as GSO is defined: every robot broadcasts its new luciferin, then every
         # robot picks its leader from the broadcasts of this iteration.
         stamp = ros_time_s(t)
-        link_state = links()
         moving: list[int] = []
         for i, robot in enumerate(robots):
             if dropped[i]:
@@ -422,7 +420,7 @@ def run_events(
             moving.append(i)
             if broadcast.index == 1:  # the end of the dispersal leg
                 world.trajectories[i].append(world.positions[i].copy())
-            _deliver(spec, world, robots, i, broadcast, stamp, link_state)
+            _deliver(relay, world, robots, i, broadcast, stamp, dropped)
         for i in moving:
             waypoint = robots[i].glowworm_move(stamp)
             if waypoint is None:
@@ -446,7 +444,7 @@ def run_events(
             yaws[i] = math.atan2(leg[1], leg[0])
         world.trajectories[i].append(world.positions[i].copy())
         if out.broadcast is not None:
-            _deliver(spec, world, robots, i, out.broadcast, stamp, links())
+            _deliver(relay, world, robots, i, out.broadcast, stamp, dropped)
 
     if dropout_s <= 0.0:
         drop_out()

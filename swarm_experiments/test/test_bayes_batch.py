@@ -4,10 +4,12 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+from bayes_swarm.controller import RobotController
 from bayes_swarm.errors import ConfigError
 from bayes_swarm.messages import DecisionKind
 from swarm_common.segments import first_entry_fraction
-from swarm_experiments.bayes_batch import run_mission
+from swarm_experiments.bayes_batch import ControllerLink, robot_settings, run_events, run_mission
+from swarm_sim.peer_relay import RelayConfig, RelayModel
 
 pytestmark = pytest.mark.runtime_independent(reason='the batch runner, no node')
 
@@ -71,7 +73,7 @@ def test_moving_the_field_changes_every_decision_after_the_first(case1_spec):
 
 
 def test_out_of_range_robots_hear_only_the_broadcasts_made_at_the_common_depot(case1_spec):
-    spec = replace(case1_spec, comm_range_m=0.0)
+    spec = replace(case1_spec, comm_range_m=1e-6)
     result = run_mission(spec, 'bayes_swarm_p', 3, seed=1, keep_planners=True)
     full = run_mission(case1_spec, 'bayes_swarm_p', 3, seed=1, keep_planners=True)
     for isolated in result.planners:
@@ -157,3 +159,69 @@ def test_glowworm_swarms_iterate_in_lockstep(case1_spec):
     for sequence in ticks.values():
         assert sequence == sorted(sequence)  # 'broadcast' < 'move'
         assert sequence.count('broadcast') == sequence.count('move')
+
+
+class _SampleLog(ControllerLink):
+    """A controller link that keeps every sample value its robot is given."""
+
+    def __init__(self, controller) -> None:
+        super().__init__(controller)
+        self.samples: list[tuple[float, float]] = []
+
+    def signal(self, value: float, time_s: float) -> None:
+        self.samples.append((time_s, value))
+        super().signal(value, time_s)
+
+
+def _first_leg_samples(spec, seed):
+    n = 5
+    links = [
+        _SampleLog(RobotController(robot_settings(spec, 'bayes_swarm_p', n, i, seed), f'r{i}'))
+        for i in range(n)
+    ]
+    run_events(spec, n, seed, links)
+    # The first leg is the fixed fan (1 m at V): what the robots measure on it does not
+    # depend on what they heard from each other.
+    leg_s = 1.0 / spec.planner.velocity_mps
+    return [[v for t, v in link.samples if t < leg_s] for link in links]
+
+
+def test_lost_peer_messages_do_not_change_the_measurement_noise(case1_spec):
+    # The relay draws its losses from its own random stream (as the sim bridge does), not
+    # from the world's noise stream: dropping messages leaves the noise of every sample as is.
+    noisy = replace(case1_spec, noise_std=0.05, stop_time_s=12.0)
+    clean_link = _first_leg_samples(noisy, seed=4)
+    lossy_link = _first_leg_samples(replace(noisy, loss_probability=0.5), seed=4)
+    assert min(map(len, clean_link)) >= 5
+    assert lossy_link == clean_link
+
+
+def test_a_lossy_link_drops_deliveries_as_the_bridge_relay_draws_them(case1_spec):
+    # Every robot's first plan is broadcast from the common depot at t = 0, so what each
+    # robot heard there is what RelayModel.for_mission of the mission seed picks, robot by
+    # robot, as the sim bridge relays it.
+    spec = replace(case1_spec, loss_probability=0.5, stop_time_s=0.05)
+    n, seed = 5, 11
+    heard: list[list[int]] = [[] for _ in range(n)]
+
+    class _PeerLog(ControllerLink):
+        def __init__(self, controller, index) -> None:
+            super().__init__(controller)
+            self.index = index
+
+        def peer(self, update, time_s: float) -> None:
+            heard[self.index].append(int(update.sender[1:]))
+            super().peer(update, time_s)
+
+    links = [
+        _PeerLog(RobotController(robot_settings(spec, 'bayes_swarm_p', n, i, seed), f'r{i}'), i)
+        for i in range(n)
+    ]
+    run_events(spec, n, seed, links)
+    relay = RelayModel.for_mission(RelayConfig(loss_probability=0.5), seed)
+    expected: list[list[int]] = [[] for _ in range(n)]
+    for sender in range(n):
+        for receiver in relay.receivers(sender, np.zeros((n, 2))).tolist():
+            expected[receiver].append(sender)
+    assert heard == expected
+    assert 0 < sum(map(len, heard)) < n * (n - 1)
