@@ -9,7 +9,11 @@ import math
 from typing import Any
 
 import numpy as np
-from swarm_common.angles import UNIT_QUATERNION_NORM_SQ_TOLERANCE, yaw_from_odometry_quaternion
+from swarm_common.angles import (
+    ODOM_QUATERNION_NORM_TOLERANCE,
+    UNIT_QUATERNION_NORM_SQ_TOLERANCE,
+    yaw_from_odometry_quaternion,
+)
 from swarm_common.stamps import stamp_from_seconds, stamp_to_seconds
 from swarm_runtime.ros import message_module
 
@@ -17,6 +21,7 @@ from bayes_swarm.errors import ObservationError
 from bayes_swarm.messages import Decision, PeerUpdate
 
 __all__ = [
+    'ODOM_QUATERNION_NORM_TOLERANCE',
     'UNIT_QUATERNION_NORM_SQ_TOLERANCE',
     'decision_to_state',
     'glowworm_peer_from_ros',
@@ -144,11 +149,14 @@ def odometry_to_pose(msg: Any) -> tuple[float, float, float]:
     """(x [m], y [m], yaw [rad]) of a nav_msgs/Odometry (planar yaw from the quaternion).
 
     A quaternion whose squared norm is off 1 by more than
-    :data:`UNIT_QUATERNION_NORM_SQ_TOLERANCE` is read as if normalised.
+    :data:`UNIT_QUATERNION_NORM_SQ_TOLERANCE` is read as if normalised, as long as its norm
+    is within :data:`ODOM_QUATERNION_NORM_TOLERANCE` of 1 (the MSC node reads odometry the
+    same way).
 
     Raises:
         ObservationError: the quaternion is zero (including one whose squared norm underflows)
-            or not finite: it has no orientation.
+            or not finite, so it has no orientation, or its norm is further than
+            :data:`ODOM_QUATERNION_NORM_TOLERANCE` from 1 (a broken publisher).
     """
     p = msg.pose.pose.position
     q = msg.pose.pose.orientation

@@ -151,13 +151,24 @@ def test_odometry_without_an_orientation_is_rejected(quaternion):
         odometry_to_pose(msg)
 
 
-def test_a_non_unit_odometry_quaternion_is_read_as_if_normalised_and_a_unit_one_as_before():
+def test_a_slightly_non_unit_odometry_quaternion_is_read_as_if_normalised():
     msg = message_module('nav_msgs').Odometry()
     o = msg.pose.pose.orientation
-    o.z, o.w = 1.0, 1.0
-    assert odometry_to_pose(msg)[2] == pytest.approx(math.pi / 2)
-    o.z, o.w = 0.0, 5.0
+    for scale in (0.95, 1.05, 1.0 + 1e-7):
+        o.z, o.w = scale * math.sin(0.4), scale * math.cos(0.4)
+        assert odometry_to_pose(msg)[2] == pytest.approx(0.8)
+    o.z, o.w = 0.0, 1.09
     assert odometry_to_pose(msg)[2] == 0.0
     for yaw in np.linspace(-3.1, 3.1, 41):
         o.z, o.w = math.sin(yaw / 2), math.cos(yaw / 2)
         assert odometry_to_pose(msg)[2] == yaw_from_unit_quaternion(0.0, 0.0, o.z, o.w)
+
+
+@pytest.mark.parametrize('quaternion', [(0, 0, 1, 1), (0, 0, 0, 5), (0, 0, 0.5, 0.5)])
+def test_an_odometry_quaternion_far_from_unit_is_rejected_as_the_msc_node_rejects_it(quaternion):
+    # A norm of sqrt(2), 5 or 1 / sqrt(2): no integrator drifts that far; a broken publisher.
+    msg = message_module('nav_msgs').Odometry()
+    o = msg.pose.pose.orientation
+    o.x, o.y, o.z, o.w = (float(v) for v in quaternion)
+    with pytest.raises(ObservationError, match='norm'):
+        odometry_to_pose(msg)

@@ -12,6 +12,7 @@ from collections.abc import Collection
 from typing import Any
 
 import numpy as np
+from swarm_common.angles import ODOM_QUATERNION_NORM_TOLERANCE
 from swarm_common.angles import yaw_from_odometry_quaternion as odometry_yaw
 from swarm_common.stamps import stamp_from_seconds, stamp_to_seconds
 
@@ -40,11 +41,6 @@ __all__ = [
 #: can make a receiver allocate.
 MAX_PEER_ARRAY_LENGTH = 256
 
-#: Largest accepted deviation of an odometry quaternion's norm from 1. Within it the
-#: quaternion is normalised; beyond it (a zero, tiny, huge or non-finite quaternion: a broken
-#: publisher) the odometry message is dropped, so the pose goes stale and the robot stops.
-ODOM_QUATERNION_NORM_TOLERANCE = 0.1
-
 
 def robot_id_from_name(name: str) -> int:
     """Numeric ID of a robot name such as 'r3' (or '/r3'); raises ValueError otherwise."""
@@ -66,13 +62,13 @@ def stamp_to_ros(time_s: float, builtin_interfaces: Any) -> Any:
 
 def yaw_from_odometry_quaternion(x: float, y: float, z: float, w: float) -> float:
     """Yaw [rad] of an odometry orientation, normalised when it is not unit
-    (:func:`swarm_common.angles.yaw_from_odometry_quaternion`).
+    (:func:`swarm_common.angles.yaw_from_odometry_quaternion`, the nodes' shared policy).
 
     Raises:
         ValueError: the quaternion is zero or not finite, or its norm is further than
-            :data:`ODOM_QUATERNION_NORM_TOLERANCE` from 1.
+            :data:`~swarm_common.angles.ODOM_QUATERNION_NORM_TOLERANCE` from 1.
     """
-    return odometry_yaw(x, y, z, w, max_norm_error=ODOM_QUATERNION_NORM_TOLERANCE)
+    return odometry_yaw(x, y, z, w)
 
 
 def pose_from_odometry(msg: Any) -> tuple[float, float, float]:

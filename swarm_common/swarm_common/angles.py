@@ -8,6 +8,7 @@ from typing import overload
 import numpy as np
 
 __all__ = [
+    'ODOM_QUATERNION_NORM_TOLERANCE',
     'TWO_PI',
     'UNIT_QUATERNION_NORM_SQ_TOLERANCE',
     'wrap_angle',
@@ -21,6 +22,12 @@ TWO_PI = 2.0 * math.pi
 #: A quaternion whose squared norm is within this of 1 counts as unit (float32 fields hold
 #: about seven digits).
 UNIT_QUATERNION_NORM_SQ_TOLERANCE = 1e-6
+#: Largest accepted deviation of an odometry quaternion's norm from 1 (the nodes' shared
+#: policy). Within it the quaternion is read as if normalised (float32 fields and integrated
+#: orientations drift off unit a little); beyond it (a tiny, huge, zero or non-finite
+#: quaternion: a broken publisher) the reader raises, the node drops the message, its pose
+#: goes stale and the robot stops.
+ODOM_QUATERNION_NORM_TOLERANCE = 0.1
 
 
 @overload
@@ -65,7 +72,12 @@ def yaw_from_quaternion(x: float, y: float, z: float, w: float) -> float:
 
 
 def yaw_from_odometry_quaternion(
-    x: float, y: float, z: float, w: float, *, max_norm_error: float | None = None
+    x: float,
+    y: float,
+    z: float,
+    w: float,
+    *,
+    max_norm_error: float | None = ODOM_QUATERNION_NORM_TOLERANCE,
 ) -> float:
     """Yaw [rad] of an odometry orientation (x, y, z, w), read as normalised if it is not unit.
 
@@ -73,8 +85,9 @@ def yaw_from_odometry_quaternion(
     :func:`yaw_from_unit_quaternion`, any other the scale-free :func:`yaw_from_quaternion`.
 
     Raises:
-        ValueError: a zero or non-finite quaternion (no orientation), or, with
-            ``max_norm_error``, one whose norm is further than that from 1.
+        ValueError: a zero or non-finite quaternion (no orientation), or one whose norm is
+            further than ``max_norm_error`` from 1 (default
+            :data:`ODOM_QUATERNION_NORM_TOLERANCE`; None accepts any other scale).
     """
     x, y, z, w = float(x), float(y), float(z), float(w)
     norm_sq = x * x + y * y + z * z + w * w

@@ -7,7 +7,9 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 from swarm_common.angles import (
+    ODOM_QUATERNION_NORM_TOLERANCE,
     wrap_angle,
+    yaw_from_odometry_quaternion,
     yaw_from_quaternion,
     yaw_from_unit_quaternion,
     yaw_to_quaternion,
@@ -64,3 +66,19 @@ def test_unnormalised_quaternions_keep_their_yaw_and_zero_ones_are_rejected():
         yaw_from_quaternion(0.0, 0.0, 0.0, 0.0)
     with pytest.raises(ValueError, match='no orientation'):
         yaw_from_quaternion(math.nan, 0.0, 0.0, 1.0)
+
+
+@given(
+    yaw=st.floats(-math.pi, math.pi),
+    scale=st.floats(0.5, 2.0).filter(lambda s: abs(s - 1.0) > ODOM_QUATERNION_NORM_TOLERANCE),
+)
+def test_odometry_reader_normalises_near_unit_quaternions_and_rejects_far_ones(yaw, scale):
+    z, w = math.sin(yaw / 2), math.cos(yaw / 2)
+    near = 1.0 + 0.9 * ODOM_QUATERNION_NORM_TOLERANCE * math.copysign(1.0, scale - 1.0)
+    got = yaw_from_odometry_quaternion(0.0, 0.0, near * z, near * w)
+    assert got == pytest.approx(yaw_from_unit_quaternion(0.0, 0.0, z, w), abs=1e-12)
+    with pytest.raises(ValueError, match='norm'):
+        yaw_from_odometry_quaternion(0.0, 0.0, scale * z, scale * w)
+    # Without the bound any non-zero scale is read as if normalised.
+    free = yaw_from_odometry_quaternion(0.0, 0.0, scale * z, scale * w, max_norm_error=None)
+    assert free == pytest.approx(got, abs=1e-12)
