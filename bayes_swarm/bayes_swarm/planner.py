@@ -225,19 +225,33 @@ class BayesSwarmPlanner:
         :data:`PEER_ARENA_MARGIN_FRACTION` of its diagonal; the sample arrays must match.
         (Single implausible samples and weaker sources are dropped by :meth:`receive`.)
         """
+        checked = self._checked_peer(update)
+        return checked if isinstance(checked, str) else ''
+
+    def _checked_peer(
+        self, update: PeerUpdate
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | str:
+        """``update``'s position, waypoint and the samples :meth:`receive` keeps (each
+        array read once), or why it is malformed (:meth:`peer_update_defect`)."""
+        lower, upper = self._peer_region()
         try:
             position = np.asarray(update.position_m, dtype=float).reshape(2)
             waypoint = np.asarray(update.waypoint_m, dtype=float).reshape(2)
-            finite_samples(update.sample_points_m, update.sample_values)
+            pts, vals = finite_samples(
+                update.sample_points_m,
+                update.sample_values,
+                max_abs_value=self._max_abs_signal,
+                lower_m=lower,
+                upper_m=upper,
+            )
         except (ValueError, TypeError) as err:
             return f'malformed arrays ({err})'
         if not (np.all(np.isfinite(position)) and np.all(np.isfinite(waypoint))):
             return 'position or waypoint not finite'
-        lower, upper = self._peer_region()
         for name, point in (('position', position), ('waypoint', waypoint)):
             if np.any(point < lower) or np.any(point > upper):
                 return f'{name} {point.tolist()} m far outside the arena'
-        return ''
+        return position, waypoint, pts, vals
 
     def receive(self, update: PeerUpdate) -> bool:
         """RECEIVEINFORMATION: merge a peer's broadcast; False if it was ignored.
@@ -256,19 +270,12 @@ class BayesSwarmPlanner:
         last = self._peer_last_index.get(update.sender)
         if last is not None and last - PEER_INDEX_REORDER_WINDOW <= index <= last:
             return False
-        if self.peer_update_defect(update):
+        checked = self._checked_peer(update)
+        if isinstance(checked, str):
             self.rejected_peer_updates += 1
             return False
-        position = np.asarray(update.position_m, dtype=float).reshape(2)
-        waypoint = np.asarray(update.waypoint_m, dtype=float).reshape(2)
+        position, waypoint, pts, vals = checked
         lower, upper = self._peer_region()
-        pts, vals = finite_samples(
-            update.sample_points_m,
-            update.sample_values,
-            max_abs_value=self._max_abs_signal,
-            lower_m=lower,
-            upper_m=upper,
-        )
         self._peer_last_index[update.sender] = index
         self._data.extend(pts, vals)
         self._peer_plans[update.sender] = (position, waypoint)
