@@ -14,6 +14,10 @@ profiles are this project's departures, each listed in docs/bayes_swarm.md.
   robot's belief at every decision as in Gonzalez et al.'s local penalization (M the largest
   observation, L the largest gradient norm of the GP mean over the arena), instead of the
   fixed values.
+* ``estimated-penalty-log``: ``estimated-penalty`` with the acquisition and the penalty
+  combined in log space (log g + sum of log phi, GPyOpt's form of local penalization): the
+  same argmax in exact arithmetic, but COBYLA no longer stalls where the product of many
+  peers' factors underflows (Case 3's 47 peers).
 * ``weaker-within-eps``: the paper's solvers, L, M and T_max; Algorithm 2 lowers alpha to
   0.1 only when the expected source lies within eps of a known weaker source (the disc its
   robot searched and found empty), instead of within a squared distance of 2 l_robot
@@ -53,6 +57,11 @@ PROFILES: dict[str, Profile] = {
             'estimated-penalty',
             "the paper's solvers; L and M estimated from the belief GP (local penalization)",
             {'penalty_estimate': True},
+        ),
+        Profile(
+            'estimated-penalty-log',
+            'as estimated-penalty, acquisition and penalty combined in log space',
+            {'penalty_estimate': True, 'penalty_log_space': True},
         ),
         Profile(
             'weaker-within-eps',
