@@ -34,6 +34,7 @@ setup(
         'dask',
         'distributed',
         'rich',
+        'threadpoolctl',
         'swarm_common',
         'swarm_runtime',
         'swarm_analysis',

@@ -31,6 +31,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     'ReportPage',
+    'blas_setups',
     'markdown_table',
     'paired_differences',
     'reference_table',
@@ -47,6 +48,13 @@ MAX_LINES = 12
 MAX_BARS = 40
 #: The exported tables of a study, beside its report.md.
 RESULTS_NAME = 'results.json'
+
+
+def blas_setups(rows: pd.DataFrame) -> list[str]:
+    """The distinct ``blas`` values of the rows, sorted (rows from before the column: none)."""
+    if 'blas' not in rows:
+        return []
+    return sorted(str(value) for value in rows['blas'].dropna().unique())
 
 
 def _short(column: str) -> str:
@@ -455,6 +463,16 @@ def _generic_sections(page: ReportPage) -> None:
             if column in page.rows:
                 values = sorted(str(v) for v in page.rows[column].dropna().unique())
                 lines.append(f'- {label}: {", ".join(values)}')
+        setups = blas_setups(page.rows)
+        if setups:
+            lines.append(f'- BLAS: {" | ".join(setups)}')
+        if len(setups) > 1:
+            lines.append(
+                f'- **the rows ran on {len(setups)} BLAS setups**: another kernel rounds '
+                'the last bits of linear algebra differently, and a run that hinges on a '
+                'close decision (a Gaussian-process planner) can come out otherwise; give '
+                'every worker the same kernel (OPENBLAS_CORETYPE) for rows that must agree'
+            )
     axes = manifest.get('axes', {})
     if axes:
         lines.append('- axes: ' + '; '.join(f'{k} = {v}' for k, v in axes.items()))
@@ -569,5 +587,6 @@ def results_document(page: ReportPage, report_command: str | None = None) -> dic
         'runs_failed': len(page.all_rows) - len(rows),
         'cpu_s': round(float(rows['cpu_s'].sum()), 1) if 'cpu_s' in rows else None,
         'code_versions': versions,
+        'blas': blas_setups(rows),
         'tables': page.exports,
     }

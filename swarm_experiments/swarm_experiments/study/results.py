@@ -14,6 +14,7 @@ Row schema (one row per run; see docs/studies.md):
 ``error``          one line (``Type: message``) for a failed run, else null
 ``traceback``      the failed run's traceback, else null
 ``code_version``   ``git describe`` of the code that ran (or the package version)
+``blas``           the BLAS libraries and kernels of the process (:func:`~.version.blas_kernels`)
 ``engine``         ``serial``, ``pool`` or ``dask``
 ``host`` ``pid``   where it ran
 ``cpu_s``          CPU seconds of the process during the run
@@ -48,6 +49,7 @@ import pyarrow.parquet as pq
 
 from .errors import ResultsError, StudyDefinitionError
 from .spec import RunSpec, flatten
+from .version import blas_kernels
 
 __all__ = [
     'MANIFEST_NAME',
@@ -62,7 +64,16 @@ __all__ = [
 ]
 
 #: Columns that depend on where and when a run executed, not on its spec.
-VOLATILE_COLUMNS = ('engine', 'host', 'pid', 'cpu_s', 'wall_s', 'started_utc', 'traceback')
+VOLATILE_COLUMNS = (
+    'engine',
+    'host',
+    'pid',
+    'cpu_s',
+    'wall_s',
+    'started_utc',
+    'traceback',
+    'blas',
+)
 MANIFEST_NAME = 'study.json'
 LOCK_NAME = '.lock'
 
@@ -148,6 +159,7 @@ def execute(
         wall_s=time.perf_counter() - wall_start,
         started_utc=started,
     )
+    row['blas'] = blas_kernels()
     return row
 
 

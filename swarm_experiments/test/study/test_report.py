@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import math
 import warnings
 from pathlib import Path
@@ -72,6 +73,34 @@ def test_the_page_tables_mean_std_count_per_configuration(tmp_path: Path) -> Non
     for name in figures:
         assert (directory / 'figures' / name).read_bytes().startswith(PNG)
         assert f'(figures/{name})' in page
+
+
+def test_the_page_names_the_blas_setups_and_warns_when_the_rows_mix_them(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    kernel = ['openblas 0.3.30 Haswell']
+    monkeypatch.setattr('swarm_experiments.study.results.blas_kernels', lambda: kernel[0])
+
+    def export(page: ReportPage) -> None:  # results.json holds studies that export a table
+        table = summary_table(page.rows, 'metric.coverage', ['config.variant'])
+        page.add_table(table, title='coverage', export='coverage')
+
+    study = search_study(report=export)
+    with make_engine('serial') as engine:
+        run_study(make_specs(study, runs=2), tmp_path, engine, code_version='v')
+    page = write_reports(tmp_path)[0].read_text()
+    assert '- BLAS: openblas 0.3.30 Haswell\n' in page
+    assert 'BLAS setups' not in page
+    # The study resumed where OpenBLAS picked another kernel for the CPU.
+    kernel[0] = 'openblas 0.3.30 Sandybridge'
+    with make_engine('serial') as engine:
+        run_study(make_specs(study, runs=3), tmp_path, engine, code_version='v')
+    (page_path,) = write_reports(tmp_path, StudyRegistry([study]))
+    page = page_path.read_text()
+    assert '- BLAS: openblas 0.3.30 Haswell | openblas 0.3.30 Sandybridge\n' in page
+    assert '**the rows ran on 2 BLAS setups**' in page
+    document = json.loads((page_path.parent / 'results.json').read_text())
+    assert document['blas'] == ['openblas 0.3.30 Haswell', 'openblas 0.3.30 Sandybridge']
 
 
 def test_a_hook_adds_its_own_sections_with_paper_numbers(tmp_path: Path) -> None:

@@ -3,13 +3,22 @@
 from __future__ import annotations
 
 import os
+import platform
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 import pytest
 from study_fixtures import search_study
-from swarm_experiments.study import ResultsError, RunSpec, make_specs, read_rows
+from swarm_experiments.study import (
+    VOLATILE_COLUMNS,
+    ResultsError,
+    RunSpec,
+    make_specs,
+    read_rows,
+)
 from swarm_experiments.study.results import (
     PartWriter,
     done_run_ids,
@@ -17,6 +26,7 @@ from swarm_experiments.study.results import (
     read_manifest,
     study_lock,
 )
+from swarm_experiments.study.version import blas_kernels
 
 
 def _spec(**config_changes: object) -> RunSpec:
@@ -50,6 +60,34 @@ def test_a_row_has_the_config_params_metrics_series_and_bookkeeping() -> None:
     assert row['pid'] == os.getpid()
     assert row['cpu_s'] >= 0
     assert row['wall_s'] >= 0
+
+
+def test_a_row_records_the_blas_kernels_of_its_process_as_a_volatile_column() -> None:
+    row = execute(search_study().run, _spec(), 'v1', 'serial')
+    assert row['blas'] == blas_kernels()
+    assert row['blas'] != 'unknown', 'numpy links a BLAS'
+    assert 'blas' in VOLATILE_COLUMNS
+
+
+def _kernels_in_a_process(environment: dict[str, str]) -> str:
+    code = 'from swarm_experiments.study.version import blas_kernels; print(blas_kernels())'
+    return subprocess.run(
+        [sys.executable, '-c', code],
+        env={**os.environ, **environment},
+        capture_output=True,
+        text=True,
+        check=True,
+        timeout=120,
+    ).stdout.strip()
+
+
+def test_the_blas_column_names_the_kernel_openblas_was_made_to_use() -> None:
+    if 'openblas' not in blas_kernels() or platform.machine() != 'x86_64':
+        pytest.skip('needs the dynamic-architecture OpenBLAS of the x86-64 numpy wheels')
+    forced = _kernels_in_a_process({'OPENBLAS_CORETYPE': 'Nehalem'})
+    entries = forced.split('; ')
+    assert all(entry.startswith('openblas ') for entry in entries), forced
+    assert all(entry.endswith(' Nehalem') for entry in entries), forced
 
 
 def test_an_exception_in_the_run_gives_a_failed_row_with_one_line() -> None:
