@@ -129,7 +129,11 @@ def render_region(name: str, document: Mapping[str, Any], source: str) -> str:
         facts += f', {failed} failed'
     if cpu is not None:
         facts += f', {cpu:.0f} CPU s'
-    lines += ['', f'_{facts}; code version {versions}._', '']
+    facts += f'; code version {versions}'
+    setups = document.get('blas') or []
+    if setups:  # results stored before rows recorded their BLAS have none
+        facts += f'; BLAS {" | ".join(setups)}'
+    lines += ['', f'_{facts}._', '']
     if table.get('title'):
         lines += [f'**{table["title"]}**', '']
     lines.append(render_cells(table))

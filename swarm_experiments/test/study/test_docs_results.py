@@ -71,10 +71,15 @@ def test_a_region_is_rewritten_from_the_store_and_check_sees_stale_text(
     assert f'swarm_study report {out}\n```' in new
     assert '| variant | mean | std | count |' in new
     assert 'from store/synthetic-search.json' in new
+    (setup,) = read_rows(out / 'synthetic-search')['blas'].unique()
+    assert f'; BLAS {setup}._' in new
     # Regenerating the generated text changes nothing; new rows change it.
     assert update_text(new, documents, page='p.md', store_label='store') == new
     documents['synthetic-search']['tables']['coverage']['rows'][0][1] = '0.000'
     assert update_text(new, documents, page='p.md', store_label='store') != new
+    # Results stored before the rows recorded their BLAS name none.
+    del documents['synthetic-search']['blas']
+    assert 'BLAS' not in update_text(new, documents, page='p.md', store_label='store')
 
 
 def test_markers_inside_code_blocks_are_examples_not_regions() -> None:
