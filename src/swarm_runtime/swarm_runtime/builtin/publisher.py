@@ -48,8 +48,8 @@ class Publisher:
         msg_type: type,
         topic: str,
         qos_profile: QoSProfile,
-        event_callbacks: Any = None,
-        callback_group: Any = None,
+        event_callbacks: Any,
+        callback_group: Any,
     ) -> None:
         self.msg_type = msg_type
         self.topic = topic

@@ -65,7 +65,7 @@ class Subscription:
         callback_group: Any,
         qos_profile: QoSProfile,
         raw: bool,
-        event_callbacks: Any = None,
+        event_callbacks: Any,
     ) -> None:
         self.msg_type = msg_type
         self.topic = topic

@@ -218,7 +218,7 @@ class Timer:
 class Rate:
     """Not provided: ``Rate.sleep()`` blocks, which would stall the single-threaded simulation."""
 
-    def __init__(self, *args: Any, **kwargs: Any) -> None:
+    def __init__(self, timer: Any, *, context: Any) -> None:
         raise BuiltinRuntimeUnsupported(
             'rclpy Rate (node.create_rate) blocks in sleep(), which would stall the built-in '
             "runtime's single-threaded simulation; use node.create_timer instead"

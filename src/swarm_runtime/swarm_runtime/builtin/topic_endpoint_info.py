@@ -45,6 +45,7 @@ class TopicEndpointInfo:
 
     def __init__(
         self,
+        *,
         node_name: str = '',
         node_namespace: str = '',
         topic_type: str = '',
