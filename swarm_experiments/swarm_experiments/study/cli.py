@@ -33,7 +33,7 @@ from .projection import (
     costs_for_plan,
     project_wall_time,
 )
-from .report import study_directories, write_reports
+from .report import blas_setups, study_directories, write_reports
 from .results import read_manifest, read_rows
 from .runner import run_study
 from .spec import StudyPlan, make_specs, parse_overrides
@@ -251,6 +251,14 @@ def _run_plan(plan: StudyPlan, args: argparse.Namespace, terminated: Sequence[in
         f'already stored, {summary.unfinished} not run of {summary.planned}; '
         f'rows in {summary.directory}'
     )
+    setups = blas_setups(read_rows(summary.directory))
+    if len(setups) > 1:
+        print(
+            f'{PROG}: warning: the rows in {summary.directory} ran on {len(setups)} BLAS '
+            f'setups ({" | ".join(setups)}); a run that hinges on a close decision can '
+            'come out otherwise on another',
+            file=sys.stderr,
+        )
     if summary.interrupted and terminated:
         print(f'{PROG}: stopped by SIGTERM; run the same command again to resume', file=sys.stderr)
         return EXIT_TERMINATED

@@ -51,6 +51,24 @@ def test_run_then_rerun_skips_everything(
     assert len(read_rows(tmp_path / 'synthetic-search-smoke')) == 6
 
 
+def test_a_study_resumed_under_another_blas_kernel_warns_in_one_line(
+    registry: StudyRegistry,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    kernel = ['openblas 0.3.30 Haswell']
+    monkeypatch.setattr('swarm_experiments.study.results.blas_kernels', lambda: kernel[0])
+    argv = ['run', 'synthetic-search', '--engine', 'serial', '--quiet', '--out', str(tmp_path)]
+    assert _run(registry, *argv, '--sites', '1') == 0
+    assert 'BLAS' not in capsys.readouterr().err
+    kernel[0] = 'openblas 0.3.30 Sandybridge'
+    assert _run(registry, *argv, '--sites', '2') == 0
+    (warning,) = capsys.readouterr().err.splitlines()
+    assert warning.startswith('swarm_study: warning: the rows in ')
+    assert 'ran on 2 BLAS setups (openblas 0.3.30 Haswell | openblas 0.3.30 Sandybridge)' in warning
+
+
 def test_sites_and_set_shape_the_study(registry: StudyRegistry, tmp_path: Path) -> None:
     argv = [
         'run',
