@@ -113,7 +113,8 @@ def _start(executable: Executable, namespace: str) -> subprocess.Popen[str]:
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
-        env={**os.environ, 'PYTHONUNBUFFERED': '1'},
+        # faulthandler dumps every thread's stack on SIGABRT: what a hung stop waits for.
+        env={**os.environ, 'PYTHONUNBUFFERED': '1', 'PYTHONFAULTHANDLER': '1'},
     )
 
 
@@ -122,8 +123,12 @@ def _failure(executable: Executable, child: subprocess.Popen[str], signum: signa
     try:
         stdout, stderr = child.communicate(timeout=30.0)
     except subprocess.TimeoutExpired:
-        child.kill()
-        stdout, stderr = child.communicate()
+        child.send_signal(signal.SIGABRT)  # the stacks of its threads, then the end
+        try:
+            stdout, stderr = child.communicate(timeout=10.0)
+        except subprocess.TimeoutExpired:
+            child.kill()
+            stdout, stderr = child.communicate()
         return f'{signum.name}: did not exit within 30 s\n{stderr}'
     if child.returncode != 0 or 'Traceback' in stderr or 'Exception ignored' in stderr:
         return f'{signum.name}: exit status {child.returncode}\n{stderr}'
