@@ -17,6 +17,12 @@ loop and controller; cProfile inflates the Python-heavy parts, this does not, bu
 timers cost a little of their own). ``--repeat N`` runs every site N times on both
 simulators (alternating) and keeps each one's least CPU time: on a machine shared with
 other jobs, the least time of a few runs is the one least disturbed by them.
+
+Both simulators end a run when every room is covered, so a configuration whose robots leave a
+room unfound longer (or never) runs longer in both and the ratio mixes the simulators' speed
+with the robots' search. ``--full-budget`` runs every mission to the end of its budget in
+both (the grid's action budget, our sim-time budget, the Table II budget in each) and so
+compares the cost of simulating the same mission length.
 """
 
 from __future__ import annotations
@@ -34,9 +40,19 @@ from typing import Any
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 
-def _ours(site: int, config: str, variant: str, departure: str, robots: int, profile: str):
-    from swarm_experiments.oabug_batch import run_spawn_batch
-    from swarm_experiments.spawn import SpawnSettings
+def _ours(
+    site: int,
+    config: str,
+    variant: str,
+    departure: str,
+    robots: int,
+    profile: str,
+    full_budget: bool = False,
+):
+    import dataclasses
+
+    from swarm_experiments.oabug_batch import run_oabug_batch
+    from swarm_experiments.spawn import SpawnSettings, run
 
     settings = SpawnSettings(
         site=config,
@@ -47,7 +63,15 @@ def _ours(site: int, config: str, variant: str, departure: str, robots: int, pro
         seed=site,
         profile=profile,
     )
-    return run_spawn_batch(settings)
+    if not full_budget:
+        return run(settings, runner=run_oabug_batch)
+
+    def whole_budget(spec: Any, **kwargs: Any) -> Any:
+        return run_oabug_batch(
+            dataclasses.replace(spec, stop_when_all_rooms_covered=False), **kwargs
+        )
+
+    return run(settings, runner=whole_budget)
 
 
 # The parts --breakdown times: (label, module, class or None, function), nested parts
@@ -111,6 +135,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         '--repeat', type=int, default=1, help='runs per site and simulator; the least CPU counts'
     )
     parser.add_argument('--breakdown', action='store_true', help='time the parts of our runs')
+    parser.add_argument(
+        '--full-budget',
+        action='store_true',
+        help='run every mission to the end of its budget (no stop when all rooms are covered)',
+    )
     args = parser.parse_args(argv)
     if not args.ours_only and args.simulator is None:
         parser.error('give --simulator DIR or --ours-only')
@@ -134,21 +163,31 @@ def main(argv: Sequence[str] | None = None) -> int:
     ours_cpu: list[float] = []
     grid_cpu: list[float] = []
     ours_cov: list[float] = []
+    ours_sim_s: list[float] = []  # mission length [s of sim time]
     ours_timed = 0.0  # CPU of all our runs, repeats included
     grid_cov: list[float] = []
+    grid_actions: list[int] = []  # mission length [actions per robot]
     for site in range(args.first_site, args.first_site + args.sites):
         grid_times: list[float] = []
         ours_times: list[float] = []
         for _ in range(args.repeat):
             if grid is not None:
                 start = time.process_time()
-                run = grid.run(site, args.variant, args.departure, args.robots)
+                run = grid.run(
+                    site, args.variant, args.departure, args.robots, full_budget=args.full_budget
+                )
                 grid_times.append(time.process_time() - start)
             start = time.process_time()
             if profiler is not None:
                 profiler.enable()
             result = _ours(
-                site, args.config, args.variant, args.departure, args.robots, args.oabug_profile
+                site,
+                args.config,
+                args.variant,
+                args.departure,
+                args.robots,
+                args.oabug_profile,
+                args.full_budget,
             )
             if profiler is not None:
                 profiler.disable()
@@ -156,28 +195,37 @@ def main(argv: Sequence[str] | None = None) -> int:
         if grid is not None:
             grid_cpu.append(min(grid_times))
             grid_cov.append(run.coverage_pct)
+            grid_actions.append(run.actions)
         ours_cpu.append(min(ours_times))
         ours_timed += sum(ours_times)
         ours_cov.append(100.0 * result.coverage)
-        line = f'site {site}: ours {ours_cpu[-1]:.3f} CPU s ({ours_cov[-1]:.1f} %)'
+        ours_sim_s.append(result.mission.sim_time_s)
+        line = (
+            f'site {site}: ours {ours_cpu[-1]:.3f} CPU s ({ours_cov[-1]:.1f} %, '
+            f'{ours_sim_s[-1]:.0f} s)'
+        )
         if grid is not None:
-            line += f', grid {grid_cpu[-1]:.3f} CPU s ({grid_cov[-1]:.1f} %)'
+            line += f', grid {grid_cpu[-1]:.3f} CPU s ({grid_cov[-1]:.1f} %, {run.actions} actions)'
         print(line, flush=True)
     what = (
         f'{args.config}, {args.variant}, {args.robots} robots from the {args.departure}, '
         f'{args.sites} sites from {args.first_site}, profile {args.oabug_profile}'
     )
+    if args.full_budget:
+        what += ', every run to the end of its budget'
     if args.repeat > 1:
         what += f', least CPU of {args.repeat} runs each'
     print(f'\n{what}')
     print(
         f'ours: {statistics.mean(ours_cpu):.3f} CPU s per run (median '
-        f'{statistics.median(ours_cpu):.3f}), coverage {statistics.mean(ours_cov):.1f} %'
+        f'{statistics.median(ours_cpu):.3f}), coverage {statistics.mean(ours_cov):.1f} %, '
+        f'{statistics.mean(ours_sim_s):.0f} s of sim time'
     )
     if grid is not None:
         print(
             f'grid: {statistics.mean(grid_cpu):.3f} CPU s per run (median '
-            f'{statistics.median(grid_cpu):.3f}), coverage {statistics.mean(grid_cov):.1f} %'
+            f'{statistics.median(grid_cpu):.3f}), coverage {statistics.mean(grid_cov):.1f} %, '
+            f'{statistics.mean(grid_actions):.0f} actions'
         )
         print(
             f'ratio ours / grid: {sum(ours_cpu) / sum(grid_cpu):.2f} (sum of CPU), '

@@ -170,8 +170,14 @@ class GridSimulator:
                 raise RuntimeError(msg)
         return self._sites[site]
 
-    def run(self, site: int, variant: str, departure: str, robots: int) -> GridRun:
-        """One search run; coverage in percent of the rooms generated."""
+    def run(
+        self, site: int, variant: str, departure: str, robots: int, *, full_budget: bool = False
+    ) -> GridRun:
+        """One search run; coverage in percent of the rooms generated.
+
+        The run ends when every room is covered or the action budget is spent; with
+        ``full_budget`` only the budget ends it.
+        """
         start = time.perf_counter()
         seed, generated = self._site(site)
         edge = departure == 'edge'
@@ -186,7 +192,7 @@ class GridSimulator:
             act_after_finding_injury=False,
         )
         recent: list[list[tuple[int, int]]] = []
-        while not (layout or manager.action_count >= self.config.actions):
+        while not ((not full_budget and layout) or manager.action_count >= self.config.actions):
             manager.update()
             recent.append([tuple(robot.position) for robot in manager.robots])
             del recent[:-LOCK_WINDOW_ACTIONS]

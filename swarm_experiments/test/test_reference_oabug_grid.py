@@ -76,3 +76,57 @@ def test_a_missing_simulator_checkout_is_a_clear_usage_error(grid, tmp_path, cap
     err = capsys.readouterr().err
     assert err.count('\n') == 1
     assert 'no SwarmSearchSimulation checkout' in err
+
+
+class _Layout:
+    """Every room covered once ``covered_after`` actions have run."""
+
+    def __init__(self, manager_box: list, covered_after: int) -> None:
+        self.manager_box, self.covered_after = manager_box, covered_after
+
+    def __bool__(self) -> bool:
+        return self.manager_box[0].action_count >= self.covered_after
+
+    def report(self) -> tuple[int, ...]:
+        return (4 if self else 3,)
+
+
+class _Manager:
+    def __init__(self) -> None:
+        self.action_count = 0
+        self.robots = [_Robot()]
+        self.robots[0].position = (0, 0)
+
+    def update(self) -> None:
+        self.action_count += 1
+
+
+def _fake_simulator(grid, covered_after: int):
+    """A GridSimulator whose modules are stand-ins: rooms all covered after N actions."""
+    from types import SimpleNamespace
+
+    simulator = object.__new__(grid.GridSimulator)
+    simulator.config = grid.GridConfig(60, 30, 4, 0, 50)
+    simulator.robot_hit_turn = 'right'
+    simulator._sites = {0: (grid.site_seed(0), SimpleNamespace(room_cnt=4))}
+    simulator._robots = dict.fromkeys(grid.VARIANTS)
+    box: list = []
+
+    def manager(*_args, **_kwargs):
+        box.append(_Manager())
+        return box[0]
+
+    simulator._manager = manager
+    simulator._layout = SimpleNamespace(
+        from_generator=lambda *_args, **_kwargs: _Layout(box, covered_after)
+    )
+    return simulator
+
+
+def test_a_run_ends_when_every_room_is_covered_unless_the_whole_budget_is_asked_for(grid):
+    early = _fake_simulator(grid, covered_after=20).run(0, 'gas', 'edge', 1)
+    assert (early.actions, early.coverage_pct) == (20, 100.0)
+    whole = _fake_simulator(grid, covered_after=20).run(0, 'gas', 'edge', 1, full_budget=True)
+    assert (whole.actions, whole.coverage_pct) == (50, 100.0)
+    short = _fake_simulator(grid, covered_after=80).run(0, 'gas', 'edge', 1)
+    assert (short.actions, short.coverage_pct) == (50, 75.0)
