@@ -51,7 +51,7 @@ def _ours(
 ):
     import dataclasses
 
-    from swarm_experiments.oabug_batch import run_oabug_batch
+    from swarm_experiments.oabug_batch import run_oabug_batch, run_spawn_batch
     from swarm_experiments.spawn import SpawnSettings, run
 
     settings = SpawnSettings(
@@ -64,7 +64,7 @@ def _ours(
         profile=profile,
     )
     if not full_budget:
-        return run(settings, runner=run_oabug_batch)
+        return run_spawn_batch(settings)
 
     def whole_budget(spec: Any, **kwargs: Any) -> Any:
         return run_oabug_batch(
@@ -205,7 +205,10 @@ def main(argv: Sequence[str] | None = None) -> int:
             f'{ours_sim_s[-1]:.0f} s)'
         )
         if grid is not None:
-            line += f', grid {grid_cpu[-1]:.3f} CPU s ({grid_cov[-1]:.1f} %, {run.actions} actions)'
+            line += (
+                f', grid {grid_cpu[-1]:.3f} CPU s ({grid_cov[-1]:.1f} %, '
+                f'{grid_actions[-1]} actions)'
+            )
         print(line, flush=True)
     what = (
         f'{args.config}, {args.variant}, {args.robots} robots from the {args.departure}, '
